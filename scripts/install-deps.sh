@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# Installs every Debian 12 package kinograph builds, tests or benchmarks with.
+# Idempotent: packages already present are skipped; apt runs only when something is missing.
+set -euo pipefail
+
+PACKAGES=(
+  # toolchain
+  cmake ninja-build pkg-config g++ git
+  # messaging
+  liblcm-dev liblcm-bin libglib2.0-dev
+  # numerics, collision, models, meshes
+  libeigen3-dev libsuitesparse-dev libbullet-dev liburdfdom-dev libassimp-dev
+  # rendering and plots
+  libosmesa6-dev libpng-dev libfreetype-dev fonts-dejavu-core
+  # tools, config, logging
+  nlohmann-json3-dev libyaml-cpp-dev libcli11-dev libspdlog-dev
+  # tests and benchmarks (KDL and Ceres are test/bench-only oracles; OMPL for the SST baseline)
+  libgtest-dev libgmock-dev libbenchmark-dev liborocos-kdl-dev libceres-dev libompl-dev
+  # third-party URDFs with real meshes for renderer tests
+  dart-doc
+  # network namespaces for LCM multicast tests
+  iproute2 util-linux
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#PACKAGES[@]} packages present"
+  exit 0
+fi
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+echo "install-deps: installing ${missing[*]}"
+$SUDO apt-get update -qq
+DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"

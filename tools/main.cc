@@ -1,0 +1,36 @@
+// The `kinograph` command-line tool: dispatches to the verbs in cmd_*.cc.
+#include <iostream>
+
+#include "tools/command_registry.h"
+
+namespace kinograph::tools {
+
+std::vector<CommandSetup>& command_registry() {
+  static std::vector<CommandSetup> registry;
+  return registry;
+}
+
+bool register_command(CommandSetup setup) {
+  command_registry().push_back(std::move(setup));
+  return true;
+}
+
+}  // namespace kinograph::tools
+
+int main(int argc, char** argv) {
+  CLI::App app{"kinograph: kinodynamic motion planning on dynamic factor graphs"};
+  app.require_subcommand(1);
+  for (const auto& setup : kinograph::tools::command_registry()) setup(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const kinograph::tools::CommandFailure& e) {
+    std::cerr << "kinograph: error: " << e.what() << "\n";
+    return e.get_exit_code();
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const std::exception& e) {
+    std::cerr << "kinograph: error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}
