@@ -11,7 +11,7 @@ PACKAGES=(
   # numerics, collision, models, meshes
   libeigen3-dev libsuitesparse-dev libbullet-dev liburdfdom-dev libassimp-dev
   # rendering and plots
-  libosmesa6-dev libpng-dev libfreetype-dev fonts-dejavu-core
+  libosmesa6-dev libpng-dev libfreetype-dev fonts-dejavu-core libcairo2-dev
   # tools, config, logging
   nlohmann-json3-dev libyaml-cpp-dev libcli11-dev libspdlog-dev
   # tests and benchmarks (KDL and Ceres are test/bench-only oracles; OMPL for the SST baseline)
