@@ -1,0 +1,133 @@
+#include "kinograph/collision/convex_shape.h"
+
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <btBulletCollisionCommon.h>
+
+#include <assimp/Importer.hpp>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#ifndef BT_USE_DOUBLE_PRECISION
+#error "kinograph_collision must be compiled against bullet-float64 (BT_USE_DOUBLE_PRECISION)"
+#endif
+
+namespace kinograph::collision {
+namespace {
+
+void require_positive(double v, const char* what) {
+  if (!(v > 0)) {
+    throw std::invalid_argument(std::string("collision shape: ") + what +
+                                " must be positive, got " + std::to_string(v));
+  }
+}
+
+// Collects every vertex of every mesh in the scene, in the file's root frame.
+void collect_vertices(const aiScene* scene, const aiNode* node, const aiMatrix4x4& parent,
+                      const Eigen::Vector3d& scale, std::vector<Eigen::Vector3d>& out) {
+  const aiMatrix4x4 tf = parent * node->mTransformation;
+  for (unsigned i = 0; i < node->mNumMeshes; ++i) {
+    const aiMesh* mesh = scene->mMeshes[node->mMeshes[i]];
+    for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
+      const aiVector3D p = tf * mesh->mVertices[v];
+      out.emplace_back(scale.x() * p.x, scale.y() * p.y, scale.z() * p.z);
+    }
+  }
+  for (unsigned c = 0; c < node->mNumChildren; ++c) {
+    collect_vertices(scene, node->mChildren[c], tf, scale, out);
+  }
+}
+
+std::vector<Eigen::Vector3d> load_mesh_vertices(const Shape& s) {
+  std::string path = s.mesh_path;
+  if (path.rfind("file://", 0) == 0) path = path.substr(7);
+  Assimp::Importer importer;
+  const aiScene* scene = importer.ReadFile(path, aiProcess_JoinIdenticalVertices);
+  if (scene == nullptr || scene->mRootNode == nullptr) {
+    throw std::invalid_argument("collision mesh '" + s.mesh_path +
+                                "' cannot be read: " + importer.GetErrorString());
+  }
+  std::vector<Eigen::Vector3d> vertices;
+  collect_vertices(scene, scene->mRootNode, aiMatrix4x4(), s.mesh_scale, vertices);
+  if (vertices.size() < 4) {
+    throw std::invalid_argument("collision mesh '" + s.mesh_path + "' has " +
+                                std::to_string(vertices.size()) +
+                                " vertices; a convex hull needs at least 4");
+  }
+  return vertices;
+}
+
+}  // namespace
+
+ConvexShape::ConvexShape(const Shape& shape) : shape_(shape) {
+  const Eigen::Vector3d& sz = shape.size;
+  switch (shape.kind) {
+    case ShapeKind::kSphere: {
+      require_positive(sz.x(), "sphere radius");
+      bullet_ = std::make_unique<btSphereShape>(sz.x());  // radius is the margin
+      bound_radius_ = sz.x();
+      break;
+    }
+    case ShapeKind::kBox: {
+      require_positive(sz.x(), "box x extent");
+      require_positive(sz.y(), "box y extent");
+      require_positive(sz.z(), "box z extent");
+      auto box = std::make_unique<btBoxShape>(btVector3(sz.x() / 2, sz.y() / 2, sz.z() / 2));
+      box->setMargin(0);  // keeps the outer size and makes edges and corners sharp
+      bullet_ = std::move(box);
+      bound_radius_ = sz.norm() / 2;
+      break;
+    }
+    case ShapeKind::kCylinder: {
+      require_positive(sz.x(), "cylinder radius");
+      require_positive(sz.y(), "cylinder length");
+      auto cyl = std::make_unique<btCylinderShapeZ>(btVector3(sz.x(), sz.x(), sz.y() / 2));
+      cyl->setMargin(0);  // sharp rims, exact outer size
+      bullet_ = std::move(cyl);
+      bound_radius_ = std::hypot(sz.x(), sz.y() / 2);
+      break;
+    }
+    case ShapeKind::kCapsule: {
+      require_positive(sz.x(), "capsule radius");
+      if (!(sz.y() >= 0)) throw std::invalid_argument("collision shape: capsule length < 0");
+      // btCapsuleShapeZ's height is the distance between the cap centres, as ours.
+      bullet_ = std::make_unique<btCapsuleShapeZ>(sz.x(), sz.y());
+      bound_radius_ = sz.x() + sz.y() / 2;
+      break;
+    }
+    case ShapeKind::kMesh: {
+      const std::vector<Eigen::Vector3d> vertices = load_mesh_vertices(shape);
+      auto hull = std::make_unique<btConvexHullShape>();
+      Eigen::Vector3d lo = vertices.front(), hi = vertices.front();
+      for (const Eigen::Vector3d& v : vertices) {
+        hull->addPoint(btVector3(v.x(), v.y(), v.z()), false);
+        lo = lo.cwiseMin(v);
+        hi = hi.cwiseMax(v);
+      }
+      hull->recalcLocalAabb();
+      hull->optimizeConvexHull();  // keep only hull vertices: support queries scan them all
+      // btConvexHullShape adds its margin outside the hull; 0 keeps the hull exact.
+      hull->setMargin(0);
+      bullet_ = std::move(hull);
+      bound_center_ = (lo + hi) / 2;
+      for (const Eigen::Vector3d& v : vertices) {
+        bound_radius_ = std::max(bound_radius_, (v - bound_center_).norm());
+      }
+      break;
+    }
+  }
+}
+
+ConvexShape::~ConvexShape() = default;
+ConvexShape::ConvexShape(ConvexShape&&) noexcept = default;
+ConvexShape& ConvexShape::operator=(ConvexShape&&) noexcept = default;
+
+void bullet_precision_link_guard() {
+  btSphereShape s(1);
+  btVector3 inertia;
+  // Qualified, non-virtual call into the library: undefined reference on a precision mismatch.
+  s.btSphereShape::calculateLocalInertia(btScalar(1), inertia);
+}
+
+}  // namespace kinograph::collision
