@@ -1,0 +1,104 @@
+#pragma once
+// A factor is one term ½‖r(x)‖² of the least-squares cost over a few variables. Authors
+// implement evaluate() (raw error and its Jacobian blocks); the noise model whitens both.
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "kinograph/graph/key.h"
+#include "kinograph/graph/noise_model.h"
+#include "kinograph/graph/values.h"
+
+namespace kinograph::graph {
+
+/// Read-only view of the current values of one factor's variables, in the factor's key order.
+class FactorValues {
+ public:
+  FactorValues(const double* const* data, const int* dims) : data_(data), dims_(dims) {}
+  /// The i-th variable of the factor (i indexes keys()).
+  Eigen::Map<const Eigen::VectorXd> operator[](int i) const { return {data_[i], dims_[i]}; }
+
+ private:
+  const double* const* data_;
+  const int* dims_;
+};
+
+/// Writable view of a factor's Jacobian, one dense block per key, stacked side by side in key
+/// order (residual_dim rows). Blocks arrive zeroed, so authors fill only non-zero entries.
+class Jacobians {
+ public:
+  using Block = Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>>;
+  Jacobians(double* data, Eigen::Index rows, Eigen::Index outer_stride, const int* col_offsets,
+            const int* dims)
+      : data_(data), rows_(rows), stride_(outer_stride), offsets_(col_offsets), dims_(dims) {}
+  /// de/dx_i: residual_dim × dim(key i).
+  Block block(int i) const {
+    return Block(data_ + offsets_[i] * stride_, rows_, dims_[i], Eigen::OuterStride<>(stride_));
+  }
+
+ private:
+  double* data_;
+  Eigen::Index rows_;
+  Eigen::Index stride_;
+  const int* offsets_;
+  const int* dims_;
+};
+
+/// One cost term over a fixed set of vector variables. Keys, their dimensions and the residual
+/// dimension never change after construction (the solvers cache structure on them); the noise
+/// model and any targets held by a subclass may change between solves.
+class Factor {
+ public:
+  /// Throws std::invalid_argument on an empty key list, duplicate keys, sizes that disagree,
+  /// non-positive dimensions, or a noise model of another dimension. A null noise model means
+  /// unit (r = e).
+  Factor(std::vector<Key> keys, std::vector<int> dims, int residual_dim,
+         NoiseModelPtr noise = nullptr);
+  virtual ~Factor() = default;
+
+  /// The raw error e(x) and, if J is non-null, its Jacobian blocks de/dx_i (zeroed on entry).
+  virtual void evaluate(const FactorValues& x, Eigen::Ref<Eigen::VectorXd> e,
+                        const Jacobians* J) const = 0;
+
+  /// Name used in error messages; defaults to the demangled class name.
+  virtual std::string name() const;
+
+  const std::vector<Key>& keys() const { return keys_; }
+  /// Dimension of each key's variable, in key order.
+  const std::vector<int>& dims() const { return dims_; }
+  /// Column of key i's block in the stacked Jacobian.
+  const std::vector<int>& block_offsets() const { return offsets_; }
+  int residual_dim() const { return residual_dim_; }
+  /// Sum of the key dimensions (columns of the stacked Jacobian).
+  int jacobian_cols() const { return cols_; }
+
+  const NoiseModelPtr& noise() const { return noise_; }
+  /// Replaces the noise model (same dimension; throws std::invalid_argument otherwise). Keeps the
+  /// graph structure, so solvers reuse their symbolic analysis.
+  void set_noise(NoiseModelPtr noise);
+
+  /// Whitened residual r (resized to residual_dim) and whitened stacked Jacobian J (resized to
+  /// residual_dim × jacobian_cols) at `values`. Fixed variables get blocks like any other.
+  /// Throws std::out_of_range if a key is missing and std::invalid_argument if a dimension
+  /// differs. Does not check for NaN (see all_finite()).
+  void linearize(const Values& values, Eigen::VectorXd& r, Eigen::MatrixXd& J) const;
+  /// Whitened residual only.
+  void whitened_residual(const Values& values, Eigen::VectorXd& r) const;
+  /// Cost ½‖r‖² of this factor at `values`.
+  double error(const Values& values) const;
+
+  /// Raw-pointer entry used by the solvers' hot loops: `x` holds one pointer per key; `J` may be
+  /// null. Applies the noise model.
+  void whitened(const double* const* x, Eigen::Ref<Eigen::VectorXd> r,
+                Eigen::Ref<Eigen::MatrixXd>* J) const;
+
+ private:
+  std::vector<Key> keys_;
+  std::vector<int> dims_;
+  std::vector<int> offsets_;
+  int residual_dim_;
+  int cols_;
+  NoiseModelPtr noise_;
+};
+
+}  // namespace kinograph::graph
