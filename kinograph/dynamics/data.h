@@ -33,10 +33,14 @@ class Data {
   struct Scratch {
     std::vector<Vector6> S, Sdot, Vw, aw, fw, Fw;     // screws, twists, accelerations, wrenches
     std::vector<Vector6> alpha, beta, dF_dq, dF_dqd;  // per-joint derivative seeds
-    std::vector<Matrix6> Iw, Ic, Bc, Dc;              // world inertias and composites
+    std::vector<Matrix6> Iw, Ic, Ec;                  // world inertias and composites
     std::vector<Vector6> SIc, SBc, SDc;               // S_i^T times the composites
     std::vector<Vector6> fext;                        // external wrenches per body
     std::vector<Eigen::Isometry3d> joint_pose;        // T_parent,body(q)
+    std::vector<double> mass;                         // body mass, COM and inertia about the
+    std::vector<Eigen::Vector3d> com;                 // COM (body frame), split out of G once
+    std::vector<Eigen::Matrix3d> Icom;
+    std::vector<Vector6> hc;  // composite momenta
     Eigen::VectorXd bias;
     Eigen::LLT<Eigen::MatrixXd> llt;
   } scratch;
