@@ -1,0 +1,308 @@
+// Round trips, truncation and fingerprint rejection for every kinograph LCM type, and one
+// publish/receive over the in-process memq:// provider.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <lcm/lcm-cpp.hpp>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "kinograph/goal_t.hpp"
+#include "kinograph/obstacle_list_t.hpp"
+#include "kinograph/obstacle_t.hpp"
+#include "kinograph/plan_t.hpp"
+#include "kinograph/planner_status_t.hpp"
+#include "kinograph/robot_state_t.hpp"
+
+namespace {
+
+using kinograph::goal_t;
+using kinograph::obstacle_list_t;
+using kinograph::obstacle_t;
+using kinograph::plan_t;
+using kinograph::planner_status_t;
+using kinograph::robot_state_t;
+
+std::mt19937 rng(20240611);
+
+double random_double() { return std::uniform_real_distribution<double>(-10.0, 10.0)(rng); }
+
+std::vector<double> random_vector(int n) {
+  std::vector<double> v(n);
+  for (double& x : v) x = random_double();
+  return v;
+}
+
+std::vector<std::string> joint_names(int n) {
+  std::vector<std::string> names;
+  for (int i = 1; i <= n; ++i) names.push_back("iiwa_joint_" + std::to_string(i));
+  return names;
+}
+
+robot_state_t make_robot_state() {
+  robot_state_t m;
+  m.utime = 1'700'000'000'123'456;
+  m.robot = "iiwa14";
+  m.num_joints = 7;
+  m.joint_name = joint_names(7);
+  m.position = random_vector(7);
+  m.velocity = random_vector(7);
+  return m;
+}
+
+goal_t make_goal() {
+  goal_t m;
+  m.utime = 42;
+  m.goal_id = 9'000'000'001;
+  m.robot = "iiwa14";
+  m.kind = goal_t::KIND_END_EFFECTOR_POSE;
+  m.num_joints = 0;
+  m.ee_frame = "iiwa_link_ee_kuka";
+  for (double& x : m.ee_position) x = random_double();
+  const double q[4] = {0.5, 0.5, -0.5, 0.5};
+  for (int i = 0; i < 4; ++i) m.ee_quaternion[i] = q[i];
+  m.duration_s = 2.5;
+  return m;
+}
+
+obstacle_t make_obstacle(const std::string& id, int8_t shape) {
+  obstacle_t m;
+  m.id = id;
+  m.action = obstacle_t::ADD_OR_MOVE;
+  m.shape = shape;
+  for (double& x : m.size) x = std::abs(random_double());
+  for (double& x : m.position) x = random_double();
+  const double q[4] = {1, 0, 0, 0};
+  for (int i = 0; i < 4; ++i) m.quaternion[i] = q[i];
+  return m;
+}
+
+obstacle_list_t make_obstacle_list() {
+  obstacle_list_t m;
+  m.utime = 7;
+  m.obstacles = {make_obstacle("table", obstacle_t::BOX), make_obstacle("ball", obstacle_t::SPHERE),
+                 make_obstacle("pole", obstacle_t::CYLINDER),
+                 make_obstacle("arm", obstacle_t::CAPSULE)};
+  m.obstacles[1].action = obstacle_t::REMOVE;
+  m.num_obstacles = static_cast<int32_t>(m.obstacles.size());
+  m.replace_all = true;
+  return m;
+}
+
+plan_t make_plan(int num_steps) {
+  const int n = 7;
+  plan_t m;
+  m.utime = 123;
+  m.plan_id = 5;
+  m.goal_id = 9'000'000'001;
+  m.robot = "iiwa14";
+  m.status = plan_t::SUCCESS;
+  m.status_message = "";
+  m.method = "incremental";
+  m.num_joints = n;
+  m.joint_name = joint_names(n);
+  m.num_steps = num_steps;
+  for (int k = 0; k < num_steps; ++k) {
+    m.t.push_back(0.1 * k);
+    m.q.push_back(random_vector(n));
+    m.qd.push_back(random_vector(n));
+    m.qdd.push_back(random_vector(n));
+    m.tau.push_back(random_vector(n));
+  }
+  m.solve_time_s = 0.0123;
+  m.iterations = 17;
+  m.cost = 3.25;
+  m.max_dynamics_residual = 1e-9;
+  m.max_collocation_residual = 2e-9;
+  m.min_clearance = 0.031;
+  m.goal_error = 1e-4;
+  m.valid = true;
+  return m;
+}
+
+planner_status_t make_planner_status() {
+  planner_status_t m;
+  m.utime = 99;
+  m.robot = "acrobot";
+  m.state = planner_status_t::ERROR;
+  m.last_goal_id = 3;
+  m.last_plan_id = -1;
+  m.message = "goal 3 rejected: joint_position has 3 entries, robot has 2 joints";
+  m.num_plans = 2;
+  m.num_failures = 1;
+  return m;
+}
+
+template <typename Msg>
+std::vector<uint8_t> encode(const Msg& m) {
+  const int size = m.getEncodedSize();
+  std::vector<uint8_t> buf(size);
+  EXPECT_EQ(m.encode(buf.data(), 0, size), size);
+  return buf;
+}
+
+// Decoding what was encoded and encoding it again gives the same bytes: every field survived.
+template <typename Msg>
+Msg round_trip(const Msg& m) {
+  const std::vector<uint8_t> bytes = encode(m);
+  Msg out;
+  EXPECT_EQ(out.decode(bytes.data(), 0, static_cast<int>(bytes.size())),
+            static_cast<int>(bytes.size()));
+  EXPECT_EQ(encode(out), bytes);
+  return out;
+}
+
+// Every strict prefix of a valid message must be rejected, never read past its end.
+template <typename Msg>
+void expect_truncations_fail(const Msg& m) {
+  const std::vector<uint8_t> bytes = encode(m);
+  for (size_t len = 0; len < bytes.size(); ++len) {
+    std::vector<uint8_t> prefix(bytes.begin(), bytes.begin() + len);  // exact size for ASan
+    Msg out;
+    EXPECT_LT(out.decode(prefix.data(), 0, static_cast<int>(len)), 0) << "prefix length " << len;
+  }
+}
+
+TEST(LcmTypes, RobotStateRoundTrip) {
+  const robot_state_t m = make_robot_state();
+  const robot_state_t out = round_trip(m);
+  EXPECT_EQ(out.utime, m.utime);
+  EXPECT_EQ(out.robot, "iiwa14");
+  EXPECT_EQ(out.joint_name, m.joint_name);
+  EXPECT_EQ(out.position, m.position);
+  EXPECT_EQ(out.velocity, m.velocity);
+}
+
+TEST(LcmTypes, GoalRoundTrip) {
+  const goal_t m = make_goal();
+  const goal_t out = round_trip(m);
+  EXPECT_EQ(out.goal_id, m.goal_id);
+  EXPECT_EQ(out.kind, goal_t::KIND_END_EFFECTOR_POSE);
+  EXPECT_TRUE(out.joint_position.empty());
+  EXPECT_EQ(out.ee_frame, "iiwa_link_ee_kuka");
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(out.ee_position[i], m.ee_position[i]);
+  for (int i = 0; i < 4; ++i) EXPECT_EQ(out.ee_quaternion[i], m.ee_quaternion[i]);
+  EXPECT_EQ(out.duration_s, 2.5);
+}
+
+TEST(LcmTypes, JointGoalRoundTrip) {
+  goal_t m = make_goal();
+  m.kind = goal_t::KIND_JOINT_CONFIGURATION;
+  m.joint_position = {3.141592653589793, 0.0};
+  m.num_joints = 2;
+  const goal_t out = round_trip(m);
+  EXPECT_EQ(out.joint_position, m.joint_position);
+}
+
+TEST(LcmTypes, ObstacleRoundTrip) {
+  const obstacle_t m = make_obstacle("box", obstacle_t::BOX);
+  const obstacle_t out = round_trip(m);
+  EXPECT_EQ(out.id, "box");
+  EXPECT_EQ(out.shape, obstacle_t::BOX);
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(out.size[i], m.size[i]);
+}
+
+TEST(LcmTypes, ObstacleListRoundTrip) {
+  const obstacle_list_t m = make_obstacle_list();
+  const obstacle_list_t out = round_trip(m);
+  ASSERT_EQ(out.num_obstacles, 4);
+  ASSERT_EQ(out.obstacles.size(), 4u);
+  EXPECT_EQ(out.obstacles[1].id, "ball");
+  EXPECT_EQ(out.obstacles[1].action, obstacle_t::REMOVE);
+  EXPECT_EQ(out.obstacles[3].shape, obstacle_t::CAPSULE);
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(out.obstacles[2].position[i], m.obstacles[2].position[i]);
+  EXPECT_TRUE(out.replace_all);
+}
+
+TEST(LcmTypes, PlanRoundTrip) {
+  const plan_t m = make_plan(11);
+  const plan_t out = round_trip(m);
+  EXPECT_EQ(out.plan_id, 5);
+  EXPECT_EQ(out.goal_id, m.goal_id);
+  EXPECT_EQ(out.method, "incremental");
+  EXPECT_EQ(out.t, m.t);
+  EXPECT_EQ(out.q, m.q);
+  EXPECT_EQ(out.qd, m.qd);
+  EXPECT_EQ(out.qdd, m.qdd);
+  EXPECT_EQ(out.tau, m.tau);
+  EXPECT_EQ(out.min_clearance, m.min_clearance);
+  EXPECT_TRUE(out.valid);
+}
+
+// A failed plan carries no trajectory; the counts make that explicit and decode agrees.
+TEST(LcmTypes, EmptyFailedPlanRoundTrip) {
+  plan_t m = make_plan(0);
+  m.status = plan_t::INVALID_GOAL;
+  m.status_message = "ee_frame 'flange' is not a link of iiwa14";
+  m.valid = false;
+  const plan_t out = round_trip(m);
+  EXPECT_EQ(out.status, plan_t::INVALID_GOAL);
+  EXPECT_EQ(out.num_steps, 0);
+  EXPECT_TRUE(out.q.empty());
+  EXPECT_EQ(out.status_message, m.status_message);
+}
+
+TEST(LcmTypes, PlannerStatusRoundTrip) {
+  const planner_status_t m = make_planner_status();
+  const planner_status_t out = round_trip(m);
+  EXPECT_EQ(out.state, planner_status_t::ERROR);
+  EXPECT_EQ(out.last_plan_id, -1);
+  EXPECT_EQ(out.message, m.message);
+  EXPECT_EQ(out.num_failures, 1);
+}
+
+TEST(LcmTypes, TruncatedBuffersAreRejected) {
+  expect_truncations_fail(make_robot_state());
+  expect_truncations_fail(make_goal());
+  expect_truncations_fail(make_obstacle("x", obstacle_t::SPHERE));
+  expect_truncations_fail(make_obstacle_list());
+  expect_truncations_fail(make_plan(3));
+  expect_truncations_fail(make_planner_status());
+}
+
+// The fingerprint at the head of each message keeps one type from being read as another.
+TEST(LcmTypes, FingerprintsDifferAndMismatchIsRejected) {
+  const std::vector<int64_t> hashes = {robot_state_t::getHash(), goal_t::getHash(),
+                                       obstacle_t::getHash(),    obstacle_list_t::getHash(),
+                                       plan_t::getHash(),        planner_status_t::getHash()};
+  for (size_t i = 0; i < hashes.size(); ++i)
+    for (size_t j = i + 1; j < hashes.size(); ++j) EXPECT_NE(hashes[i], hashes[j]);
+
+  const std::vector<uint8_t> bytes = encode(make_plan(2));
+  goal_t goal;
+  EXPECT_LT(goal.decode(bytes.data(), 0, static_cast<int>(bytes.size())), 0);
+  planner_status_t status;
+  EXPECT_LT(status.decode(bytes.data(), 0, static_cast<int>(bytes.size())), 0);
+}
+
+// lcm-cpp 1.3.1 subscribes only member functions (no lambdas), hence this small sink.
+class PlanSink {
+ public:
+  void on_plan(const lcm::ReceiveBuffer*, const std::string& channel, const plan_t* msg) {
+    channels.push_back(channel);
+    plans.push_back(*msg);
+  }
+  std::vector<std::string> channels;
+  std::vector<plan_t> plans;
+};
+
+TEST(LcmTypes, PublishAndReceiveOverMemq) {
+  lcm::LCM lc("memq://");
+  ASSERT_TRUE(lc.good());
+  PlanSink sink;
+  lcm::Subscription* sub = lc.subscribe("IIWA_PLAN", &PlanSink::on_plan, &sink);
+  ASSERT_NE(sub, nullptr);
+
+  const plan_t sent = make_plan(4);
+  ASSERT_EQ(lc.publish("IIWA_PLAN", &sent), 0);
+  ASSERT_EQ(lc.publish("ACROBOT_PLAN", &sent), 0);  // another channel: must not be delivered
+  for (int i = 0; i < 2; ++i) lc.handleTimeout(100);
+
+  ASSERT_EQ(sink.plans.size(), 1u);
+  EXPECT_EQ(sink.channels[0], "IIWA_PLAN");
+  EXPECT_EQ(encode(sink.plans[0]), encode(sent));
+  lc.unsubscribe(sub);
+}
+
+}  // namespace
