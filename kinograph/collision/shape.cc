@@ -40,4 +40,29 @@ Shape Shape::mesh(std::string path, const Eigen::Vector3d& scale) {
   return s;
 }
 
+Shape shape_of(const dynamics::Geometry& g) {
+  Shape s;
+  switch (g.shape) {
+    case dynamics::Geometry::Shape::kSphere:
+      s.kind = ShapeKind::kSphere;
+      break;
+    case dynamics::Geometry::Shape::kBox:
+      s.kind = ShapeKind::kBox;
+      break;
+    case dynamics::Geometry::Shape::kCylinder:
+      s.kind = ShapeKind::kCylinder;
+      break;
+    case dynamics::Geometry::Shape::kCapsule:
+      s.kind = ShapeKind::kCapsule;
+      break;
+    case dynamics::Geometry::Shape::kMesh:
+      s.kind = ShapeKind::kMesh;
+      break;
+  }
+  s.size = g.size;
+  s.mesh_path = g.mesh_path;
+  s.mesh_scale = g.mesh_scale;
+  return s;
+}
+
 }  // namespace kinograph::collision

@@ -3,6 +3,8 @@
 #include <Eigen/Core>
 #include <string>
 
+#include "kinograph/dynamics/geometry.h"
+
 namespace kinograph::collision {
 
 // Kinds of convex solid a robot link or an obstacle can be made of.
@@ -29,5 +31,8 @@ struct Shape {
   // The convex hull of a mesh file's vertices (any format assimp reads), scaled per axis.
   static Shape mesh(std::string path, const Eigen::Vector3d& scale = Eigen::Vector3d::Ones());
 };
+
+// The solid of one robot collision geometry from the Model (its pose is kept separately).
+Shape shape_of(const dynamics::Geometry& geometry);
 
 }  // namespace kinograph::collision

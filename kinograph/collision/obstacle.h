@@ -1,0 +1,26 @@
+#pragma once
+
+#include <Eigen/Geometry>
+
+#include "kinograph/collision/pose_trajectory.h"
+#include "kinograph/collision/shape.h"
+
+namespace kinograph::collision {
+
+// A solid in the robot's workspace: a fixed body (desk, wall) or, with a trajectory, a moving
+// one (a neighbouring robot's link along its published plan). The id is the caller's handle.
+struct Obstacle {
+  int id = 0;
+  Shape shape;
+  // World pose of the shape's frame; used when the trajectory is empty.
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  // World pose over time; when non-empty it replaces `pose`.
+  PoseTrajectory trajectory;
+
+  // World pose at time t (seconds).
+  Eigen::Isometry3d pose_at(double t) const { return trajectory.empty() ? pose : trajectory.at(t); }
+  // True when the pose depends on time.
+  bool is_moving() const { return !trajectory.empty(); }
+};
+
+}  // namespace kinograph::collision
