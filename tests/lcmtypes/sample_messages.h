@@ -1,0 +1,146 @@
+#pragma once
+// Sample kinograph LCM messages with seeded random contents, shared by the lcmtypes tests.
+#include <cstdint>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "kinograph/goal_t.hpp"
+#include "kinograph/obstacle_list_t.hpp"
+#include "kinograph/obstacle_t.hpp"
+#include "kinograph/plan_t.hpp"
+#include "kinograph/planner_status_t.hpp"
+#include "kinograph/robot_state_t.hpp"
+
+namespace kinograph::lcmtypes::testing {
+
+using kinograph::goal_t;
+using kinograph::obstacle_list_t;
+using kinograph::obstacle_t;
+using kinograph::plan_t;
+using kinograph::planner_status_t;
+using kinograph::robot_state_t;
+
+inline std::mt19937& rng() {
+  static std::mt19937 engine(20240611);
+  return engine;
+}
+
+inline double random_double() { return std::uniform_real_distribution<double>(-10.0, 10.0)(rng()); }
+
+inline std::vector<double> random_vector(int n) {
+  std::vector<double> v(n);
+  for (double& x : v) x = random_double();
+  return v;
+}
+
+inline std::vector<std::string> joint_names(int n) {
+  std::vector<std::string> names;
+  for (int i = 1; i <= n; ++i) names.push_back("iiwa_joint_" + std::to_string(i));
+  return names;
+}
+
+inline robot_state_t make_robot_state() {
+  robot_state_t m;
+  m.utime = 1'700'000'000'123'456;
+  m.robot = "iiwa14";
+  m.num_joints = 7;
+  m.joint_name = joint_names(7);
+  m.position = random_vector(7);
+  m.velocity = random_vector(7);
+  return m;
+}
+
+inline goal_t make_goal() {
+  goal_t m;
+  m.utime = 42;
+  m.goal_id = 9'000'000'001;
+  m.robot = "iiwa14";
+  m.kind = goal_t::KIND_END_EFFECTOR_POSE;
+  m.num_joints = 0;
+  m.ee_frame = "iiwa_link_ee_kuka";
+  for (double& x : m.ee_position) x = random_double();
+  const double q[4] = {0.5, 0.5, -0.5, 0.5};
+  for (int i = 0; i < 4; ++i) m.ee_quaternion[i] = q[i];
+  m.duration_s = 2.5;
+  return m;
+}
+
+inline obstacle_t make_obstacle(const std::string& id, int8_t shape) {
+  obstacle_t m;
+  m.id = id;
+  m.action = obstacle_t::ADD_OR_MOVE;
+  m.shape = shape;
+  for (double& x : m.size) x = std::abs(random_double());
+  for (double& x : m.position) x = random_double();
+  const double q[4] = {1, 0, 0, 0};
+  for (int i = 0; i < 4; ++i) m.quaternion[i] = q[i];
+  return m;
+}
+
+inline obstacle_list_t make_obstacle_list() {
+  obstacle_list_t m;
+  m.utime = 7;
+  m.obstacles = {make_obstacle("table", obstacle_t::BOX), make_obstacle("ball", obstacle_t::SPHERE),
+                 make_obstacle("pole", obstacle_t::CYLINDER),
+                 make_obstacle("arm", obstacle_t::CAPSULE)};
+  m.obstacles[1].action = obstacle_t::REMOVE;
+  m.num_obstacles = static_cast<int32_t>(m.obstacles.size());
+  m.replace_all = true;
+  return m;
+}
+
+inline plan_t make_plan(int num_steps) {
+  const int n = 7;
+  plan_t m;
+  m.utime = 123;
+  m.plan_id = 5;
+  m.goal_id = 9'000'000'001;
+  m.robot = "iiwa14";
+  m.status = plan_t::SUCCESS;
+  m.status_message = "";
+  m.method = "incremental";
+  m.num_joints = n;
+  m.joint_name = joint_names(n);
+  m.num_steps = num_steps;
+  for (int k = 0; k < num_steps; ++k) {
+    m.t.push_back(0.1 * k);
+    m.q.push_back(random_vector(n));
+    m.qd.push_back(random_vector(n));
+    m.qdd.push_back(random_vector(n));
+    m.tau.push_back(random_vector(n));
+  }
+  m.solve_time_s = 0.0123;
+  m.iterations = 17;
+  m.cost = 3.25;
+  m.max_dynamics_residual = 1e-9;
+  m.max_collocation_residual = 2e-9;
+  m.min_clearance = 0.031;
+  m.goal_error = 1e-4;
+  m.valid = true;
+  return m;
+}
+
+inline planner_status_t make_planner_status() {
+  planner_status_t m;
+  m.utime = 99;
+  m.robot = "acrobot";
+  m.state = planner_status_t::ERROR;
+  m.last_goal_id = 3;
+  m.last_plan_id = -1;
+  m.message = "goal 3 rejected: joint_position has 3 entries, robot has 2 joints";
+  m.num_plans = 2;
+  m.num_failures = 1;
+  return m;
+}
+
+/// The message's bytes as LCM sends them (empty if encoding failed).
+template <typename Msg>
+std::vector<uint8_t> encode(const Msg& m) {
+  const int size = m.getEncodedSize();
+  std::vector<uint8_t> buf(size);
+  if (m.encode(buf.data(), 0, size) != size) buf.clear();
+  return buf;
+}
+
+}  // namespace kinograph::lcmtypes::testing
