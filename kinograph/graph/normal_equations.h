@@ -49,34 +49,40 @@ class NormalEquations {
   /// H·v for v in elimination order (uses the upper triangle twice).
   void multiply(const Eigen::Ref<const Eigen::VectorXd>& v, Eigen::Ref<Eigen::VectorXd> out) const;
 
-  /// delta (laid out like Values::vector(), zero on fixed variables) from a step in elimination
-  /// order.
-  void scatter_step(const Eigen::Ref<const Eigen::VectorXd>& step,
-                    Eigen::Ref<Eigen::VectorXd> delta) const;
+  /// x ← x + step on the free variables, with x laid out like Values::vector() and the step
+  /// in elimination order.
+  void add_step(const Eigen::Ref<const Eigen::VectorXd>& step, Eigen::Ref<Eigen::VectorXd> x) const;
+  /// Values-layout slot of the free variable eliminated k-th.
+  const std::vector<int>& elimination_slots() const { return var_slot_; }
   /// The variable whose block holds scalar column `col` of H.
   Key key_of_column(int col, const Values& values) const;
 
  private:
   struct Pair {     // one upper block of H touched by a factor
-    int col_block;  // factor-local key index of the block column (later in elimination)
-    int row_block;  // factor-local key index of the block row
-    int first_pos;  // position in h_ of entry (first row of row block, first column)
-    bool diagonal;
+    int row_key;    // factor-local key index of the block row (earlier in elimination)
+    int col_key;    // factor-local key index of the block column
+    int first_col;  // first scalar column of the block in H
+    int within;     // offset of the block's first row inside each of its columns
+    bool diagonal;  // row_key == col_key: only the upper triangle is stored
   };
   struct FactorInfo {
-    int slot;                   // graph slot
-    int first_var;              // into var_ptr_offsets_ (one per key)
-    int first_pair, num_pairs;  // into pairs_
+    int slot;        // graph slot
+    int first_key;   // into key_value_offset_ / key_col_ (one entry per key)
+    int first_pair;  // into pairs_
+    int num_pairs;
   };
+
+  template <bool kWithJacobian>
+  bool run(const FactorGraph& graph, const Values& values, double* error, std::string* reason);
 
   uint64_t graph_id_ = 0;
   uint64_t layout_id_ = 0;
   int n_ = 0;
-  std::vector<int> var_slot_;     // free variable (elimination order) → Values slot
-  std::vector<int> var_col_;      // free variable → first scalar column of H
-  std::vector<int> slot_to_var_;  // Values slot → free variable or −1 if fixed
+  std::vector<int> var_slot_;          // free variable (elimination order) → Values slot
+  std::vector<int> var_col_;           // free variable → first scalar column of H
+  std::vector<int> var_value_offset_;  // free variable → offset in Values::vector()
+  std::vector<int> var_dim_;
   std::vector<int> col_ptr_, row_idx_, diag_pos_;
-  std::vector<int> col_stride_;  // per scalar column of a block: positions step between columns
   std::vector<double> h_;
   Eigen::VectorXd g_;
   std::vector<FactorInfo> factors_;

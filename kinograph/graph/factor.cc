@@ -1,0 +1,103 @@
+#include "kinograph/graph/factor.h"
+
+#include <cxxabi.h>
+
+#include <cstdlib>
+#include <memory>
+#include <stdexcept>
+#include <typeinfo>
+
+namespace kinograph::graph {
+
+Factor::Factor(std::vector<Key> keys, std::vector<int> dims, int residual_dim, NoiseModelPtr noise)
+    : keys_(std::move(keys)), dims_(std::move(dims)), residual_dim_(residual_dim), cols_(0) {
+  if (keys_.empty()) throw std::invalid_argument("Factor: no keys");
+  if (keys_.size() != dims_.size()) {
+    throw std::invalid_argument("Factor: " + std::to_string(keys_.size()) + " keys but " +
+                                std::to_string(dims_.size()) + " dimensions");
+  }
+  if (residual_dim_ < 1) throw std::invalid_argument("Factor: residual dimension must be >= 1");
+  for (size_t i = 0; i < keys_.size(); ++i) {
+    if (dims_[i] < 1) {
+      throw std::invalid_argument("Factor: key " + keys_[i].to_string() + " has dimension " +
+                                  std::to_string(dims_[i]));
+    }
+    for (size_t j = 0; j < i; ++j) {
+      if (keys_[j] == keys_[i]) {
+        throw std::invalid_argument("Factor: key " + keys_[i].to_string() + " appears twice");
+      }
+    }
+    offsets_.push_back(cols_);
+    cols_ += dims_[i];
+  }
+  set_noise(std::move(noise));
+}
+
+std::string Factor::name() const {
+  const char* mangled = typeid(*this).name();
+  int status = 0;
+  std::unique_ptr<char, void (*)(void*)> demangled(
+      abi::__cxa_demangle(mangled, nullptr, nullptr, &status), std::free);
+  return status == 0 && demangled ? std::string(demangled.get()) : std::string(mangled);
+}
+
+void Factor::set_noise(NoiseModelPtr noise) {
+  if (noise && noise->dim() != residual_dim_) {
+    throw std::invalid_argument("Factor " + name() + ": noise model of dimension " +
+                                std::to_string(noise->dim()) + " for residual of dimension " +
+                                std::to_string(residual_dim_));
+  }
+  noise_ = std::move(noise);
+}
+
+void Factor::whitened(const double* const* x, Eigen::Ref<Eigen::VectorXd> r,
+                      Eigen::Ref<Eigen::MatrixXd>* J) const {
+  const FactorValues xv(x, dims_.data());
+  if (J == nullptr) {
+    evaluate(xv, r, nullptr);
+    if (noise_) noise_->whiten_residual(r);
+    return;
+  }
+  J->setZero();
+  const Jacobians jac(J->data(), J->rows(), J->outerStride(), offsets_.data(), dims_.data());
+  evaluate(xv, r, &jac);
+  if (noise_) noise_->whiten_system(r, *J);
+}
+
+namespace {
+std::vector<const double*> gather(const Factor& f, const Values& values) {
+  std::vector<const double*> ptrs(f.keys().size());
+  for (size_t i = 0; i < ptrs.size(); ++i) {
+    const int s = values.slot(f.keys()[i]);
+    if (values.dim(s) != f.dims()[i]) {
+      throw std::invalid_argument("Factor " + f.name() + ": key " + f.keys()[i].to_string() +
+                                  " has dimension " + std::to_string(values.dim(s)) +
+                                  " in Values, factor expects " + std::to_string(f.dims()[i]));
+    }
+    ptrs[i] = values.vector().data() + values.offset(s);
+  }
+  return ptrs;
+}
+}  // namespace
+
+void Factor::linearize(const Values& values, Eigen::VectorXd& r, Eigen::MatrixXd& J) const {
+  const auto ptrs = gather(*this, values);
+  r.setZero(residual_dim_);
+  J.resize(residual_dim_, cols_);
+  Eigen::Ref<Eigen::MatrixXd> ref(J);
+  whitened(ptrs.data(), r, &ref);
+}
+
+void Factor::whitened_residual(const Values& values, Eigen::VectorXd& r) const {
+  const auto ptrs = gather(*this, values);
+  r.setZero(residual_dim_);
+  whitened(ptrs.data(), r, nullptr);
+}
+
+double Factor::error(const Values& values) const {
+  Eigen::VectorXd r;
+  whitened_residual(values, r);
+  return 0.5 * r.squaredNorm();
+}
+
+}  // namespace kinograph::graph

@@ -1,0 +1,168 @@
+#pragma once
+// Incremental smoothing and mapping (ISAM2, Kaess et al., IJRR 2012) on the kinograph engine:
+// the iDFGP solver. A Bayes tree holds the factorized linearized problem; each update re-
+// eliminates only the cliques touched by new, removed or relinearized factors and their
+// ancestors, reattaching the untouched subtrees through their cached marginal factors.
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "kinograph/graph/bayes_tree.h"
+#include "kinograph/graph/factor_graph.h"
+#include "kinograph/graph/values.h"
+
+namespace kinograph::graph {
+
+/// How each update turns the linear solution into a new estimate.
+enum class ISAM2Step {
+  kGaussNewton,  ///< δ from the Bayes tree (LM-damped on the re-eliminated part if unsafe)
+  kDogleg,       ///< Powell's dogleg between the Gauss–Newton and steepest-descent steps
+};
+
+/// Options of ISAM2 (fixed for its lifetime). Defaults suit planning problems in SI units.
+struct ISAM2Options {
+  /// A variable is relinearized when max|δ_j| exceeds this (GTSAM's default 0.1).
+  double relinearize_threshold = 0.1;
+  /// Check relinearization only every k-th update (1 = every update).
+  int relinearize_skip = 1;
+  /// Back-substitution stops descending where a variable changes by less than this (max-abs);
+  /// 0 gives the exact solution.
+  double wildfire_threshold = 1e-7;
+  /// Re-eliminate everything when the affected top holds more than this fraction of the
+  /// variables (cheaper than detaching and reattaching most of the tree).
+  double full_reelimination_fraction = 0.6;
+  ISAM2Step step = ISAM2Step::kGaussNewton;
+
+  /// Safeguard: evaluate the nonlinear error after each update; with Gauss–Newton, if it rose,
+  /// re-eliminate the affected top with Marquardt damping λ·diag(H) (λ grows by lambda_factor)
+  /// until it no longer rises. Without it the update never evaluates the error.
+  bool safeguard = true;
+  double lambda_initial = 1e-2;  ///< first damping after a rejected step (paper's λ₀)
+  double lambda_factor = 10;     ///< λ grows by this after a rejection, shrinks after acceptance
+  double lambda_min = 1e-7;      ///< below this λ drops to 0 (plain Gauss–Newton again)
+  double lambda_max = 1e12;      ///< give up (flag the increase) beyond this
+  double min_diagonal = 1e-6;    ///< clamp of diag(H) in the damping (keeps it positive)
+  /// Relative slack before a rise counts (rounding, wildfire approximation).
+  double error_rise_tolerance = 1e-9;
+
+  /// Dogleg: initial trust radius (‖δ‖₂), its floor (give up below it) and trials per update.
+  double trust_radius_initial = 1.0;
+  double trust_radius_min = 1e-12;
+  int max_dogleg_trials = 40;
+};
+
+/// Per-call options of ISAM2::update().
+struct ISAM2UpdateOptions {
+  /// Variables to eliminate last (near the root) besides those touched by changed factors, e.g.
+  /// the final step of a trajectory whose goal will change.
+  std::vector<Key> constrained_last;
+  /// Relinearize every variable with a non-zero δ, regardless of the threshold.
+  bool force_relinearize = false;
+};
+
+/// Outcome of one update.
+enum class ISAM2Status {
+  kOk,         ///< estimate computed (see error_increased for the safeguard's verdict)
+  kSingular,   ///< a clique's information block is not positive definite (reason names it)
+  kNonFinite,  ///< a factor returned NaN/Inf (reason names it)
+};
+
+/// "ok", "singular", "non_finite".
+std::string to_string(ISAM2Status status);
+
+/// What an update did and what it cost.
+struct ISAM2Result {
+  ISAM2Status status = ISAM2Status::kOk;
+  std::string reason;
+  std::vector<size_t> new_factor_indices;  ///< index of each added factor, for later removal
+  /// True when the returned estimate's error exceeds error_before (safeguard off, or it could
+  /// not find a decreasing step). Never silently worse.
+  bool error_increased = false;
+  double error_before = 0;  ///< new graph's error at the previous estimate (if evaluated)
+  double error_after = 0;   ///< error at the new estimate (if evaluated)
+  bool error_evaluated = false;
+  bool full_reelimination = false;
+  int variables_reeliminated = 0;
+  int cliques_reeliminated = 0;   ///< cliques built by this update
+  int variables_relinearized = 0;
+  int factors_linearized = 0;     ///< new factors plus those touching relinearized variables
+  int cliques_solved = 0;         ///< cliques back-substituted (last trial)
+  int trials = 0;                 ///< numeric eliminations (GN) or dogleg steps tried
+  double lambda = 0;              ///< damping of the accepted GN trial
+  double trust_radius = 0;        ///< Dogleg radius after the update
+  double linearize_s = 0, eliminate_s = 0, solve_s = 0, total_s = 0;
+
+  bool ok() const { return status == ISAM2Status::kOk; }
+};
+
+/// Incremental nonlinear least squares on a growing/changing factor graph. Factors are added
+/// and removed by index (indices are stable, as in FactorGraph); variables are added with their
+/// initial values and never removed. Fixed variables (Values::set_fixed in new_values) stay
+/// constant.
+class ISAM2 {
+ public:
+  explicit ISAM2(ISAM2Options options = {});
+
+  /// Adds `new_factors` (their variables must be known or in `new_values`), removes the factors
+  /// with the given indices, relinearizes, re-eliminates the affected top of the Bayes tree and
+  /// back-substitutes. Removing a factor and adding its replacement in one call is the goal-
+  /// change pattern. Throws std::invalid_argument / std::out_of_range for inconsistent input
+  /// (unknown key, duplicate variable, bad index), before changing any state; numerical trouble
+  /// comes back in the result (then the next update re-eliminates everything).
+  ISAM2Result update(const std::vector<FactorPtr>& new_factors = {},
+                     const std::vector<size_t>& removed_factor_indices = {},
+                     const Values& new_values = {}, const ISAM2UpdateOptions& options = {});
+
+  /// Current estimate θ + δ.
+  const Values& estimate() const { return estimate_; }
+  /// Linearization point θ.
+  const Values& linearization_point() const { return theta_; }
+  /// The factors (removed slots empty).
+  const FactorGraph& graph() const { return graph_; }
+  const BayesTree& bayes_tree() const { return tree_; }
+  const ISAM2Options& options() const { return options_; }
+  /// Nonlinear error ½Σ‖r‖² at the estimate (evaluates every factor).
+  double error() const { return graph_.error(estimate_); }
+
+  /// Checks the Bayes tree's invariants against the current graph (every free variable frontal
+  /// once, every active factor with a free variable in exactly one clique, separators ⊆
+  /// parents' variables). Empty string when they hold.
+  std::string check_invariants() const;
+
+ private:
+  struct Linearization;
+  bool linearize_factor(int f, std::string* reason);
+  double factor_error_at_estimate(int f);
+  void refresh_estimate(const std::vector<int>& changed_vars);
+  void sync_layout();
+  double total_error() const;
+  void apply_dogleg(ISAM2Result& result, double error_theta);
+
+  ISAM2Options options_;
+  FactorGraph graph_;
+  Values theta_;
+  Values estimate_;
+  Eigen::VectorXd delta_;     // applied step (θ + delta_ = estimate)
+  Eigen::VectorXd delta_gn_;  // Bayes tree solution (equals delta_ with Gauss–Newton)
+  BayesTree tree_;
+  std::vector<LinearizedFactor> linearized_;   // per factor index
+  std::vector<std::vector<int>> factor_slots_; // per factor: Values slot per key
+  std::vector<double> factor_error_;           // per factor: error at the estimate
+  std::vector<std::vector<int>> var_factors_;  // per slot: factor indices touching it
+  std::vector<int> damped_vars_;               // eliminated with damping last time
+  std::vector<int> stamp_;                     // per slot scratch
+  int stamp_counter_ = 0;
+  std::vector<int> factor_stamp_;
+  int factor_stamp_counter_ = 0;
+  double lambda_ = 0;
+  double trust_radius_;
+  bool last_step_limited_ = false;
+  bool needs_full_ = true;
+  int update_count_ = 0;
+  // Workspaces for linearizing one factor.
+  Eigen::VectorXd r_;
+  Eigen::MatrixXd J_;
+  std::vector<const double*> ptrs_;
+};
+
+}  // namespace kinograph::graph

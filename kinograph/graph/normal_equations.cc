@@ -1,0 +1,250 @@
+#include "kinograph/graph/normal_equations.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace kinograph::graph {
+
+NormalEquations::NormalEquations(const FactorGraph& graph, const Values& values,
+                                 OrderingMethod ordering)
+    : graph_id_(graph.structure_id()), layout_id_(values.layout_id()) {
+  // Free variables in slot order ("natural" index), and their factors' incidence.
+  std::vector<int> natural_of_slot(values.size(), -1);
+  std::vector<int> slot_of_natural;
+  for (int s = 0; s < values.size(); ++s) {
+    if (!values.is_fixed_slot(s)) {
+      natural_of_slot[s] = static_cast<int>(slot_of_natural.size());
+      slot_of_natural.push_back(s);
+    }
+  }
+  const int num_free = static_cast<int>(slot_of_natural.size());
+  std::vector<std::vector<int>> factor_vars;
+  std::vector<std::vector<int>> factor_slots;
+  factor_vars.reserve(graph.num_factors());
+  int max_rows = 0, max_cols = 0, max_keys = 0;
+  for (size_t fi = 0; fi < graph.size(); ++fi) {
+    const auto& f = graph[fi];
+    if (!f) continue;
+    std::vector<int> vars, slots;
+    for (size_t k = 0; k < f->keys().size(); ++k) {
+      const Key key = f->keys()[k];
+      const int s = values.find(key);
+      if (s < 0) {
+        throw std::invalid_argument("factor " + std::to_string(fi) + " (" + f->name() + ") uses " +
+                                    key.to_string() + ", which is not in Values");
+      }
+      if (values.dim(s) != f->dims()[k]) {
+        throw std::invalid_argument("factor " + std::to_string(fi) + " (" + f->name() +
+                                    ") expects " + key.to_string() + " of dimension " +
+                                    std::to_string(f->dims()[k]) + ", Values has " +
+                                    std::to_string(values.dim(s)));
+      }
+      slots.push_back(s);
+      if (natural_of_slot[s] >= 0) vars.push_back(natural_of_slot[s]);
+    }
+    factor_vars.push_back(std::move(vars));
+    factor_slots.push_back(std::move(slots));
+    max_rows = std::max(max_rows, f->residual_dim());
+    max_cols = std::max(max_cols, f->jacobian_cols());
+    max_keys = std::max(max_keys, static_cast<int>(f->keys().size()));
+  }
+
+  // Elimination order and scalar columns.
+  const std::vector<int> order = compute_ordering(num_free, factor_vars, ordering);
+  std::vector<int> pos_of_natural(num_free);
+  var_slot_.resize(num_free);
+  var_col_.resize(num_free);
+  var_value_offset_.resize(num_free);
+  var_dim_.resize(num_free);
+  for (int k = 0; k < num_free; ++k) {
+    pos_of_natural[order[k]] = k;
+    const int s = slot_of_natural[order[k]];
+    var_slot_[k] = s;
+    var_col_[k] = n_;
+    var_value_offset_[k] = values.offset(s);
+    var_dim_[k] = values.dim(s);
+    n_ += var_dim_[k];
+  }
+
+  // Block pattern: for each block column b, the block rows a ≤ b coupled to it (always b).
+  std::vector<std::vector<int>> block_rows(num_free);
+  for (int b = 0; b < num_free; ++b) block_rows[b].push_back(b);
+  for (const auto& vars : factor_vars) {
+    for (int va : vars) {
+      for (int vb : vars) {
+        const int a = pos_of_natural[va], b = pos_of_natural[vb];
+        if (a < b) block_rows[b].push_back(a);
+      }
+    }
+  }
+  // Offset of each block row inside its block column (the same for every scalar column).
+  std::vector<std::vector<int>> block_within(num_free);
+  col_ptr_.assign(n_ + 1, 0);
+  for (int b = 0; b < num_free; ++b) {
+    auto& rows = block_rows[b];
+    std::sort(rows.begin(), rows.end());
+    rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
+    int within = 0;
+    for (int a : rows) {
+      block_within[b].push_back(within);
+      within += var_dim_[a];
+    }
+    const int off_diagonal = within - var_dim_[b];
+    for (int k = 0; k < var_dim_[b]; ++k) {
+      const int c = var_col_[b] + k;
+      col_ptr_[c + 1] = col_ptr_[c] + off_diagonal + k + 1;
+      for (int a : rows) {
+        const int rows_here = a == b ? k + 1 : var_dim_[a];
+        for (int r = 0; r < rows_here; ++r) row_idx_.push_back(var_col_[a] + r);
+      }
+    }
+  }
+  diag_pos_.resize(n_);
+  for (int c = 0; c < n_; ++c) diag_pos_[c] = col_ptr_[c + 1] - 1;
+  h_.assign(row_idx_.size(), 0.0);
+  g_.setZero(n_);
+
+  // Per factor: where its keys live in Values and H, and the upper blocks of H it touches.
+  size_t fi_dense = 0;
+  for (size_t fi = 0; fi < graph.size(); ++fi) {
+    const auto& f = graph[fi];
+    if (!f) continue;
+    const auto& slots = factor_slots[fi_dense++];
+    FactorInfo info{static_cast<int>(fi), static_cast<int>(key_col_.size()),
+                    static_cast<int>(pairs_.size()), 0};
+    std::vector<int> pos(slots.size(), -1);
+    for (size_t k = 0; k < slots.size(); ++k) {
+      key_value_offset_.push_back(values.offset(slots[k]));
+      const int nat = natural_of_slot[slots[k]];
+      pos[k] = nat < 0 ? -1 : pos_of_natural[nat];
+      key_col_.push_back(nat < 0 ? -1 : var_col_[pos[k]]);
+    }
+    for (size_t i = 0; i < slots.size(); ++i) {
+      for (size_t j = 0; j < slots.size(); ++j) {
+        if (pos[i] < 0 || pos[j] < 0 || pos[i] > pos[j]) continue;
+        const int a = pos[i], b = pos[j];
+        const auto& rows = block_rows[b];
+        const auto it = std::lower_bound(rows.begin(), rows.end(), a);
+        pairs_.push_back(Pair{static_cast<int>(i), static_cast<int>(j), var_col_[b],
+                              block_within[b][it - rows.begin()], a == b});
+        ++info.num_pairs;
+      }
+    }
+    factors_.push_back(info);
+  }
+
+  r_.setZero(max_rows);
+  J_.setZero(max_rows, max_cols);
+  JtJ_.setZero(max_cols, max_cols);
+  Jtr_.setZero(max_cols);
+  x_ptrs_.resize(max_keys);
+}
+
+template <bool kWithJacobian>
+bool NormalEquations::run(const FactorGraph& graph, const Values& values, double* error,
+                          std::string* reason) {
+  if (!matches(graph, values)) {
+    throw std::logic_error("NormalEquations used with a graph or Values of another structure");
+  }
+  if constexpr (kWithJacobian) {
+    std::fill(h_.begin(), h_.end(), 0.0);
+    g_.setZero();
+  }
+  const double* base = values.vector().data();
+  double total = 0;
+  for (const FactorInfo& info : factors_) {
+    const Factor& f = *graph[info.slot];
+    const int m = f.residual_dim();
+    const int nk = static_cast<int>(f.keys().size());
+    for (int k = 0; k < nk; ++k) x_ptrs_[k] = base + key_value_offset_[info.first_key + k];
+    auto r = r_.head(m);
+    r.setZero();
+    if constexpr (!kWithJacobian) {
+      f.whitened(x_ptrs_.data(), r, nullptr);
+      if (!r.allFinite()) {
+        if (reason) {
+          *reason = "factor " + std::to_string(info.slot) + " (" + f.name() +
+                    ") has a non-finite residual";
+        }
+        return false;
+      }
+      total += 0.5 * r.squaredNorm();
+      continue;
+    } else {
+      const int nc = f.jacobian_cols();
+      Eigen::Ref<Eigen::MatrixXd> J = J_.topLeftCorner(m, nc);
+      f.whitened(x_ptrs_.data(), r, &J);
+      const bool r_ok = r.allFinite();
+      if (!r_ok || !J.allFinite()) {
+        if (reason) {
+          *reason = "factor " + std::to_string(info.slot) + " (" + f.name() +
+                    ") has a non-finite " + (r_ok ? "Jacobian" : "residual");
+        }
+        return false;
+      }
+      total += 0.5 * r.squaredNorm();
+      if (info.num_pairs == 0) continue;
+      auto JtJ = JtJ_.topLeftCorner(nc, nc);
+      JtJ.noalias() = J.transpose() * J;
+      auto Jtr = Jtr_.head(nc);
+      Jtr.noalias() = J.transpose() * r;
+      const auto& offsets = f.block_offsets();
+      const auto& dims = f.dims();
+      for (int k = 0; k < nk; ++k) {
+        const int col = key_col_[info.first_key + k];
+        if (col >= 0) g_.segment(col, dims[k]) += Jtr.segment(offsets[k], dims[k]);
+      }
+      double* h = h_.data();
+      for (int p = info.first_pair; p < info.first_pair + info.num_pairs; ++p) {
+        const Pair& pair = pairs_[p];
+        const int ro = offsets[pair.row_key], co = offsets[pair.col_key];
+        const int dr = dims[pair.row_key], dc = dims[pair.col_key];
+        for (int k = 0; k < dc; ++k) {
+          double* dst = h + col_ptr_[pair.first_col + k] + pair.within;
+          const double* src = JtJ.data() + (co + k) * JtJ.outerStride() + ro;
+          const int rows = pair.diagonal ? k + 1 : dr;
+          for (int i = 0; i < rows; ++i) dst[i] += src[i];
+        }
+      }
+    }
+  }
+  *error = total;
+  return true;
+}
+
+bool NormalEquations::linearize(const FactorGraph& graph, const Values& values, double* error,
+                                std::string* reason) {
+  return run<true>(graph, values, error, reason);
+}
+
+bool NormalEquations::evaluate_error(const FactorGraph& graph, const Values& values, double* error,
+                                     std::string* reason) {
+  return run<false>(graph, values, error, reason);
+}
+
+void NormalEquations::multiply(const Eigen::Ref<const Eigen::VectorXd>& v,
+                               Eigen::Ref<Eigen::VectorXd> out) const {
+  out.setZero();
+  for (int c = 0; c < n_; ++c) {
+    for (int p = col_ptr_[c]; p < col_ptr_[c + 1]; ++p) {
+      const int r = row_idx_[p];
+      out[r] += h_[p] * v[c];
+      if (r != c) out[c] += h_[p] * v[r];
+    }
+  }
+}
+
+void NormalEquations::add_step(const Eigen::Ref<const Eigen::VectorXd>& step,
+                               Eigen::Ref<Eigen::VectorXd> x) const {
+  for (size_t k = 0; k < var_slot_.size(); ++k) {
+    x.segment(var_value_offset_[k], var_dim_[k]) += step.segment(var_col_[k], var_dim_[k]);
+  }
+}
+
+Key NormalEquations::key_of_column(int col, const Values& values) const {
+  const auto it = std::upper_bound(var_col_.begin(), var_col_.end(), col);
+  return values.key(var_slot_[static_cast<size_t>(it - var_col_.begin()) - 1]);
+}
+
+}  // namespace kinograph::graph
