@@ -1,0 +1,186 @@
+// URDF loading: tree flattening, fixed-joint merging, limits, geometry and mesh paths, and
+// every bad-input case (each must throw UrdfError naming the file and the element, silently).
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "kinograph/dynamics/data.h"
+#include "kinograph/dynamics/kinematics.h"
+#include "kinograph/dynamics/model.h"
+#include "test_util.h"
+
+namespace kinograph::dynamics {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Expects UrdfError from loading `path`, with every `needle` in its message and no output on
+// stderr (urdfdom's console_bridge messages are captured, not printed).
+void expect_urdf_error(const std::string& path, std::initializer_list<std::string> needles) {
+  ::testing::internal::CaptureStderr();
+  try {
+    Model::from_urdf_file(path);
+    ADD_FAILURE() << "no UrdfError for " << path;
+  } catch (const UrdfError& e) {
+    const std::string msg = e.what();
+    for (const std::string& n : needles) {
+      EXPECT_NE(msg.find(n), std::string::npos) << "'" << n << "' not in: " << msg;
+    }
+  }
+  EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
+}
+
+TEST(UrdfBadInput, MissingFile) {
+  expect_urdf_error(testing::data_path("no_such_robot.urdf"),
+                    {"no_such_robot.urdf", "does not exist"});
+}
+
+TEST(UrdfBadInput, DirectoryInsteadOfFile) {
+  expect_urdf_error(testing::data_path("meshpkg"), {"meshpkg", "directory"});
+}
+
+TEST(UrdfBadInput, UnreadableFile) {
+  if (geteuid() == 0) GTEST_SKIP() << "root can read files without read permission";
+  const fs::path p = fs::temp_directory_path() / "kinograph_unreadable.urdf";
+  std::ofstream(p) << "<robot name='x'/>";
+  fs::permissions(p, fs::perms::none);
+  expect_urdf_error(p.string(), {"kinograph_unreadable.urdf", "cannot open"});
+  fs::remove(p);
+}
+
+TEST(UrdfBadInput, MalformedXml) {
+  expect_urdf_error(testing::data_path("malformed.urdf"), {"malformed.urdf", "malformed URDF"});
+}
+
+TEST(UrdfBadInput, FloatingJoint) {
+  expect_urdf_error(testing::data_path("floating_joint.urdf"),
+                    {"floating_joint.urdf", "floating_base_joint", "floating"});
+}
+
+TEST(UrdfBadInput, PlanarJoint) {
+  expect_urdf_error(testing::data_path("planar_joint.urdf"),
+                    {"planar_joint.urdf", "planar_base_joint", "planar"});
+}
+
+TEST(UrdfBadInput, MissingInertialOnMovingLink) {
+  expect_urdf_error(testing::data_path("missing_inertial.urdf"),
+                    {"missing_inertial.urdf", "massless_arm", "inertial"});
+}
+
+TEST(UrdfBadInput, MeshNotFound) {
+  expect_urdf_error(testing::data_path("missing_mesh.urdf"),
+                    {"missing_mesh.urdf", "l1", "does_not_exist.stl", "not found"});
+}
+
+TEST(UrdfBadInput, StringsAndEdgeCases) {
+  EXPECT_THROW(Model::from_urdf_string(""), UrdfError);
+  EXPECT_THROW(Model::from_urdf_string("<robot name='x'><link name='a'/>"), UrdfError);
+  EXPECT_THROW(Model::from_urdf_string("not xml at all"), UrdfError);
+  // A zero joint axis cannot define a screw.
+  const std::string zero_axis = R"(<robot name="z"><link name="b"/>
+    <joint name="jz" type="revolute"><parent link="b"/><child link="c"/><axis xyz="0 0 0"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+    <link name="c"><inertial><mass value="1"/>
+      <inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link></robot>)";
+  try {
+    Model::from_urdf_string(zero_axis);
+    ADD_FAILURE();
+  } catch (const UrdfError& e) {
+    EXPECT_NE(std::string(e.what()).find("jz"), std::string::npos) << e.what();
+  }
+}
+
+TEST(UrdfLoad, MeshesMaterialsAndMerging) {
+  const std::string path = testing::data_path("meshpkg/urdf/meshes.urdf");
+  const Model m = Model::from_urdf_file(path);
+  const std::string mesh = fs::weakly_canonical(testing::data_path("meshpkg/meshes/wedge.stl"));
+  EXPECT_EQ(m.name, "meshes");
+  EXPECT_EQ(m.urdf_path, fs::absolute(path).string());
+  ASSERT_EQ(m.nq(), 2);
+
+  // Visuals: base (package://, scaled, named material), l1 (relative path, inline material).
+  ASSERT_EQ(m.visual.size(), 2u);
+  EXPECT_EQ(m.visual[0].shape, Geometry::Shape::kMesh);
+  EXPECT_EQ(m.visual[0].mesh_path, mesh);
+  EXPECT_EQ(m.visual[0].body, -1);
+  EXPECT_TRUE(m.visual[0].mesh_scale.isApprox(Eigen::Vector3d(2, 2, 2)));
+  EXPECT_TRUE(m.visual[0].rgba.isApprox(Eigen::Vector4d(0, 0.5, 0.5, 1)));
+  EXPECT_EQ(m.visual[1].mesh_path, mesh);
+  EXPECT_EQ(m.visual[1].body, 0);
+  EXPECT_TRUE(m.visual[1].rgba.isApprox(Eigen::Vector4d(1, 0, 0, 1)));
+
+  // Collisions: l1's mesh and box, then the merged tool link's sphere and cylinder, posed in
+  // body l1 through the fixed joint (z 0.3, yaw π/2).
+  ASSERT_EQ(m.collision.size(), 4u);
+  EXPECT_EQ(m.collision[0].shape, Geometry::Shape::kMesh);
+  EXPECT_EQ(m.collision[1].shape, Geometry::Shape::kBox);
+  EXPECT_TRUE(m.collision[1].size.isApprox(Eigen::Vector3d(0.1, 0.2, 0.3)));
+  EXPECT_EQ(m.collision[2].shape, Geometry::Shape::kSphere);
+  EXPECT_DOUBLE_EQ(m.collision[2].size.x(), 0.04);
+  EXPECT_EQ(m.collision[2].body, 0);
+  EXPECT_EQ(m.collision[2].link_name, "tool_link");
+  EXPECT_TRUE(m.collision[2].origin.translation().isApprox(Eigen::Vector3d(0, 0, 0.35)));
+  EXPECT_EQ(m.collision[3].shape, Geometry::Shape::kCylinder);
+  EXPECT_TRUE(m.collision[3].size.isApprox(Eigen::Vector3d(0.02, 0.1, 0)));
+
+  // Continuous joint: unbounded, axis normalised; default grey where no material.
+  const Body& b0 = m.bodies[0];
+  EXPECT_TRUE(std::isinf(b0.limits.lower) && b0.limits.lower < 0);
+  EXPECT_TRUE(std::isinf(b0.limits.upper));
+  EXPECT_TRUE(std::isinf(b0.limits.effort));
+  EXPECT_TRUE(b0.actuated);
+  EXPECT_TRUE(b0.screw_axis.isApprox((Vector6() << 0, 0, 1, 0, 0, 0).finished()));
+  // Merged inertia: 1 kg at the origin plus 0.5 kg at (0, 0.1, 0.3) (yawed fixed joint).
+  EXPECT_NEAR(b0.inertia(3, 3), 1.5, 1e-12);
+  const Eigen::Matrix3d mc = b0.inertia.topRightCorner<3, 3>();
+  EXPECT_TRUE(Eigen::Vector3d(mc(2, 1), mc(0, 2), mc(1, 0))
+                  .isApprox(0.5 * Eigen::Vector3d(0, 0.1, 0.3), 1e-12));
+
+  // Prismatic child of the merged link: placement through the fixed joint, effort 0.
+  const Body& b1 = m.bodies[1];
+  EXPECT_EQ(b1.joint_type, JointType::kPrismatic);
+  EXPECT_EQ(b1.parent, 0);
+  EXPECT_FALSE(b1.actuated);
+  EXPECT_DOUBLE_EQ(b1.damping, 3.0);
+  EXPECT_DOUBLE_EQ(b1.limits.upper, 0.04);
+  EXPECT_TRUE(b1.parent_to_joint.translation().isApprox(Eigen::Vector3d(0, 0, 0.3)));
+  EXPECT_TRUE(b1.screw_axis.isApprox((Vector6() << 0, 0, 0, 0, 1, 0).finished()));
+
+  // Frames: every link, merged ones on their body.
+  const Frame& tool = m.frames[m.frame_index("tool_link")];
+  EXPECT_EQ(tool.body, 0);
+  EXPECT_EQ(m.frames[m.frame_index("base")].body, -1);
+  Data d(m);
+  forward_kinematics(m, d, Eigen::Vector2d(M_PI / 2, 0.02));
+  // At q1 = π/2 the tool frame is yawed by π; the finger slides along its own y, i.e. −y.
+  EXPECT_TRUE(d.body_pose[1].translation().isApprox(Eigen::Vector3d(0, -0.02, 0.8), 1e-12))
+      << d.body_pose[1].translation().transpose();
+}
+
+TEST(UrdfLoad, ShippedRobotsLoad) {
+  for (const char* r : {"acrobot/acrobot.urdf", "rr/rr.urdf", "iiwa14/iiwa14.urdf"}) {
+    ::testing::internal::CaptureStderr();
+    EXPECT_NO_THROW(Model::from_urdf_file(testing::robot_path(r))) << r;
+    ::testing::internal::GetCapturedStderr();
+  }
+  const Model rr = Model::from_urdf_file(testing::robot_path("rr/rr.urdf"));
+  ASSERT_EQ(rr.nq(), 2);
+  EXPECT_NEAR(rr.total_mass(), 3.5, 1e-12);
+  EXPECT_TRUE(rr.bodies[0].actuated && rr.bodies[1].actuated);
+}
+
+TEST(UrdfLoad, TreeIsTopologicallyOrdered) {
+  const Model m = Model::from_urdf_string(testing::kTreeUrdf);
+  ASSERT_EQ(m.nq(), 6);
+  for (int i = 0; i < m.nq(); ++i) EXPECT_LT(m.bodies[i].parent, i);
+  EXPECT_EQ(m.bodies[m.body_index("d")].parent, m.body_index("c"));
+  EXPECT_EQ(m.bodies[m.body_index("f")].parent, m.body_index("e"));
+  EXPECT_EQ(m.frames[m.frame_index("c_ext")].body, m.body_index("c"));
+  EXPECT_EQ(m.frames[m.frame_index("e_tool_frame")].body, m.body_index("e"));
+}
+
+}  // namespace
+}  // namespace kinograph::dynamics
