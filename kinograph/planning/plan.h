@@ -1,0 +1,54 @@
+#pragma once
+// A planned trajectory: states, accelerations and torques at every step, with how it was
+// solved and whether it validates.
+#include <Eigen/Core>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace kinograph::planning {
+
+/// How a plan was solved.
+struct SolveStats {
+  std::string method;        ///< "batch-L", "batch-W", "incremental"
+  std::string status;        ///< "converged", "max_iterations", "invalid_problem", ...
+  std::string reason;        ///< one line explaining a non-converged status
+  int iterations = 0;        ///< LM linearizations over all inner solves
+  int outer_iterations = 0;  ///< augmented-Lagrangian outer iterations
+  int linear_solves = 0;     ///< sparse factorizations + solves
+  double solve_time_s = 0;   ///< wall time of the whole plan() call
+  double cost = 0;           ///< final soft cost ½Σ‖r‖² (without constraint terms)
+  double max_constraint_violation = 0;  ///< largest must-hold residual at the end
+};
+
+/// The checks of validate(), figure by figure; failures lists one line per failed check.
+struct Validation {
+  bool valid = false;
+  std::vector<std::string> failures;
+  double max_dynamics_residual = 0;     ///< max |τ − RNEA(q, q̇, q̈)| (N·m)
+  double max_position_consistency = 0;  ///< max |q_{k+1} − q_k − ½(q̇_k + q̇_{k+1})Δt| (rad)
+  double max_velocity_consistency = 0;  ///< max |q̇_{k+1} − q̇_k − ½(q̈_k + q̈_{k+1})Δt| (rad/s)
+  double max_q_violation = 0;           ///< how far q leaves [lower, upper]
+  double max_qd_violation = 0;          ///< how far |q̇| exceeds the velocity limit
+  double max_qdd_violation = 0;         ///< how far |q̈| exceeds a finite acceleration limit
+  double max_tau_violation = 0;         ///< how far |τ| exceeds the effort limit
+  double min_clearance = std::numeric_limits<double>::infinity();  ///< m, over steps and between
+  double goal_error = 0;             ///< joint goal: max |q_N − q_goal|; pose goal: max(m, rad)
+  double max_task_error = 0;         ///< worst task-constraint error (rad or m)
+  double max_unactuated_torque = 0;  ///< max |τ| on unactuated joints (N·m)
+  double start_error = 0;            ///< max |q_0 − start_q|, |q̇_0 − start_qd|
+  double final_velocity = 0;         ///< max |q̇_N|, |q̈_N| (the goal is at rest)
+};
+
+/// A trajectory: rows are states 0..steps, columns joints.
+struct Plan {
+  std::vector<double> t;
+  Eigen::MatrixXd q, qd, qdd, tau;
+  SolveStats stats;
+  Validation validation;
+
+  /// A plan succeeds only if it validates.
+  bool success() const { return validation.valid; }
+};
+
+}  // namespace kinograph::planning

@@ -1,0 +1,69 @@
+#pragma once
+// A planning problem: everything one plan depends on (robot, horizon, start, goal, obstacles,
+// task constraints and the weights of the soft objectives). Scene files describe one.
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "kinograph/collision/obstacle.h"
+#include "kinograph/dynamics/model.h"
+
+namespace kinograph::planning {
+
+/// Where the trajectory ends; in both kinds the robot ends at rest (q̇_N = q̈_N = 0).
+struct Goal {
+  enum class Kind { kJoint, kPose };
+  Kind kind = Kind::kJoint;
+  Eigen::VectorXd q;  ///< kJoint: the final configuration (nq entries)
+  std::string frame;  ///< kPose: a frame name of the Model (e.g. "iiwa_link_ee_kuka")
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  ///< kPose: desired world pose
+  bool position_only = false;  ///< kPose: ignore the orientation of `pose`
+};
+
+/// Keeps a frame's orientation (or full pose) at `target` at every step, e.g. to keep a carried
+/// block level. Errors are the rotation angle (rad) and position distance (m).
+struct TaskConstraint {
+  std::string frame;
+  bool orientation_only = true;
+  Eigen::Isometry3d target = Eigen::Isometry3d::Identity();
+  double tolerance = 0.05;  ///< rad (and m); the validator's threshold for this constraint
+};
+
+/// Soft terms and planner margins, with their defaults.
+struct Objectives {
+  /// Weight w of the minimum-torque term w·Σ_k Σ_j τ_kj² (0 = off).
+  double min_torque = 0.0;
+  /// Power-spectral density Qc (per joint) of the GP constant-acceleration (white-noise jerk)
+  /// prior; larger means a weaker smoothness prior.
+  double qc = 1.0;
+  /// Safety distance ε (m) of the collision hinge: the planner keeps every robot body at least
+  /// this far from every obstacle (the validator only requires no penetration).
+  double collision_epsilon = 0.05;
+  /// Margin ε of the limit hinges: the planner keeps q, q̇, q̈, τ this far inside their limits.
+  double limit_epsilon = 0.0;
+  /// Number of interpolated states checked for collision between consecutive steps by the
+  /// planner's collision factors (0 = only at the steps).
+  int collision_substeps = 2;
+};
+
+/// A kinodynamic planning problem: move from (start_q, start_qd) to the goal in `horizon`
+/// seconds over `steps` intervals, within all limits, without collision.
+struct Problem {
+  std::string name;
+  /// The robot (payload attached, limit overrides applied).
+  std::shared_ptr<const dynamics::Model> model;
+  double horizon = 1.0;  ///< s
+  int steps = 50;        ///< intervals; states 0..steps
+  Eigen::VectorXd start_q, start_qd;
+  Goal goal;
+  std::vector<collision::Obstacle> obstacles;
+  std::vector<TaskConstraint> task_constraints;
+  Objectives objectives;
+
+  /// Time between consecutive states (s).
+  double dt() const { return horizon / steps; }
+};
+
+}  // namespace kinograph::planning

@@ -1,0 +1,219 @@
+#include "kinograph/planning/validate.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <sstream>
+
+#include "kinograph/collision/collision_world.h"
+#include "kinograph/collision/segment_checker.h"
+#include "kinograph/dynamics/inverse_dynamics.h"
+#include "kinograph/dynamics/kinematics.h"
+#include "kinograph/planning/pose_error.h"
+
+namespace kinograph::planning {
+namespace {
+
+std::string fmt(const char* what, double value, double threshold) {
+  std::ostringstream os;
+  os << what << " " << value << " exceeds " << threshold;
+  return os.str();
+}
+
+// How far x leaves [lo, hi] (0 inside).
+double excess(double x, double lo, double hi) { return std::max({0.0, lo - x, x - hi}); }
+
+// Cubic Hermite state between two steps at fraction s (positions from q, q̇ at both ends); the
+// validator's own interpolation, independent of the planner's collocation.
+Eigen::VectorXd hermite(const Plan& plan, int k, double s, double dt) {
+  const double h00 = 2 * s * s * s - 3 * s * s + 1, h10 = s * s * s - 2 * s * s + s;
+  const double h01 = -2 * s * s * s + 3 * s * s, h11 = s * s * s - s * s;
+  return (h00 * plan.q.row(k) + h10 * dt * plan.qd.row(k) + h01 * plan.q.row(k + 1) +
+          h11 * dt * plan.qd.row(k + 1))
+      .transpose();
+}
+
+}  // namespace
+
+Validation validate(const Problem& problem, const Plan& plan,
+                    const ValidationThresholds& thresholds) {
+  Validation v;
+  auto fail = [&v](std::string why) { v.failures.push_back(std::move(why)); };
+  if (!problem.model) {
+    fail("problem has no robot model");
+    return v;
+  }
+  const dynamics::Model& model = *problem.model;
+  const int n = model.nq(), N = problem.steps, rows = N + 1;
+  if (N <= 0 || !(problem.horizon > 0)) {
+    fail("problem has no steps or a non-positive horizon");
+    return v;
+  }
+  if (plan.q.rows() != rows || plan.qd.rows() != rows || plan.qdd.rows() != rows ||
+      plan.tau.rows() != rows || plan.q.cols() != n || plan.qd.cols() != n ||
+      plan.qdd.cols() != n || plan.tau.cols() != n) {
+    std::ostringstream os;
+    os << "plan has the wrong shape: expected " << rows << " x " << n << " for q, qd, qdd, tau";
+    fail(os.str());
+    return v;
+  }
+  if (!plan.q.allFinite() || !plan.qd.allFinite() || !plan.qdd.allFinite() ||
+      !plan.tau.allFinite()) {
+    fail("plan holds NaN or infinite values");
+    return v;
+  }
+  const double dt = problem.dt();
+  dynamics::Data data(model);
+
+  // Physics: inverse dynamics and the trapezoid integration residuals.
+  for (int k = 0; k < rows; ++k) {
+    const Eigen::VectorXd q = plan.q.row(k).transpose(), qd = plan.qd.row(k).transpose(),
+                          qdd = plan.qdd.row(k).transpose();
+    const Eigen::VectorXd& tau = dynamics::rnea(model, data, q, qd, qdd);
+    v.max_dynamics_residual = std::max(v.max_dynamics_residual,
+                                       (plan.tau.row(k).transpose() - tau).cwiseAbs().maxCoeff());
+    if (k < N) {
+      const Eigen::RowVectorXd rq =
+          plan.q.row(k + 1) - plan.q.row(k) - 0.5 * dt * (plan.qd.row(k) + plan.qd.row(k + 1));
+      const Eigen::RowVectorXd rv =
+          plan.qd.row(k + 1) - plan.qd.row(k) - 0.5 * dt * (plan.qdd.row(k) + plan.qdd.row(k + 1));
+      v.max_position_consistency = std::max(v.max_position_consistency, rq.cwiseAbs().maxCoeff());
+      v.max_velocity_consistency = std::max(v.max_velocity_consistency, rv.cwiseAbs().maxCoeff());
+    }
+    for (int j = 0; j < n; ++j) {
+      const dynamics::JointLimits& lim = model.bodies[j].limits;
+      v.max_q_violation = std::max(v.max_q_violation, excess(plan.q(k, j), lim.lower, lim.upper));
+      v.max_qd_violation =
+          std::max(v.max_qd_violation, excess(plan.qd(k, j), -lim.velocity, lim.velocity));
+      if (std::isfinite(lim.acceleration)) {
+        v.max_qdd_violation = std::max(v.max_qdd_violation,
+                                       excess(plan.qdd(k, j), -lim.acceleration, lim.acceleration));
+      }
+      if (model.bodies[j].actuated) {
+        v.max_tau_violation =
+            std::max(v.max_tau_violation, excess(plan.tau(k, j), -lim.effort, lim.effort));
+      } else {
+        v.max_unactuated_torque = std::max(v.max_unactuated_torque, std::abs(plan.tau(k, j)));
+      }
+    }
+  }
+  if (v.max_dynamics_residual > thresholds.dynamics)
+    fail(fmt("dynamics residual |tau - ID| (N·m)", v.max_dynamics_residual, thresholds.dynamics));
+  if (v.max_position_consistency > thresholds.position_consistency)
+    fail(fmt("position consistency (rad)", v.max_position_consistency,
+             thresholds.position_consistency));
+  if (v.max_velocity_consistency > thresholds.velocity_consistency)
+    fail(fmt("velocity consistency (rad/s)", v.max_velocity_consistency,
+             thresholds.velocity_consistency));
+  if (v.max_q_violation > thresholds.limit)
+    fail(fmt("joint position limit violation", v.max_q_violation, thresholds.limit));
+  if (v.max_qd_violation > thresholds.limit)
+    fail(fmt("joint velocity limit violation", v.max_qd_violation, thresholds.limit));
+  if (v.max_qdd_violation > thresholds.limit)
+    fail(fmt("joint acceleration limit violation", v.max_qdd_violation, thresholds.limit));
+  if (v.max_tau_violation > thresholds.limit)
+    fail(fmt("effort limit violation (N·m)", v.max_tau_violation, thresholds.limit));
+  if (v.max_unactuated_torque > thresholds.unactuated_torque)
+    fail(fmt("torque on an unactuated joint (N·m)", v.max_unactuated_torque,
+             thresholds.unactuated_torque));
+
+  // Start and goal (at rest).
+  if (problem.start_q.size() == n) {
+    v.start_error = (plan.q.row(0).transpose() - problem.start_q).cwiseAbs().maxCoeff();
+  }
+  if (problem.start_qd.size() == n) {
+    v.start_error = std::max(v.start_error,
+                             (plan.qd.row(0).transpose() - problem.start_qd).cwiseAbs().maxCoeff());
+  }
+  if (v.start_error > thresholds.start)
+    fail(fmt("start state error", v.start_error, thresholds.start));
+  v.final_velocity =
+      std::max(plan.qd.row(N).cwiseAbs().maxCoeff(), plan.qdd.row(N).cwiseAbs().maxCoeff());
+  if (v.final_velocity > thresholds.final_velocity)
+    fail(fmt("final velocity/acceleration (goal is at rest)", v.final_velocity,
+             thresholds.final_velocity));
+  const Eigen::VectorXd q_final = plan.q.row(N).transpose();
+  if (problem.goal.kind == Goal::Kind::kJoint) {
+    if (problem.goal.q.size() != n) {
+      fail("joint goal has the wrong size");
+    } else {
+      v.goal_error = (q_final - problem.goal.q).cwiseAbs().maxCoeff();
+    }
+  } else {
+    int frame = -1;
+    try {
+      frame = model.frame_index(problem.goal.frame);
+    } catch (const std::out_of_range&) {
+      fail("goal frame '" + problem.goal.frame + "' is not in the model");
+    }
+    if (frame >= 0) {
+      dynamics::forward_kinematics(model, data, q_final);
+      const PoseError e = pose_error(dynamics::frame_pose(model, data, frame), problem.goal.pose);
+      v.goal_error = problem.goal.position_only ? e.position : std::max(e.position, e.rotation);
+    }
+  }
+  if (v.goal_error > thresholds.goal) fail(fmt("goal error", v.goal_error, thresholds.goal));
+
+  // Task constraints at every step.
+  for (const TaskConstraint& task : problem.task_constraints) {
+    int frame = -1;
+    try {
+      frame = model.frame_index(task.frame);
+    } catch (const std::out_of_range&) {
+      fail("task-constraint frame '" + task.frame + "' is not in the model");
+      continue;
+    }
+    double worst = 0;
+    for (int k = 0; k < rows; ++k) {
+      dynamics::forward_kinematics(model, data, plan.q.row(k).transpose());
+      const PoseError e = pose_error(dynamics::frame_pose(model, data, frame), task.target);
+      worst =
+          std::max(worst, task.orientation_only ? e.rotation : std::max(e.rotation, e.position));
+    }
+    v.max_task_error = std::max(v.max_task_error, worst);
+    if (worst > task.tolerance)
+      fail(fmt(("task constraint on '" + task.frame + "'").c_str(), worst, task.tolerance));
+  }
+
+  // Collision: every step and dense samples along the validator's Hermite interpolation.
+  if (!problem.obstacles.empty()) {
+    collision::CollisionWorld world(model);
+    bool ok = true;
+    for (const collision::Obstacle& o : problem.obstacles) {
+      const collision::Status s = world.add_obstacle(o);
+      if (!s.ok) {
+        fail("obstacle " + std::to_string(o.id) + ": " + s.reason);
+        ok = false;
+      }
+    }
+    if (ok) {
+      collision::SegmentChecker checker(model);
+      const int sub = std::max(1, thresholds.collision_samples);
+      Eigen::VectorXd a, b;
+      for (int k = 0; k < N; ++k) {
+        a = plan.q.row(k).transpose();
+        for (int i = 1; i <= sub; ++i) {
+          const double s = static_cast<double>(i) / sub;
+          b = i == sub ? Eigen::VectorXd(plan.q.row(k + 1).transpose()) : hermite(plan, k, s, dt);
+          const double t0 = plan.t.size() == static_cast<size_t>(rows)
+                                ? plan.t[k] + (s - 1.0 / sub) * dt
+                                : (k + s - 1.0 / sub) * dt;
+          const collision::SegmentCheckResult r =
+              checker.check(world, data, a, b, t0, t0 + dt / sub);
+          v.min_clearance = std::min(v.min_clearance, r.min_distance);
+          a = b;
+        }
+      }
+      if (v.min_clearance < thresholds.min_clearance) {
+        std::ostringstream os;
+        os << "collision: clearance " << v.min_clearance << " m below " << thresholds.min_clearance;
+        fail(os.str());
+      }
+    }
+  }
+
+  v.valid = v.failures.empty();
+  return v;
+}
+
+}  // namespace kinograph::planning

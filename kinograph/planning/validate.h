@@ -1,0 +1,30 @@
+#pragma once
+// Checks a plan against its problem independently of the solver: the physics (inverse dynamics,
+// integration consistency), every limit, collision at and between steps, start, goal and task
+// constraints. "Success" means a plan validates.
+#include "kinograph/planning/plan.h"
+#include "kinograph/planning/problem.h"
+
+namespace kinograph::planning {
+
+/// Thresholds of validate(). The collision check requires no penetration (clearance ≥
+/// min_clearance); the planner's safety distance ε is its own margin, not the validator's.
+struct ValidationThresholds {
+  double dynamics = 1e-3;              ///< max |τ − RNEA(q,q̇,q̈)| (N·m)
+  double position_consistency = 2e-2;  ///< trapezoid residual of q (rad)
+  double velocity_consistency = 2e-2;  ///< trapezoid residual of q̇ (rad/s)
+  double limit = 1e-3;                 ///< allowed excess over any q, q̇, q̈, τ limit
+  double unactuated_torque = 1e-3;     ///< max |τ| on unactuated joints (N·m)
+  double min_clearance = 0.0;          ///< m; negative allows that much penetration
+  double goal = 1e-2;                  ///< goal error (rad; m and rad for pose goals)
+  double start = 1e-6;                 ///< start state error (rad, rad/s)
+  double final_velocity = 1e-2;        ///< |q̇_N|, |q̈_N| at the goal
+  int collision_samples = 10;          ///< states checked per interval (dense sampling)
+};
+
+/// Validates `plan` for `problem`: fills every figure of Validation, lists each failed check
+/// in failures, and sets valid. Malformed plans (wrong sizes, NaN) are invalid, never a crash.
+Validation validate(const Problem& problem, const Plan& plan,
+                    const ValidationThresholds& thresholds = {});
+
+}  // namespace kinograph::planning
