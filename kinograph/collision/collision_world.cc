@@ -131,6 +131,11 @@ const Obstacle* CollisionWorld::find_obstacle(int id) const {
   return i < 0 ? nullptr : &obstacles_[i].obstacle;
 }
 
+bool CollisionWorld::has_moving_obstacles() const {
+  return std::any_of(obstacles_.begin(), obstacles_.end(),
+                     [](const ObstacleEntry& o) { return o.obstacle.is_moving(); });
+}
+
 void CollisionWorld::update_poses(const dynamics::Data& data, double t) {
   for (RobotGeom& g : robot_) {
     g.world = g.body < 0 ? g.origin : data.body_pose[g.body] * g.origin;

@@ -58,6 +58,8 @@ class CollisionWorld {
   const Obstacle* find_obstacle(int id) const;
   // Number of obstacles.
   int num_obstacles() const { return static_cast<int>(obstacles_.size()); }
+  // True when some obstacle follows a trajectory.
+  bool has_moving_obstacles() const;
   // The robot's collision geometry as Bullet shapes, one per Model::collision entry.
   const ConvexShape& robot_shape(int geom) const { return robot_[geom].shape; }
   const CollisionWorldOptions& options() const { return options_; }

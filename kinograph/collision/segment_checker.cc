@@ -50,7 +50,7 @@ SegmentChecker::SegmentChecker(const dynamics::Model& model, SegmentCheckOptions
 }
 
 int SegmentChecker::intervals(const Eigen::Ref<const Eigen::VectorXd>& q0,
-                              const Eigen::Ref<const Eigen::VectorXd>& q1) const {
+                              const Eigen::Ref<const Eigen::VectorXd>& q1, double time_span) const {
   double max_step = 0, sweep = 0;
   for (int j = 0; j < model_.nq(); ++j) {
     const double dq = std::abs(q1[j] - q0[j]);
@@ -58,7 +58,8 @@ int SegmentChecker::intervals(const Eigen::Ref<const Eigen::VectorXd>& q0,
     sweep += dq * lever_[j];
   }
   const double n = std::max({1.0, std::ceil(max_step / options_.max_joint_step),
-                             std::ceil(sweep / options_.max_sweep_step)});
+                             std::ceil(sweep / options_.max_sweep_step),
+                             std::ceil(std::abs(time_span) / options_.max_time_step)});
   return static_cast<int>(std::min(n, 1e6));
 }
 
@@ -68,7 +69,7 @@ SegmentCheckResult SegmentChecker::check(CollisionWorld& world, dynamics::Data& 
                                          double t1) {
   SegmentCheckResult result;
   result.min_distance = std::numeric_limits<double>::infinity();
-  const int n = intervals(q0, q1);
+  const int n = intervals(q0, q1, world.has_moving_obstacles() ? t1 - t0 : 0.0);
   for (int k = 0; k <= n; ++k) {
     const double s = static_cast<double>(k) / n;
     q_ = q0 + s * (q1 - q0);

@@ -20,6 +20,9 @@ struct SegmentCheckOptions {
   // (m), from a configuration-independent bound of each joint's lever arm. Default 0.01: an
   // obstacle thinner than this can still slip between two samples, by at most this much.
   double max_sweep_step = 0.01;
+  // Largest time between samples (s) when the world has moving obstacles, whose own motion
+  // the sweep bound does not cover. Default 0.02.
+  double max_time_step = 0.02;
 };
 
 // The smallest signed distance found along a segment.
@@ -46,9 +49,10 @@ class SegmentChecker {
                            const Eigen::Ref<const Eigen::VectorXd>& q0,
                            const Eigen::Ref<const Eigen::VectorXd>& q1, double t0 = 0,
                            double t1 = 0);
-  // Number of intervals the segment is cut into (samples − 1).
+  // Number of intervals the segment is cut into (samples − 1); the time span counts only
+  // when there are moving obstacles.
   int intervals(const Eigen::Ref<const Eigen::VectorXd>& q0,
-                const Eigen::Ref<const Eigen::VectorXd>& q1) const;
+                const Eigen::Ref<const Eigen::VectorXd>& q1, double time_span = 0) const;
   // Bound on |∂p/∂q_j| over every point p of the robot's collision geometry (m/rad; 1 for a
   // prismatic joint), valid at any configuration.
   const Eigen::VectorXd& lever() const { return lever_; }

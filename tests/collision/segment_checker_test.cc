@@ -1,0 +1,129 @@
+// Between-steps checking: the sweep bound, a thin plate the end states straddle, a moving
+// obstacle met only mid-segment.
+#include "kinograph/collision/segment_checker.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "kinograph/dynamics/kinematics.h"
+
+namespace kinograph::collision {
+namespace {
+
+const std::string kRobots = std::string(KINOGRAPH_SOURCE_DIR) + "/robots/";
+
+Eigen::Isometry3d at(double x, double y, double z) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.translation() = Eigen::Vector3d(x, y, z);
+  return T;
+}
+
+class RrSegment : public testing::Test {
+ protected:
+  RrSegment() : model(dynamics::Model::from_urdf_file(kRobots + "rr/rr.urdf")), data(model) {}
+  dynamics::Model model;
+  dynamics::Data data;
+};
+
+// Joint 1 carries the whole arm: its farthest point is the tip sphere's top, 1 + 0.8 + 0.045.
+TEST_F(RrSegment, LeverArmsAreTheArmsReach) {
+  const SegmentChecker checker(model);
+  ASSERT_EQ(checker.lever().size(), 2);
+  EXPECT_NEAR(checker.lever()[0], 1.845, 1e-12);
+  EXPECT_NEAR(checker.lever()[1], 0.845, 1e-12);
+}
+
+// Swinging the upright arm from one side to the other passes through a 5 mm plate above the
+// shoulder; both end states are far from it.
+TEST_F(RrSegment, FindsThinPlateBetweenClearEndStates) {
+  CollisionWorld world(model);
+  Obstacle plate;
+  plate.id = 1;
+  plate.shape = Shape::box(0.005, 0.5, 0.1);
+  plate.pose = at(0.0, 0, 1.5);
+  ASSERT_TRUE(world.add_obstacle(plate));
+  Eigen::VectorXd q0(2), q1(2);
+  q0 << -M_PI / 2 + 0.1, 0;
+  q1 << M_PI / 2 - 0.1, 0;
+  dynamics::forward_kinematics(model, data, q0);
+  EXPECT_GT(world.closest(data).distance, 0.3);
+  dynamics::forward_kinematics(model, data, q1);
+  EXPECT_GT(world.closest(data).distance, 0.3);
+
+  SegmentChecker checker(model);
+  const SegmentCheckResult r = checker.check(world, data, q0, q1);
+  EXPECT_LT(r.min_distance, -0.03);  // the forearm (r 0.04) cuts the plate
+  EXPECT_NEAR(r.s, 0.5, 0.01);
+  EXPECT_EQ(r.closest.obstacle, 1);
+  // Sampling only the ends would have missed it.
+  SegmentChecker coarse(model, {.max_joint_step = 10, .max_sweep_step = 100});
+  EXPECT_EQ(coarse.check(world, data, q0, q1).samples, 2);
+  EXPECT_GT(coarse.check(world, data, q0, q1).min_distance, 0.3);
+}
+
+// A sphere that crosses the arm's path only in the middle of the time interval.
+TEST_F(RrSegment, MovingObstacleAtInterpolatedTime) {
+  CollisionWorld world(model);
+  Obstacle o;
+  o.id = 4;
+  o.shape = Shape::sphere(0.1);
+  o.trajectory = PoseTrajectory({0.0, 1.0, 2.0}, {at(0, 0, 3), at(0, 0, 1.2), at(0, 0, 3)});
+  ASSERT_TRUE(world.add_obstacle(o));
+  Eigen::VectorXd q0 = Eigen::VectorXd::Zero(2), q1 = Eigen::VectorXd::Zero(2);
+  q1[1] = 0.01;  // barely moving: the obstacle's time span drives the sampling
+  SegmentChecker checker(model, {.max_time_step = 0.1});
+  const SegmentCheckResult r = checker.check(world, data, q0, q1, 0.0, 2.0);
+  EXPECT_EQ(r.samples, 21);
+  EXPECT_NEAR(r.s, 0.5, 1e-12);
+  EXPECT_LT(r.min_distance, -0.1);  // the upright link-1 cylinder is inside the sphere at t = 1
+}
+
+// Between consecutive samples no geometry point moves farther than max_sweep_step.
+TEST(SegmentChecker, ConsecutiveSamplesRespectSweepBoundOnIiwa) {
+  const dynamics::Model model = dynamics::Model::from_urdf_file(kRobots + "iiwa14/iiwa14.urdf");
+  dynamics::Data data(model);
+  const SegmentCheckOptions opts{.max_joint_step = 1.0, .max_sweep_step = 0.02};
+  const SegmentChecker checker(model, opts);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.5, 1.5);
+  // Test points: each geometry's centre and six points on its bounding sphere.
+  for (int trial = 0; trial < 20; ++trial) {
+    Eigen::VectorXd q0(model.nq()), q1(model.nq());
+    for (int j = 0; j < model.nq(); ++j) {
+      q0[j] = u(rng);
+      q1[j] = q0[j] + 0.5 * u(rng);
+    }
+    const int n = checker.intervals(q0, q1);
+    ASSERT_GE(n, 1);
+    std::vector<Eigen::Vector3d> prev, cur;
+    for (int k = 0; k <= n; ++k) {
+      const Eigen::VectorXd q = q0 + (static_cast<double>(k) / n) * (q1 - q0);
+      dynamics::forward_kinematics(model, data, q);
+      cur.clear();
+      for (const auto& g : model.collision) {
+        if (g.body < 0) continue;
+        const Eigen::Isometry3d T = data.body_pose[g.body] * g.origin;
+        const double r = g.size.x();
+        for (const Eigen::Vector3d& d :
+             {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(r, 0, 0), Eigen::Vector3d(-r, 0, 0),
+              Eigen::Vector3d(0, r, 0), Eigen::Vector3d(0, -r, 0), Eigen::Vector3d(0, 0, r),
+              Eigen::Vector3d(0, 0, -r)}) {
+          cur.push_back(T * d);
+        }
+      }
+      if (k > 0) {
+        for (size_t i = 0; i < cur.size(); ++i) {
+          EXPECT_LE((cur[i] - prev[i]).norm(), opts.max_sweep_step) << "trial " << trial;
+        }
+      }
+      prev = cur;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace kinograph::collision
