@@ -1,0 +1,6 @@
+#pragma once
+// OpenGL entry points come straight from libOSMesa (it exports every gl* symbol), so no loader
+// is needed; never link libGL as well (platform.md §7).
+#define GL_GLEXT_PROTOTYPES 1
+#include <GL/gl.h>
+#include <GL/glext.h>

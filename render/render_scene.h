@@ -1,0 +1,43 @@
+#pragma once
+// What the renderer draws: a robot model moving along a trajectory among obstacles.
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "kinograph/dynamics/geometry.h"
+#include "kinograph/dynamics/model.h"
+#include "render/camera.h"
+
+namespace kinograph::render {
+
+/// Joint positions sampled in time (a plan's t and q).
+struct Trajectory {
+  std::vector<double> t;           ///< increasing sample times, s
+  std::vector<Eigen::VectorXd> q;  ///< joint positions at each time, one per sample
+
+  /// Joint positions at `time`, linearly interpolated and clamped to the ends.
+  Eigen::VectorXd at(double time) const;
+  /// `count` times spread evenly from the first to the last sample (the first if count is 1).
+  std::vector<double> even_times(int count) const;
+};
+
+/// Everything a picture of a plan depends on. The model is borrowed and must outlive the
+/// scene; obstacles are shapes with body = -1 whose `origin` is their world pose.
+struct RenderScene {
+  const dynamics::Model* model = nullptr;
+  Trajectory trajectory;
+  std::vector<dynamics::Geometry> obstacles;
+  std::optional<Camera> camera;    ///< automatic framing when absent
+  std::string end_effector_frame;  ///< frame whose path a ghost overlay draws; empty = last frame
+
+  /// Throws std::invalid_argument naming the problem when the scene cannot be drawn (no model,
+  /// empty trajectory, joint vectors of the wrong size, decreasing times).
+  void check() const;
+};
+
+/// The common world direction of all joint axes when the robot is planar (every joint axis
+/// parallel, checked at configuration q), else nullopt. Such robots are best seen along it.
+std::optional<Eigen::Vector3d> planar_axis(const dynamics::Model& model, const Eigen::VectorXd& q);
+
+}  // namespace kinograph::render
