@@ -4,13 +4,17 @@
 // solver starts at zero dynamics residual.
 #include <Eigen/Core>
 #include <cstddef>
+#include <memory>
+#include <string>
 #include <vector>
 
 #include "kinograph/dynamics/inverse_dynamics.h"
 #include "kinograph/dynamics/model.h"
 #include "kinograph/graph/factor_graph.h"
 #include "kinograph/graph/values.h"
+#include "kinograph/planning/constrained_factor.h"
 #include "kinograph/planning/dfg_factors.h"
+#include "kinograph/planning/dynamics_factors.h"
 
 namespace kinograph::planning {
 
@@ -59,6 +63,9 @@ struct DfgOptions {
   /// Constant wrenches the environment applies to bodies (body frame, as dynamics::rnea), e.g.
   /// a payload not merged into the Model; they enter the wrench-balance factors.
   std::vector<dynamics::ExternalWrench> external;
+  /// Scale s of the equation rows when the DFG is added as augmented-Lagrangian constraints
+  /// (add_dfg_constraints): a row's violation is measured as |e|/s.
+  double constraint_scale = 1.0;
 };
 
 /// Where one step's DFG factors sit in the graph (FactorGraph indices), by kind and body, so a
@@ -93,6 +100,55 @@ DfgStep add_dfg_dynamics(graph::FactorGraph& graph, graph::Values& values,
 /// the graph's V, V̇, F, τ are from satisfying the equations of motion.
 double dfg_max_residual(const graph::FactorGraph& graph, const graph::Values& values,
                         const std::vector<size_t>& factors);
+
+/// A DFG factor as must-hold equality rows e = 0 (scale s) of the augmented-Lagrangian planner;
+/// the wrapped factor's own noise model is ignored.
+class DfgConstraintFactor final : public ConstrainedFactor {
+ public:
+  /// Throws std::invalid_argument on a null factor or a non-positive scale.
+  DfgConstraintFactor(graph::FactorPtr equation, double scale);
+  void compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
+               const graph::Jacobians* J) const override;
+  std::string name() const override;
+  const graph::FactorPtr& equation() const { return equation_; }
+
+ private:
+  graph::FactorPtr equation_;
+};
+
+/// The torque rows of the condensed DynamicsStepFactor (unactuated τ_j = 0, effort bounds,
+/// minimum-torque soft rows; same RowSpecs), but on the DFG's torque variables, so the two
+/// formulations pose the same problem.
+class DfgTorqueRowsFactor final : public ConstrainedFactor {
+ public:
+  /// Throws std::invalid_argument if the model and options give no rows (see
+  /// DynamicsStepFactor::rows_for).
+  DfgTorqueRowsFactor(const dynamics::Model& model, int step, const DynamicsStepOptions& options,
+                      const DfgKeys& keys = {});
+  void compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
+               const graph::Jacobians* J) const override;
+
+ private:
+  std::vector<int> slot_of_row_, comp_of_row_;
+};
+
+/// One step of the DFG in the planner's constrained form: what add_dfg_constraints added.
+struct DfgConstraintStep {
+  int step = 0;
+  /// The 4·nq equations of motion (DfgConstraintFactor), then the torque rows if any.
+  std::vector<std::shared_ptr<ConstrainedFactor>> factors;
+  std::vector<size_t> indices;  ///< their FactorGraph indices, same order
+};
+
+/// The DFG formulation of one step for the augmented-Lagrangian planner, in place of the
+/// condensed DynamicsStepFactor: adds the equations of motion as equality constraints (scale
+/// options.constraint_scale) and the torque rows `torque_rows` on τ, and inserts the step's V, V̇,
+/// F, τ initialised by RNEA from q, q̇, q̈ in `values` (std::out_of_range if those are missing).
+/// Register every returned factor with the AugmentedLagrangian.
+DfgConstraintStep add_dfg_constraints(graph::FactorGraph& graph, graph::Values& values,
+                                      const dynamics::Model& model, dynamics::Data& data, int step,
+                                      const DynamicsStepOptions& torque_rows,
+                                      const DfgOptions& options = {});
 
 /// The torques of `step` read back from the graph (nq entries).
 Eigen::VectorXd dfg_torques(const graph::Values& values, const dynamics::Model& model, int step,

@@ -20,7 +20,10 @@
 #include "kinograph/graph/factor_graph.h"
 #include "kinograph/graph/levenberg_marquardt.h"
 #include "kinograph/graph/prior_factor.h"
+#include "kinograph/graph/testing/numerical_jacobian.h"
 #include "kinograph/graph/values.h"
+#include "kinograph/planning/augmented_lagrangian.h"
+#include "kinograph/planning/dynamics_factors.h"
 
 namespace kinograph::planning {
 namespace {
@@ -204,6 +207,125 @@ TEST(DfgBuilder, SingleStepSolveRecoversForwardDynamics) {
         << values.at(options.keys.qdd_key(0)).transpose() << "\n"
         << qdd.transpose();
   }
+}
+
+// The constrained form: every DFG equation as equality rows, and the torque rows on τ. At
+// RNEA-initialised values the equations hold (no violation) and the torque rows read the same z
+// as the condensed DynamicsStepFactor; Jacobians (through the augmented-Lagrangian residual,
+// with multipliers and μ set) match central differences.
+TEST(DfgBuilder, ConstraintStepMatchesCondensedRows) {
+  std::mt19937 rng(21);
+  for (bool torque_vector : {false, true}) {
+    auto model =
+        std::make_shared<const Model>(Model::from_urdf_file(robot("acrobot/acrobot.urdf")));
+    const int n = model->nq();
+    DfgOptions options;
+    options.keys.torque_vector = torque_vector;
+    options.constraint_scale = 2.0;
+    DynamicsStepOptions rows;
+    rows.min_torque = 0.5;
+    graph::FactorGraph graph;
+    graph::Values values;
+    const Eigen::VectorXd q = uniform(rng, n, 3), qd = uniform(rng, n, 2), qdd = uniform(rng, n, 5);
+    insert_joints(values, options.keys, 4, q, qd, qdd);
+    dynamics::Data data(*model);
+    const DfgConstraintStep s = add_dfg_constraints(graph, values, *model, data, 4, rows, options);
+    ASSERT_EQ(s.factors.size(), 4u * n + 1);  // + the torque rows
+    ASSERT_EQ(s.indices.size(), s.factors.size());
+    for (size_t i = 0; i < s.factors.size(); ++i) {
+      EXPECT_EQ(graph.at(s.indices[i]).get(), s.factors[i].get());
+      if (i < 4u * n) {
+        EXPECT_LT(s.factors[i]->violation(values), 1e-10) << s.factors[i]->name();
+      }
+    }
+    // Same rows and values as the condensed factor at the same state.
+    auto workspace = std::make_shared<dynamics::Data>(*model);
+    const DynamicsStepFactor condensed(4, model, workspace, rows);
+    Eigen::VectorXd z_dfg, z_condensed;
+    s.factors.back()->values_at(values, z_dfg);
+    graph::Values joint_values;
+    insert_joints(joint_values, options.keys, 4, q, qd, qdd);
+    condensed.values_at(joint_values, z_condensed);
+    ASSERT_EQ(z_dfg.size(), z_condensed.size());
+    EXPECT_LT((z_dfg - z_condensed).cwiseAbs().maxCoeff(), 1e-10);
+    ASSERT_EQ(s.factors.back()->rows().size(), condensed.rows().size());
+    for (size_t r = 0; r < condensed.rows().size(); ++r) {
+      EXPECT_EQ(s.factors.back()->rows()[r].kind, condensed.rows()[r].kind);
+      EXPECT_EQ(s.factors.back()->rows()[r].lower, condensed.rows()[r].lower);
+      EXPECT_EQ(s.factors.back()->rows()[r].upper, condensed.rows()[r].upper);
+    }
+
+    // Jacobians of the augmented-Lagrangian residuals away from RNEA's values.
+    for (int i = 0; i < values.size(); ++i) {
+      if (values.key(i).kind() != 'q' && values.key(i).kind() != 'v' &&
+          values.key(i).kind() != 'a') {
+        values.at_slot(i) += uniform(rng, values.dim(i), 0.5);
+      }
+    }
+    for (const auto& f : s.factors) {
+      f->set_penalty(30.0);
+      f->set_multipliers(uniform(rng, f->residual_dim(), 1.0),
+                         uniform(rng, f->residual_dim(), 1.0).cwiseAbs());
+      const auto check = graph::testing::check_jacobians(*f, values);
+      EXPECT_TRUE(check.ok) << f->name() << "\n" << check.report();
+    }
+  }
+}
+
+// The two formulations pose the same single-step problem: the Acrobot at a fixed (q, q̇) with
+// q̈ pulled towards a target by a soft prior, subject to the shoulder being unactuated
+// (τ₁ = 0) and the elbow's ±8 N·m. The augmented-Lagrangian loop on the DFG and on the condensed
+// factor reach the same q̈ and torques.
+TEST(DfgBuilder, ConstrainedSingleStepAgreesWithCondensed) {
+  auto model = std::make_shared<const Model>(Model::from_urdf_file(robot("acrobot/acrobot.urdf")));
+  const int n = model->nq();
+  const Eigen::Vector2d q(0.4, -0.9), qd(1.5, -2.0), target(6.0, -9.0);
+  DynamicsStepOptions rows;
+  struct Result {
+    Eigen::VectorXd qdd, tau;
+  };
+  auto solve = [&](bool dfg) {
+    DfgOptions options;
+    graph::FactorGraph graph;
+    graph::Values values;
+    insert_joints(values, options.keys, 0, q, qd, Eigen::VectorXd::Zero(n));
+    values.set_fixed(options.keys.q_key(0));
+    values.set_fixed(options.keys.qd_key(0));
+    graph.emplace<graph::PriorFactor>(options.keys.qdd_key(0), target);
+    std::vector<std::shared_ptr<ConstrainedFactor>> constraints;
+    auto workspace = std::make_shared<dynamics::Data>(*model);
+    if (dfg) {
+      constraints =
+          add_dfg_constraints(graph, values, *model, *workspace, 0, rows, options).factors;
+    } else {
+      auto f = std::make_shared<DynamicsStepFactor>(0, model, workspace, rows);
+      graph.add(f);
+      constraints.push_back(f);
+    }
+    AugmentedLagrangian al(constraints);
+    graph::LevenbergMarquardtOptions lm_options;
+    lm_options.relative_error_tol = 1e-10;
+    graph::LevenbergMarquardt lm(lm_options);
+    for (int outer = 0; outer < 30; ++outer) {
+      lm.optimize(graph, values);
+      if (al.update(values) < 1e-9) break;
+    }
+    Result r;
+    r.qdd = values.at(options.keys.qdd_key(0));
+    dynamics::Data data(*model);
+    r.tau = dynamics::rnea(*model, data, q, qd, r.qdd);
+    if (dfg) {
+      EXPECT_LT((dfg_torques(values, *model, 0) - r.tau).cwiseAbs().maxCoeff(), 1e-6);
+    }
+    return r;
+  };
+  const Result condensed = solve(false), dfg = solve(true);
+  EXPECT_NEAR(condensed.tau[0], 0.0, 1e-6);
+  EXPECT_LE(std::abs(condensed.tau[1]), 8.0 + 1e-6);
+  EXPECT_GT(std::abs(condensed.tau[1]), 7.9) << "the elbow bound should be active";
+  EXPECT_LT((dfg.qdd - condensed.qdd).cwiseAbs().maxCoeff(), 1e-5)
+      << dfg.qdd.transpose() << " vs " << condensed.qdd.transpose();
+  EXPECT_LT((dfg.tau - condensed.tau).cwiseAbs().maxCoeff(), 1e-5);
 }
 
 TEST(DfgBuilder, RejectsExternalWrenchOnMissingBody) {
