@@ -1,6 +1,8 @@
 #include "kinograph/graph/gauss_newton.h"
 
+#include <algorithm>
 #include <chrono>
+#include <limits>
 
 #include "kinograph/graph/normal_equations.h"
 
@@ -82,6 +84,13 @@ OptimizationResult GaussNewton::optimize(const FactorGraph& graph, Values& value
     stats.error = new_error;
     stats.accepted = finite && new_error <= error;
     if (o.record_history) result.history.push_back(stats);
+    const double rounding = 8 * std::numeric_limits<double>::epsilon() * error;
+    if (finite && !stats.accepted &&
+        new_error - error <= std::max(o.relative_error_tol * error, rounding)) {
+      // At the optimum rounding can make the last step a hair worse: that is convergence.
+      values.vector() = x_backup;
+      return finish(SolverStatus::kConverged, "relative change below tolerance");
+    }
     if (!stats.accepted) {
       values.vector() = x_backup;
       return finish(SolverStatus::kNoDecrease,

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include "kinograph/graph/normal_equations.h"
 
@@ -133,9 +134,15 @@ OptimizationResult LevenbergMarquardt::optimize(const FactorGraph& graph, Values
         stats.evaluate_s = seconds_since(t);
         result.evaluate_s += stats.evaluate_s;
         stats.error = finite ? new_error : std::numeric_limits<double>::infinity();
-        if (finite && new_error < error) {
+        // At the optimum both the model decrease and the actual change sink below the rounding
+        // of the cost; such a step is as good as any and is kept, so LM can polish x to full
+        // precision instead of mistaking rounding for a failed step.
+        const double rounding = 8 * std::numeric_limits<double>::epsilon() * error;
+        const bool at_rounding = predicted <= rounding && new_error - error <= rounding;
+        if (finite && (new_error < error || at_rounding)) {
           accepted = true;
-          const double rho = predicted > 0 ? (error - new_error) / predicted : 1.0;
+          const double rho =
+              (predicted > 0 && !at_rounding) ? (error - new_error) / predicted : 1.0;
           lambda *= std::max(1.0 / 3.0, 1.0 - std::pow(2.0 * rho - 1.0, 3));
           lambda = std::max(lambda, o.lambda_min);
           nu = 2;

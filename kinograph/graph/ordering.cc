@@ -53,10 +53,13 @@ std::vector<int> amd(int n, const std::vector<std::vector<int>>& factor_variable
   std::vector<int> col_ptr, row_idx;
   adjacency(n, factor_variables, col_ptr, row_idx);
   std::vector<int> perm(n);
+  if (row_idx.empty()) {  // no edges: any order is perfect (and AMD rejects an empty pattern)
+    std::iota(perm.begin(), perm.end(), 0);
+    return perm;
+  }
   double control[AMD_CONTROL], info[AMD_INFO];
   amd_defaults(control);
-  const int status = amd_order(n, col_ptr.data(), row_idx.empty() ? nullptr : row_idx.data(),
-                               perm.data(), control, info);
+  const int status = amd_order(n, col_ptr.data(), row_idx.data(), perm.data(), control, info);
   if (status != AMD_OK && status != AMD_OK_BUT_JUMBLED) {
     throw std::runtime_error("AMD ordering failed with status " + std::to_string(status));
   }

@@ -1,0 +1,150 @@
+// Solver behaviour on nonlinear problems: orderings and factorizations agree, structure is reused
+// across solves after changing targets, fixed variables stay, statistics are consistent.
+#include <gtest/gtest.h>
+
+#include <numeric>
+
+#include "kinograph/graph/levenberg_marquardt.h"
+#include "kinograph/graph/ordering.h"
+#include "tests/graph/problems.h"
+
+namespace kinograph::graph {
+namespace {
+
+TEST(Solver, EveryOrderingAndFactorizationGivesTheSameSolution) {
+  const auto p = problems::chain(300);
+  Eigen::VectorXd reference;
+  for (auto ordering : {OrderingMethod::kNatural, OrderingMethod::kAmd, OrderingMethod::kColamd,
+                        OrderingMethod::kMetis}) {
+    for (auto fact :
+         {Factorization::kAuto, Factorization::kSupernodal, Factorization::kSimplicial}) {
+      LevenbergMarquardtOptions o;
+      o.ordering = ordering;
+      o.factorization = fact;
+      o.relative_error_tol = 0;  // stop on the step size, which pins x down
+      o.step_tol = 1e-11;
+      LevenbergMarquardt lm(o);
+      Values v = p.start;
+      const auto r = lm.optimize(p.graph, v);
+      ASSERT_TRUE(r.converged()) << r.reason;
+      if (fact == Factorization::kSimplicial) {
+        EXPECT_FALSE(lm.cholesky()->is_supernodal());
+      } else if (fact == Factorization::kSupernodal) {
+        EXPECT_TRUE(lm.cholesky()->is_supernodal());
+      }
+      if (reference.size() == 0) {
+        reference = v.vector();
+      } else {
+        // GN-type methods converge only linearly on a problem with non-zero residuals, and the
+        // cost's rounding (1e-16 relative) limits how far x is pinned down: ~1e-7 here.
+        EXPECT_LT((v.vector() - reference).cwiseAbs().maxCoeff(), 2e-6)
+            << to_string(ordering) << " " << to_string(fact);
+      }
+    }
+  }
+}
+
+TEST(Solver, OrderingsArePermutationsAndColamdHonoursGroups) {
+  std::vector<std::vector<int>> factors;
+  const int n = 40;
+  for (int i = 0; i + 1 < n; ++i) factors.push_back({i, i + 1});
+  factors.push_back({0, 20, 39});
+  std::vector<int> groups(n, 0);
+  groups[3] = groups[17] = 1;  // must come last
+  for (auto m : {OrderingMethod::kNatural, OrderingMethod::kAmd, OrderingMethod::kColamd,
+                 OrderingMethod::kMetis}) {
+    auto order =
+        compute_ordering(n, factors, m, m == OrderingMethod::kColamd ? groups : std::vector<int>{});
+    ASSERT_EQ(static_cast<int>(order.size()), n);
+    std::vector<int> sorted = order;
+    std::sort(sorted.begin(), sorted.end());
+    std::vector<int> iota(n);
+    std::iota(iota.begin(), iota.end(), 0);
+    EXPECT_EQ(sorted, iota) << to_string(m);
+    if (m == OrderingMethod::kColamd) {
+      EXPECT_TRUE((order[n - 1] == 3 && order[n - 2] == 17) ||
+                  (order[n - 1] == 17 && order[n - 2] == 3));
+    }
+  }
+}
+
+TEST(Solver, ResolveAfterChangingTargetsReusesStructure) {
+  auto p = problems::chain(200);
+  LevenbergMarquardtOptions o;
+  o.relative_error_tol = 0;
+  o.step_tol = 1e-11;
+  LevenbergMarquardt lm(o);
+  Values v = p.start;
+  const auto first = lm.optimize(p.graph, v);
+  ASSERT_TRUE(first.converged());
+  EXPECT_GT(first.symbolic_s, 0.0);
+  // Move the prior on x₀ and make the measurements noisier, keeping keys.
+  auto prior = std::dynamic_pointer_cast<PriorFactor>(p.graph[199]);
+  ASSERT_NE(prior, nullptr);
+  prior->set_target(prior->target() + Eigen::Vector3d(0.3, -0.2, 0.1));
+  for (size_t i = 200; i < p.graph.size(); ++i) {
+    p.graph[i]->set_noise(diagonal(Eigen::Vector2d(0.6, 0.4)));
+  }
+  const auto second = lm.optimize(p.graph, v);
+  ASSERT_TRUE(second.converged());
+  EXPECT_EQ(second.symbolic_s, 0.0);  // cached structure
+  Values fresh = p.start;
+  const auto third = LevenbergMarquardt(o).optimize(p.graph, fresh);
+  ASSERT_TRUE(third.converged());
+  EXPECT_NEAR(second.final_error, third.final_error, 1e-12 * third.final_error);
+  EXPECT_LT((v.vector() - fresh.vector()).cwiseAbs().maxCoeff(), 2e-6);
+
+  // Removing a factor changes the structure: rebuilt, still right.
+  p.graph.remove(5);
+  Values w = v;
+  const auto fourth = lm.optimize(p.graph, w);
+  EXPECT_GT(fourth.symbolic_s, 0.0);
+  Values w2 = v;
+  const auto fifth = LevenbergMarquardt(o).optimize(p.graph, w2);
+  EXPECT_NEAR(fourth.final_error, fifth.final_error, 1e-12 * fifth.final_error);
+}
+
+TEST(Solver, FixedVariablesStayFixedAndMatchCeresWithConstantBlocks) {
+  auto p = problems::chain(100);
+  for (int k : {0, 40, 99}) p.start.set_fixed(Key('x', 0, k));
+  Values v = p.start;
+  LevenbergMarquardtOptions o;
+  o.relative_error_tol = 0;
+  o.step_tol = 1e-11;
+  const auto r = LevenbergMarquardt(o).optimize(p.graph, v);
+  ASSERT_TRUE(r.converged()) << r.reason;
+  for (int k : {0, 40, 99}) {
+    EXPECT_EQ(v.at(Key('x', 0, k)), p.start.at(Key('x', 0, k)));
+  }
+  EXPECT_NE(v.at(Key('x', 0, 41)), p.start.at(Key('x', 0, 41)));
+  ceres::Problem problem;
+  Eigen::VectorXd params;
+  problems::build_ceres(p.graph, p.start, params, problem);
+  ceres::Solver::Summary summary;
+  ceres::Solve(problems::ceres_options(0, 1e-11), &problem, &summary);
+  EXPECT_NEAR(r.final_error, summary.final_cost, 1e-12 * summary.final_cost);
+  EXPECT_LT((v.vector() - params).cwiseAbs().maxCoeff(), 2e-6);
+}
+
+TEST(Solver, StatisticsAreConsistent) {
+  auto p = problems::chain(100);
+  const auto r = LevenbergMarquardt().optimize(p.graph, p.start);
+  ASSERT_TRUE(r.converged());
+  EXPECT_EQ(static_cast<int>(r.history.size()), r.trials);
+  EXPECT_GE(r.trials, r.iterations);
+  double last_accepted = r.initial_error;
+  for (const auto& s : r.history) {
+    EXPECT_GT(s.lambda, 0.0);
+    if (s.accepted) {
+      EXPECT_LT(s.error, last_accepted);  // accepted steps decrease the error monotonically
+      last_accepted = s.error;
+    }
+  }
+  EXPECT_DOUBLE_EQ(last_accepted, r.final_error);
+  EXPECT_NEAR(r.final_error, p.graph.error(p.start), 1e-12 * r.final_error);
+  EXPECT_GT(r.factorize_s, 0.0);
+  EXPECT_GE(r.total_s, r.linearize_s + r.factorize_s + r.solve_s);
+}
+
+}  // namespace
+}  // namespace kinograph::graph
