@@ -1,0 +1,244 @@
+#include "kinograph/planning/batch_planner.h"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "kinograph/collision/collision_world.h"
+#include "kinograph/dynamics/inverse_dynamics.h"
+#include "kinograph/dynamics/kinematics.h"
+#include "kinograph/graph/levenberg_marquardt.h"
+#include "kinograph/planning/initialization.h"
+
+namespace kinograph::planning {
+namespace {
+
+std::string joint_list_outside(const dynamics::Model& model, const Eigen::VectorXd& q,
+                               const char* what) {
+  std::ostringstream os;
+  for (int j = 0; j < model.nq(); ++j) {
+    const auto& l = model.bodies[j].limits;
+    if (q[j] < l.lower || q[j] > l.upper) {
+      os << what << " joint '" << model.bodies[j].joint_name << "' = " << q[j] << " is outside ["
+         << l.lower << ", " << l.upper << "]; ";
+    }
+  }
+  return os.str();
+}
+
+double min_clearance(const Problem& problem, const Eigen::VectorXd& q) {
+  collision::CollisionWorld world(*problem.model);
+  for (const auto& o : problem.obstacles) world.add_obstacle(o);
+  dynamics::Data data(*problem.model);
+  dynamics::forward_kinematics(*problem.model, data, q);
+  return world.closest(data, 0).distance;
+}
+
+Plan failed_plan(const Problem& problem, const std::string& status, const std::string& reason) {
+  Plan plan;
+  plan.stats.method = "batch-L";
+  plan.stats.status = status;
+  plan.stats.reason = reason;
+  plan.validation.valid = false;
+  plan.validation.failures.push_back(status + ": " + reason);
+  (void)problem;
+  return plan;
+}
+
+}  // namespace
+
+std::string check_problem(const Problem& p) {
+  if (!p.model) return "problem has no robot model";
+  const dynamics::Model& model = *p.model;
+  const int n = model.nq();
+  if (p.steps < 1) return "steps must be at least 1";
+  if (!(p.horizon > 0) || !std::isfinite(p.horizon)) return "horizon must be positive and finite";
+  if (p.start_q.size() != n)
+    return "start_q has " + std::to_string(p.start_q.size()) + " entries, the robot has " +
+           std::to_string(n) + " joints";
+  if (p.start_qd.size() != 0 && p.start_qd.size() != n) return "start_qd has the wrong size";
+  if (!p.start_q.allFinite() || !p.start_qd.allFinite()) return "start state holds NaN or inf";
+  if (!(p.objectives.qc > 0) || !std::isfinite(p.objectives.qc)) return "Qc must be positive";
+  if (!(p.objectives.min_torque >= 0) || !(p.objectives.collision_epsilon >= 0) ||
+      !(p.objectives.limit_epsilon >= 0))
+    return "objective weights and margins must be non-negative numbers";
+  std::string r = joint_list_outside(model, p.start_q, "start");
+  if (!r.empty()) return r;
+  if (p.goal.kind == Goal::Kind::kJoint) {
+    if (p.goal.q.size() != n) return "joint goal has the wrong size";
+    if (!p.goal.q.allFinite()) return "joint goal holds NaN or inf";
+    r = joint_list_outside(model, p.goal.q, "goal");
+    if (!r.empty()) return r;
+  } else {
+    if (!p.goal.pose.matrix().allFinite()) return "goal pose holds NaN or inf";
+    try {
+      model.frame_index(p.goal.frame);
+    } catch (const std::out_of_range&) {
+      return "goal frame '" + p.goal.frame + "' is not in the model";
+    }
+  }
+  for (const auto& t : p.task_constraints) {
+    try {
+      model.frame_index(t.frame);
+    } catch (const std::out_of_range&) {
+      return "task-constraint frame '" + t.frame + "' is not in the model";
+    }
+  }
+  if (!p.obstacles.empty()) {
+    try {
+      if (min_clearance(p, p.start_q) < 0) return "the start configuration is in collision";
+      if (p.goal.kind == Goal::Kind::kJoint && min_clearance(p, p.goal.q) < 0)
+        return "the goal configuration is in collision";
+    } catch (const std::exception& e) {
+      return std::string("bad obstacle: ") + e.what();
+    }
+  }
+  return "";
+}
+
+BatchPlanner::BatchPlanner(BatchPlannerOptions options) : options_(std::move(options)) {}
+
+Plan BatchPlanner::plan(const Problem& problem, const Plan* warm) const {
+  const auto t0 = std::chrono::steady_clock::now();
+  auto elapsed = [&t0] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  };
+  const std::string method = warm != nullptr ? "batch-W" : "batch-L";
+  const std::string problem_error = check_problem(problem);
+  if (!problem_error.empty()) {
+    Plan p = failed_plan(problem, "invalid_problem", problem_error);
+    p.stats.method = method;
+    p.stats.solve_time_s = elapsed();
+    return p;
+  }
+  const int n = problem.model->nq(), N = problem.steps;
+
+  Trajectory init;
+  try {
+    if (warm != nullptr) {
+      init = warm_start(problem, *warm);
+    } else {
+      const auto q_goal = goal_configuration(problem);
+      init = straight_line(problem, *q_goal);
+    }
+  } catch (const std::exception& e) {
+    Plan p = failed_plan(problem, "invalid_problem", e.what());
+    p.stats.method = method;
+    return p;
+  }
+
+  PlanningGraph pg;
+  try {
+    pg = build_graph(problem, init, options_.graph);
+  } catch (const std::exception& e) {
+    Plan p = failed_plan(problem, "invalid_problem", e.what());
+    p.stats.method = method;
+    return p;
+  }
+  AugmentedLagrangian al(pg.constraints, options_.augmented_lagrangian);
+
+  graph::LevenbergMarquardtOptions lm_options;
+  lm_options.record_history = false;
+  lm_options.max_iterations = options_.max_inner_iterations;
+  lm_options.relative_error_tol = options_.inner_tolerance_initial;
+  graph::LevenbergMarquardt lm(lm_options);
+
+  SolveStats stats;
+  stats.method = method;
+  std::string status = "infeasible";
+  std::string reason;
+  double violation = 0;
+  for (int outer = 0; outer < options_.max_outer_iterations; ++outer) {
+    lm_options.max_iterations =
+        std::min(options_.max_inner_iterations, options_.max_total_iterations - stats.iterations);
+    if (lm_options.max_iterations <= 0) break;
+    lm.set_options(lm_options);
+    const graph::OptimizationResult r = lm.optimize(pg.graph, pg.values);
+    stats.iterations += r.iterations;
+    stats.linear_solves += r.trials;
+    stats.outer_iterations = outer + 1;
+    if (r.status == graph::SolverStatus::kNonFinite) {
+      status = "non_finite";
+      reason = r.reason;
+      break;
+    }
+    const ConstraintReport worst = al.report(pg.values);
+    violation = worst.scaled_violation;
+    spdlog::debug("AL outer {}: mu={:.3g} LM {} its ({}), cost {:.6g}, worst {:.3g} at {}", outer,
+                  al.penalty(), r.iterations, graph::to_string(r.status), r.final_error,
+                  worst.scaled_violation, worst.where);
+    if (violation <= options_.constraint_tolerance &&
+        lm_options.relative_error_tol <= options_.inner_tolerance_final * 1.0001) {
+      status = "converged";
+      break;
+    }
+    if (violation <= options_.constraint_tolerance) {
+      // Feasible: one more solve at the final tolerance to settle the objective.
+      lm_options.relative_error_tol = options_.inner_tolerance_final;
+      al.update(pg.values);
+      continue;
+    }
+    al.update(pg.values);
+    lm_options.relative_error_tol =
+        std::max(options_.inner_tolerance_final, lm_options.relative_error_tol * 0.1);
+  }
+  const ConstraintReport worst = al.report(pg.values);
+  stats.max_constraint_violation = worst.violation;
+  if (status == "infeasible" && worst.scaled_violation <= options_.constraint_tolerance) {
+    status = "converged";
+  }
+  if (status == "infeasible") {
+    std::ostringstream os;
+    os << "constraints still violated after " << stats.outer_iterations << " outer and "
+       << stats.iterations << " LM iterations: worst " << worst.violation << " at " << worst.where;
+    reason = os.str();
+  }
+
+  // The plan: trajectory from the values, τ from inverse dynamics (the condensed formulation
+  // eliminates it, so it equals RNEA exactly).
+  Plan plan;
+  const Trajectory tr = read_trajectory(pg.values, N, n);
+  plan.q = tr.q;
+  plan.qd = tr.qd;
+  plan.qdd = tr.qdd;
+  plan.tau.resize(N + 1, n);
+  plan.t.resize(N + 1);
+  dynamics::Data data(*problem.model);
+  for (int k = 0; k <= N; ++k) {
+    plan.t[k] = problem.dt() * k;
+    plan.tau.row(k) = dynamics::rnea(*problem.model, data, tr.q.row(k).transpose(),
+                                     tr.qd.row(k).transpose(), tr.qdd.row(k).transpose())
+                          .transpose();
+  }
+  // Soft cost without the constraint terms: zero the penalty contributions by evaluating the
+  // soft factors only.
+  double soft = 0;
+  for (const auto& f : pg.graph.factors()) {
+    if (!f) continue;
+    if (auto* c = dynamic_cast<const ConstrainedFactor*>(f.get())) {
+      if (c->has_constraints()) {
+        // Soft rows of mixed factors (min-torque) count; their constraint rows do not.
+        Eigen::VectorXd z;
+        c->values_at(pg.values, z);
+        for (int i = 0; i < c->residual_dim(); ++i) {
+          const RowSpec& row = c->rows()[i];
+          if (row.kind == RowKind::kSoft)
+            soft += 0.5 * std::pow(row.weight * (z[i] - row.lower), 2);
+        }
+        continue;
+      }
+    }
+    soft += f->error(pg.values);
+  }
+  stats.cost = soft;
+  stats.status = status;
+  stats.reason = reason;
+  plan.stats = stats;
+  plan.validation = validate(problem, plan, options_.validation);
+  plan.stats.solve_time_s = elapsed();
+  return plan;
+}
+
+}  // namespace kinograph::planning

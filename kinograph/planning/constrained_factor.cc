@@ -1,0 +1,134 @@
+#include "kinograph/planning/constrained_factor.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace kinograph::planning {
+
+ConstrainedFactor::ConstrainedFactor(std::vector<graph::Key> keys, std::vector<int> dims,
+                                     std::vector<RowSpec> rows)
+    : graph::Factor(std::move(keys), std::move(dims), static_cast<int>(rows.size())),
+      rows_(std::move(rows)) {
+  for (const RowSpec& r : rows_) {
+    if (r.kind != RowKind::kSoft) {
+      ++num_constraints_;
+      if (!(r.scale > 0)) throw std::invalid_argument("constraint row scale must be positive");
+    }
+    if (r.kind == RowKind::kBounds && !(r.lower <= r.upper)) {
+      throw std::invalid_argument("constraint row has lower bound above upper bound");
+    }
+  }
+  reset_multipliers();
+}
+
+void ConstrainedFactor::set_penalty(double mu) {
+  if (!(mu > 0)) throw std::invalid_argument("penalty must be positive");
+  mu_ = mu;
+}
+
+void ConstrainedFactor::set_multipliers(const Eigen::VectorXd& lambda,
+                                        const Eigen::VectorXd& lambda_upper) {
+  if (lambda.size() != residual_dim() || lambda_upper.size() != residual_dim()) {
+    throw std::invalid_argument("multipliers have the wrong size");
+  }
+  lambda_ = lambda;
+  lambda_upper_ = lambda_upper;
+}
+
+void ConstrainedFactor::reset_multipliers() {
+  lambda_.setZero(residual_dim());
+  lambda_upper_.setZero(residual_dim());
+}
+
+void ConstrainedFactor::evaluate(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> e,
+                                 const graph::Jacobians* J) const {
+  compute(x, e, J);
+  const double sq = std::sqrt(mu_);
+  for (int i = 0; i < residual_dim(); ++i) {
+    const RowSpec& row = rows_[i];
+    const double z = e[i];
+    double f = 0;  // dr/dz
+    switch (row.kind) {
+      case RowKind::kSoft:
+        f = row.weight;
+        e[i] = row.weight * (z - row.lower);
+        break;
+      case RowKind::kEquality:
+        f = sq / row.scale;
+        e[i] = f * (z - row.lower) + lambda_[i] / sq;
+        break;
+      case RowKind::kBounds: {
+        const double a = sq * (row.lower - z) / row.scale + lambda_[i] / sq;
+        const double b = sq * (z - row.upper) / row.scale + lambda_upper_[i] / sq;
+        e[i] = std::max(0.0, a) - std::max(0.0, b);
+        f = -(sq / row.scale) * ((a > 0 ? 1.0 : 0.0) + (b > 0 ? 1.0 : 0.0));
+        break;
+      }
+    }
+    if (J != nullptr) {
+      for (size_t k = 0; k < keys().size(); ++k) J->block(static_cast<int>(k)).row(i) *= f;
+    }
+  }
+}
+
+void ConstrainedFactor::values_at(const graph::Values& values, Eigen::VectorXd& z) const {
+  std::vector<const double*> ptrs(keys().size());
+  for (size_t k = 0; k < keys().size(); ++k) ptrs[k] = values.at(keys()[k]).data();
+  z.setZero(residual_dim());
+  compute(graph::FactorValues(ptrs.data(), dims().data()), z, nullptr);
+}
+
+namespace {
+// Violation of row i in its own units: |z − t| or the bound excess (0 for soft rows).
+double row_violation(const RowSpec& row, double z) {
+  switch (row.kind) {
+    case RowKind::kSoft:
+      return 0;
+    case RowKind::kEquality:
+      return std::abs(z - row.lower);
+    case RowKind::kBounds:
+      return std::max({0.0, row.lower - z, z - row.upper});
+  }
+  return 0;
+}
+}  // namespace
+
+double ConstrainedFactor::violation(const graph::Values& values) const {
+  if (num_constraints_ == 0) return 0;
+  Eigen::VectorXd z;
+  values_at(values, z);
+  double worst = 0;
+  for (int i = 0; i < residual_dim(); ++i) worst = std::max(worst, row_violation(rows_[i], z[i]));
+  return worst;
+}
+
+double ConstrainedFactor::scaled_violation(const graph::Values& values) const {
+  if (num_constraints_ == 0) return 0;
+  Eigen::VectorXd z;
+  values_at(values, z);
+  double worst = 0;
+  for (int i = 0; i < residual_dim(); ++i) {
+    if (rows_[i].kind == RowKind::kSoft) continue;
+    worst = std::max(worst, row_violation(rows_[i], z[i]) / rows_[i].scale);
+  }
+  return worst;
+}
+
+void ConstrainedFactor::update_multipliers(const graph::Values& values) {
+  if (num_constraints_ == 0) return;
+  Eigen::VectorXd z;
+  values_at(values, z);
+  for (int i = 0; i < residual_dim(); ++i) {
+    const RowSpec& row = rows_[i];
+    if (row.kind == RowKind::kEquality) {
+      lambda_[i] += mu_ * (z[i] - row.lower) / row.scale;
+    } else if (row.kind == RowKind::kBounds) {
+      // Infinite bounds give -inf here and clip to 0.
+      lambda_[i] = std::max(0.0, lambda_[i] + mu_ * (row.lower - z[i]) / row.scale);
+      lambda_upper_[i] = std::max(0.0, lambda_upper_[i] + mu_ * (z[i] - row.upper) / row.scale);
+    }
+  }
+}
+
+}  // namespace kinograph::planning

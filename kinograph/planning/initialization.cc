@@ -1,0 +1,117 @@
+#include "kinograph/planning/initialization.h"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "kinograph/dynamics/kinematics.h"
+
+namespace kinograph::planning {
+
+std::optional<Eigen::VectorXd> goal_configuration(const Problem& problem) {
+  const dynamics::Model& model = *problem.model;
+  const int n = model.nq();
+  if (problem.goal.kind == Goal::Kind::kJoint) return problem.goal.q;
+  int frame = -1;
+  try {
+    frame = model.frame_index(problem.goal.frame);
+  } catch (const std::out_of_range&) {
+    return std::nullopt;
+  }
+  const int body = model.frames[frame].body;
+  const bool orient = !problem.goal.position_only;
+  dynamics::Data data(model);
+  Eigen::VectorXd q = problem.start_q;
+  Eigen::Matrix<double, 6, Eigen::Dynamic> J6(6, n);
+  Eigen::Matrix3Xd J3(3, n);
+  const Eigen::Isometry3d& target = problem.goal.pose;
+  double lambda = 1e-2;
+  for (int it = 0; it < 200 && body >= 0; ++it) {
+    dynamics::forward_kinematics(model, data, q);
+    const Eigen::Isometry3d T = dynamics::frame_pose(model, data, frame);
+    // Error twist: world-frame rotation vector (small-angle from R R*ᵀ) and position error.
+    const Eigen::AngleAxisd aa(T.linear() * target.linear().transpose());
+    Eigen::VectorXd e(orient ? 6 : 3);
+    Eigen::MatrixXd J(orient ? 6 : 3, n);
+    dynamics::point_jacobian(model, data, body, T.translation(), J3);
+    if (orient) {
+      dynamics::space_jacobian(model, data, body, J6);
+      e << aa.angle() * aa.axis(), T.translation() - target.translation();
+      J << J6.topRows<3>(), J3;
+    } else {
+      e = T.translation() - target.translation();
+      J = J3;
+    }
+    if (e.norm() < 1e-9) break;
+    const Eigen::MatrixXd A =
+        J * J.transpose() + lambda * Eigen::MatrixXd::Identity(J.rows(), J.rows());
+    Eigen::VectorXd dq = -J.transpose() * A.ldlt().solve(e);
+    const double step = dq.cwiseAbs().maxCoeff();
+    if (step > 0.3) dq *= 0.3 / step;
+    q += dq;
+    for (int j = 0; j < n; ++j) {
+      const auto& l = model.bodies[j].limits;
+      q[j] = std::clamp(q[j], l.lower, l.upper);
+    }
+  }
+  return q;
+}
+
+Trajectory straight_line(const Problem& problem, const Eigen::VectorXd& q_goal) {
+  const int N = problem.steps, n = static_cast<int>(q_goal.size());
+  const double T = problem.horizon;
+  Trajectory tr;
+  tr.q.resize(N + 1, n);
+  tr.qd.resize(N + 1, n);
+  tr.qdd.resize(N + 1, n);
+  const Eigen::VectorXd q0 = problem.start_q;
+  const Eigen::VectorXd v0 =
+      problem.start_qd.size() == n ? problem.start_qd : Eigen::VectorXd::Zero(n);
+  // Quintic with q(0) = q0, q̇(0) = v0, q̈(0) = 0, q(T) = q_goal, q̇(T) = q̈(T) = 0, per joint:
+  // q = q0 + v0 t + c3 t³ + c4 t⁴ + c5 t⁵.
+  const Eigen::VectorXd d = q_goal - q0 - v0 * T;
+  // (c3, c4, c5) from the end conditions q(T) − q0 − v0 T = d, q̇(T) = 0, q̈(T) = 0.
+  Eigen::Matrix3d A;
+  A << std::pow(T, 3), std::pow(T, 4), std::pow(T, 5), 3 * T * T, 4 * std::pow(T, 3),
+      5 * std::pow(T, 4), 6 * T, 12 * T * T, 20 * std::pow(T, 3);
+  const Eigen::Matrix3d Ainv = A.inverse();
+  Eigen::MatrixXd C(3, n);
+  for (int j = 0; j < n; ++j) C.col(j) = Ainv * Eigen::Vector3d(d[j], -v0[j], 0);
+  for (int k = 0; k <= N; ++k) {
+    const double t = T * k / N;
+    const double t2 = t * t, t3 = t2 * t, t4 = t3 * t, t5 = t4 * t;
+    for (int j = 0; j < n; ++j) {
+      tr.q(k, j) = q0[j] + v0[j] * t + C(0, j) * t3 + C(1, j) * t4 + C(2, j) * t5;
+      tr.qd(k, j) = v0[j] + 3 * C(0, j) * t2 + 4 * C(1, j) * t3 + 5 * C(2, j) * t4;
+      tr.qdd(k, j) = 6 * C(0, j) * t + 12 * C(1, j) * t2 + 20 * C(2, j) * t3;
+    }
+  }
+  return tr;
+}
+
+Trajectory warm_start(const Problem& problem, const Plan& previous) {
+  const int n = problem.model->nq(), N = problem.steps;
+  const int M = static_cast<int>(previous.q.rows());
+  if (previous.q.cols() != n || M < 2 || previous.qd.rows() != M || previous.qdd.rows() != M) {
+    throw std::invalid_argument("warm start plan does not match the problem's robot");
+  }
+  Trajectory tr;
+  tr.q.resize(N + 1, n);
+  tr.qd.resize(N + 1, n);
+  tr.qdd.resize(N + 1, n);
+  for (int k = 0; k <= N; ++k) {
+    // Fraction of the previous plan's horizon (plans are resampled by normalized time).
+    const double u = static_cast<double>(k) / N * (M - 1);
+    const int i = std::min(static_cast<int>(std::floor(u)), M - 2);
+    const double s = u - i;
+    tr.q.row(k) = (1 - s) * previous.q.row(i) + s * previous.q.row(i + 1);
+    tr.qd.row(k) = (1 - s) * previous.qd.row(i) + s * previous.qd.row(i + 1);
+    tr.qdd.row(k) = (1 - s) * previous.qdd.row(i) + s * previous.qdd.row(i + 1);
+  }
+  tr.q.row(0) = problem.start_q.transpose();
+  if (problem.start_qd.size() == n) tr.qd.row(0) = problem.start_qd.transpose();
+  return tr;
+}
+
+}  // namespace kinograph::planning
