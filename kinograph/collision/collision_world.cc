@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -11,6 +12,8 @@
 
 namespace kinograph::collision {
 namespace {
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 ConvexShape make_robot_shape(const dynamics::Geometry& g, size_t index) {
   try {
@@ -28,9 +31,10 @@ bool adjacent(const dynamics::Model& model, int a, int b) {
   return false;
 }
 
-// Lower bound of the signed distance of two solids from their bounding spheres.
-double bound_gap(const Eigen::Vector3d& ca, double ra, const Eigen::Vector3d& cb, double rb) {
-  return (ca - cb).norm() - ra - rb;
+// Distance from a point to an axis-aligned box (0 inside).
+double point_box_gap(const Eigen::Vector3d& p, const Eigen::Vector3d& lo,
+                     const Eigen::Vector3d& hi) {
+  return (lo - p).cwiseMax(p - hi).cwiseMax(0.0).norm();
 }
 
 }  // namespace
@@ -89,9 +93,9 @@ Status CollisionWorld::add_obstacle(const Obstacle& obstacle) {
       throw std::invalid_argument("obstacle " + std::to_string(obstacle.id) + ": " + e.what());
     }
   }();
-  const Eigen::Isometry3d world = obstacle.pose_at(0);
-  const Eigen::Vector3d centre = world * shape.bound_center();
-  obstacles_.push_back(ObstacleEntry{obstacle, std::move(shape), world, centre});
+  ObstacleEntry entry{obstacle, std::move(shape), {}, {}, {}, {}};
+  entry.place(obstacle.pose_at(0));
+  obstacles_.push_back(std::move(entry));
   reserve_output();
   return Status::success();
 }
@@ -102,8 +106,7 @@ Status CollisionWorld::move_obstacle(int id, const Eigen::Isometry3d& pose) {
   ObstacleEntry& o = obstacles_[i];
   o.obstacle.pose = pose;
   o.obstacle.trajectory = PoseTrajectory();
-  o.world = pose;
-  o.centre = pose * o.shape.bound_center();
+  o.place(pose);
   return Status::success();
 }
 
@@ -112,8 +115,7 @@ Status CollisionWorld::set_obstacle_trajectory(int id, PoseTrajectory trajectory
   if (i < 0) return Status::failure("no obstacle with id " + std::to_string(id));
   ObstacleEntry& o = obstacles_[i];
   o.obstacle.trajectory = std::move(trajectory);
-  o.world = o.obstacle.pose_at(0);
-  o.centre = o.world * o.shape.bound_center();
+  o.place(o.obstacle.pose_at(0));
   return Status::success();
 }
 
@@ -143,13 +145,36 @@ void CollisionWorld::update_poses(const dynamics::Data& data, double t) {
   }
   for (ObstacleEntry& o : obstacles_) {
     if (!o.obstacle.is_moving()) continue;  // fixed poses are set on add and move
-    o.world = o.obstacle.trajectory.at(t);
-    o.centre = o.world * o.shape.bound_center();
+    o.place(o.obstacle.trajectory.at(t));
   }
 }
 
-bool CollisionWorld::robot_obstacle(int g, const ObstacleEntry& o, Proximity& out) const {
-  const PairDistance d = pair_distance(robot_[g].shape, robot_[g].world, o.shape, o.world);
+void CollisionWorld::ObstacleEntry::place(const Eigen::Isometry3d& pose) {
+  world = pose;
+  centre = pose * shape.bound_center();
+  shape.world_aabb(pose, lo, hi);
+}
+
+double CollisionWorld::lower_bound(int g, const ObstacleEntry& o) const {
+  const RobotGeom& rg = robot_[g];
+  const double r = rg.shape.bound_radius();
+  // Both bounds hold for penetration depth too: moving the robot's bounding sphere clear of
+  // the obstacle's bounding sphere (or, if its centre is outside it, of the obstacle's box)
+  // separates the solids. With the centre inside the box the box says nothing.
+  const double sphere_bound = (rg.centre - o.centre).norm() - r - o.shape.bound_radius();
+  const double gap = point_box_gap(rg.centre, o.lo, o.hi);
+  return gap > 0 ? std::max(sphere_bound, gap - r) : sphere_bound;
+}
+
+double CollisionWorld::lower_bound(int a, int b) const {
+  return (robot_[a].centre - robot_[b].centre).norm() - robot_[a].shape.bound_radius() -
+         robot_[b].shape.bound_radius();
+}
+
+bool CollisionWorld::robot_obstacle(int g, const ObstacleEntry& o, double max_distance,
+                                    Proximity& out) const {
+  const PairDistance d =
+      pair_distance(robot_[g].shape, robot_[g].world, o.shape, o.world, max_distance);
   if (!d.valid) return false;
   out.robot_geom = g;
   out.obstacle = o.obstacle.id;
@@ -161,9 +186,9 @@ bool CollisionWorld::robot_obstacle(int g, const ObstacleEntry& o, Proximity& ou
   return true;
 }
 
-bool CollisionWorld::robot_robot(int a, int b, Proximity& out) const {
-  const PairDistance d =
-      pair_distance(robot_[a].shape, robot_[a].world, robot_[b].shape, robot_[b].world);
+bool CollisionWorld::robot_robot(int a, int b, double max_distance, Proximity& out) const {
+  const PairDistance d = pair_distance(robot_[a].shape, robot_[a].world, robot_[b].shape,
+                                       robot_[b].world, max_distance);
   if (!d.valid) return false;
   out.robot_geom = a;
   out.obstacle = -1;
@@ -183,25 +208,19 @@ std::span<const Proximity> CollisionWorld::query(const dynamics::Data& data, dou
                                                  double query_distance) {
   update_poses(data, t);
   out_.clear();
+  // Without culling every pair goes through GJK to the end: the brute-force reference.
+  const double gjk_max = options_.cull ? query_distance : kInfinity;
   Proximity p;
   for (int g = 0; g < static_cast<int>(robot_.size()); ++g) {
     if (!checks_obstacles(g)) continue;
-    const RobotGeom& rg = robot_[g];
     for (const ObstacleEntry& o : obstacles_) {
-      if (options_.cull && bound_gap(rg.centre, rg.shape.bound_radius(), o.centre,
-                                     o.shape.bound_radius()) > query_distance) {
-        continue;
-      }
-      if (robot_obstacle(g, o, p) && p.distance <= query_distance) out_.push_back(p);
+      if (options_.cull && lower_bound(g, o) > query_distance) continue;
+      if (robot_obstacle(g, o, gjk_max, p) && p.distance <= query_distance) out_.push_back(p);
     }
   }
   for (const auto& [a, b] : self_pairs_) {
-    if (options_.cull &&
-        bound_gap(robot_[a].centre, robot_[a].shape.bound_radius(), robot_[b].centre,
-                  robot_[b].shape.bound_radius()) > query_distance) {
-      continue;
-    }
-    if (robot_robot(a, b, p) && p.distance <= query_distance) out_.push_back(p);
+    if (options_.cull && lower_bound(a, b) > query_distance) continue;
+    if (robot_robot(a, b, gjk_max, p) && p.distance <= query_distance) out_.push_back(p);
   }
   return {out_.data(), out_.size()};
 }
@@ -209,26 +228,21 @@ std::span<const Proximity> CollisionWorld::query(const dynamics::Data& data, dou
 Proximity CollisionWorld::closest(const dynamics::Data& data, double t) {
   update_poses(data, t);
   Proximity best;
-  best.distance = std::numeric_limits<double>::infinity();
+  best.distance = kInfinity;
   Proximity p;
+  // Each pair only needs checking to the best distance so far.
   for (int g = 0; g < static_cast<int>(robot_.size()); ++g) {
     if (!checks_obstacles(g)) continue;
-    const RobotGeom& rg = robot_[g];
     for (const ObstacleEntry& o : obstacles_) {
-      if (options_.cull && bound_gap(rg.centre, rg.shape.bound_radius(), o.centre,
-                                     o.shape.bound_radius()) >= best.distance) {
-        continue;
-      }
-      if (robot_obstacle(g, o, p) && p.distance < best.distance) best = p;
+      if (options_.cull && lower_bound(g, o) >= best.distance) continue;
+      const double gjk_max = options_.cull ? best.distance : kInfinity;
+      if (robot_obstacle(g, o, gjk_max, p) && p.distance < best.distance) best = p;
     }
   }
   for (const auto& [a, b] : self_pairs_) {
-    if (options_.cull &&
-        bound_gap(robot_[a].centre, robot_[a].shape.bound_radius(), robot_[b].centre,
-                  robot_[b].shape.bound_radius()) >= best.distance) {
-      continue;
-    }
-    if (robot_robot(a, b, p) && p.distance < best.distance) best = p;
+    if (options_.cull && lower_bound(a, b) >= best.distance) continue;
+    const double gjk_max = options_.cull ? best.distance : kInfinity;
+    if (robot_robot(a, b, gjk_max, p) && p.distance < best.distance) best = p;
   }
   return best;
 }

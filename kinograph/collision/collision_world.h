@@ -88,15 +88,20 @@ class CollisionWorld {
     Obstacle obstacle;
     ConvexShape shape;
     Eigen::Isometry3d world;
-    Eigen::Vector3d centre;
+    Eigen::Vector3d centre;  // bounding sphere centre, world
+    Eigen::Vector3d lo, hi;  // world AABB
+    void place(const Eigen::Isometry3d& pose);
   };
 
   void update_poses(const dynamics::Data& data, double t);
   void reserve_output();
   int find_index(int id) const;
-  // Fills `out` with the pair's signed distance; returns false if GJK failed.
-  bool robot_obstacle(int g, const ObstacleEntry& o, Proximity& out) const;
-  bool robot_robot(int a, int b, Proximity& out) const;
+  // Fills `out` with the pair's signed distance if it is at most max_distance.
+  bool robot_obstacle(int g, const ObstacleEntry& o, double max_distance, Proximity& out) const;
+  bool robot_robot(int a, int b, double max_distance, Proximity& out) const;
+  // A lower bound of the pair's signed distance from bounding spheres and boxes.
+  double lower_bound(int g, const ObstacleEntry& o) const;
+  double lower_bound(int a, int b) const;
   // Robot geometry indices that take part in obstacle pairs.
   bool checks_obstacles(int g) const { return options_.base_vs_obstacles || robot_[g].body >= 0; }
 

@@ -119,6 +119,19 @@ ConvexShape::ConvexShape(const Shape& shape) : shape_(shape) {
   }
 }
 
+void ConvexShape::world_aabb(const Eigen::Isometry3d& pose, Eigen::Vector3d& lo,
+                             Eigen::Vector3d& hi) const {
+  const Eigen::Matrix3d R = pose.linear();
+  const Eigen::Vector3d p = pose.translation();
+  const btTransform T(
+      btMatrix3x3(R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2), R(2, 0), R(2, 1), R(2, 2)),
+      btVector3(p.x(), p.y(), p.z()));
+  btVector3 bmin, bmax;
+  bullet_->getAabb(T, bmin, bmax);
+  lo = Eigen::Vector3d(bmin.x(), bmin.y(), bmin.z());
+  hi = Eigen::Vector3d(bmax.x(), bmax.y(), bmax.z());
+}
+
 ConvexShape::~ConvexShape() = default;
 ConvexShape::ConvexShape(ConvexShape&&) noexcept = default;
 ConvexShape& ConvexShape::operator=(ConvexShape&&) noexcept = default;

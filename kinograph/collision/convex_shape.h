@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <memory>
 
 #include "kinograph/collision/shape.h"
@@ -30,6 +31,8 @@ class ConvexShape {
   const Eigen::Vector3d& bound_center() const { return bound_center_; }
   // Radius of a sphere about bound_center() that contains the whole solid.
   double bound_radius() const { return bound_radius_; }
+  // A world-axis-aligned box containing the shape at this pose (Bullet's, conservative).
+  void world_aabb(const Eigen::Isometry3d& pose, Eigen::Vector3d& lo, Eigen::Vector3d& hi) const;
   // The underlying Bullet shape (double precision build).
   const btConvexShape& bullet() const { return *bullet_; }
 

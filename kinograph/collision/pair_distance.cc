@@ -6,6 +6,8 @@
 #include <BulletCollision/NarrowPhaseCollision/btVoronoiSimplexSolver.h>
 #include <btBulletCollisionCommon.h>
 
+#include <cmath>
+
 namespace kinograph::collision {
 namespace {
 
@@ -22,19 +24,24 @@ Eigen::Vector3d to_eigen(const btVector3& v) { return Eigen::Vector3d(v.x(), v.y
 }  // namespace
 
 PairDistance pair_distance(const ConvexShape& a, const Eigen::Isometry3d& a_to_world,
-                           const ConvexShape& b, const Eigen::Isometry3d& b_to_world) {
+                           const ConvexShape& b, const Eigen::Isometry3d& b_to_world,
+                           double max_distance) {
   btVoronoiSimplexSolver simplex;
   btGjkEpaPenetrationDepthSolver epa;
   btGjkPairDetector detector(&a.bullet(), &b.bullet(), &simplex, &epa);
   btGjkPairDetector::ClosestPointInput input;
   input.m_transformA = to_bullet(a_to_world);
   input.m_transformB = to_bullet(b_to_world);
-  input.m_maximumDistanceSquared = BT_LARGE_FLOAT;
+  // Bullet compares this bound with the distance between the core shapes (margins removed),
+  // then reports only results whose final distance is below it.
+  const double core_max = max_distance + a.bullet().getMargin() + b.bullet().getMargin();
+  input.m_maximumDistanceSquared =
+      std::isfinite(core_max) && core_max > 0 ? core_max * core_max : BT_LARGE_FLOAT;
   btPointCollector out;
   detector.getClosestPoints(input, out, nullptr);
 
   PairDistance result;
-  if (!out.m_hasResult) return result;
+  if (!out.m_hasResult || out.m_distance > max_distance) return result;
   Eigen::Vector3d n = to_eigen(out.m_normalOnBInWorld);
   const double norm = n.norm();
   if (!(norm > 0)) return result;

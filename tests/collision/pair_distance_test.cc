@@ -237,6 +237,42 @@ TEST(PairDistance, MeshConvexHullOfCubeMatchesBox) {
   std::filesystem::remove(path);
 }
 
+// GJK's early exit at max_distance must only drop pairs that are farther than it, and must
+// not change the distance of the others (including penetrating ones).
+TEST(PairDistance, MaxDistanceOnlyDropsFartherPairs) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const ConvexShape shapes[] = {
+      ConvexShape(Shape::sphere(0.1)), ConvexShape(Shape::box(0.3, 0.2, 0.5)),
+      ConvexShape(Shape::cylinder(0.1, 0.4)), ConvexShape(Shape::capsule(0.05, 0.3))};
+  int kept = 0, dropped = 0;
+  for (int i = 0; i < 400; ++i) {
+    const ConvexShape& a = shapes[i % 4];
+    const ConvexShape& b = shapes[(i / 4) % 4];
+    Eigen::Isometry3d ta = Eigen::Isometry3d::Identity(), tb = Eigen::Isometry3d::Identity();
+    ta.linear() =
+        Eigen::Quaterniond(u(rng), u(rng), u(rng), u(rng)).normalized().toRotationMatrix();
+    tb.linear() =
+        Eigen::Quaterniond(u(rng), u(rng), u(rng), u(rng)).normalized().toRotationMatrix();
+    tb.translation() = 0.6 * Eigen::Vector3d(u(rng), u(rng), u(rng));
+    const double max_distance = 0.3 * u(rng);
+    const PairDistance full = pair_distance(a, ta, b, tb);
+    const PairDistance capped = pair_distance(a, ta, b, tb, max_distance);
+    ASSERT_TRUE(full.valid);
+    SCOPED_TRACE(testing::Message()
+                 << "case " << i << " d " << full.distance << " max " << max_distance);
+    EXPECT_EQ(capped.valid, full.distance <= max_distance);
+    if (capped.valid) {
+      EXPECT_EQ(capped.distance, full.distance);
+      ++kept;
+    } else {
+      ++dropped;
+    }
+  }
+  EXPECT_GT(kept, 50);
+  EXPECT_GT(dropped, 50);
+}
+
 TEST(PairDistance, BadShapesThrowNamingTheProblem) {
   EXPECT_THROW(ConvexShape(Shape::sphere(0)), std::invalid_argument);
   EXPECT_THROW(ConvexShape(Shape::box(1, -1, 1)), std::invalid_argument);
