@@ -83,6 +83,7 @@ class Model {
   std::vector<Frame> frames;
   std::vector<Geometry> collision, visual;
   Eigen::Vector3d gravity{0, 0, -9.81};  ///< world-frame gravitational acceleration
+  double base_mass = 0.0;                ///< mass of the links fixed to the base (not in any body)
 };
 
 }  // namespace kinograph::dynamics

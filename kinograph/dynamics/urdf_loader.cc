@@ -97,7 +97,9 @@ class Loader {
       if (!(in.mass >= 0) || !std::isfinite(in.mass)) {
         fail("link '" + link->name + "' <inertial>: mass must be finite and >= 0");
       }
-      if (body >= 0) {
+      if (body < 0) {
+        model_.base_mass += in.mass;
+      } else {
         const Eigen::Isometry3d T = placement * to_isometry(in.origin);
         Eigen::Matrix3d Ic;
         Ic << in.ixx, in.ixy, in.ixz, in.ixy, in.iyy, in.iyz, in.ixz, in.iyz, in.izz;
