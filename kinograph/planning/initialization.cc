@@ -1,6 +1,7 @@
 #include "kinograph/planning/initialization.h"
 
 #include <Eigen/Cholesky>
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>

@@ -1,6 +1,7 @@
 #include "kinograph/planning/trajectory_factors.h"
 
 #include <Eigen/Cholesky>
+#include <Eigen/LU>
 #include <stdexcept>
 
 namespace kinograph::planning {
