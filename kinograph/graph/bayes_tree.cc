@@ -243,8 +243,7 @@ bool BayesTree::factorize(const std::vector<int>& ids,
     }
     if (damping != nullptr) {
       for (int v : c.frontals) {
-        H.diagonal().segment(local_offset_[v], dims_[v]) +=
-            damping->segment(offsets_[v], dims_[v]);
+        H.diagonal().segment(local_offset_[v], dims_[v]) += damping->segment(offsets_[v], dims_[v]);
       }
     }
     for (int v : c.frontals) local_offset_[v] = -1;
@@ -274,8 +273,7 @@ bool BayesTree::factorize(const std::vector<int>& ids,
   return true;
 }
 
-int BayesTree::back_substitute(double wildfire, Eigen::VectorXd& delta,
-                               std::vector<int>* changed) {
+int BayesTree::back_substitute(double wildfire, Eigen::VectorXd& delta, std::vector<int>* changed) {
   std::vector<int> stack = roots();
   std::vector<int> flagged;
   int solved = 0;

@@ -37,7 +37,7 @@ struct Clique {
   Eigen::MatrixXd marginal_H;  ///< H_SS − R_FSᵀR_FS: information passed to the parent
   Eigen::VectorXd marginal_g;  ///< g_S + R_FSᵀd
   bool alive = false;
-  bool fresh = false;          ///< built in the current update (must be back-substituted)
+  bool fresh = false;  ///< built in the current update (must be back-substituted)
 };
 
 /// The cliques of a forest of Bayes trees over the free variables of a Values layout. Clique

@@ -83,13 +83,13 @@ struct ISAM2Result {
   bool error_evaluated = false;
   bool full_reelimination = false;
   int variables_reeliminated = 0;
-  int cliques_reeliminated = 0;   ///< cliques built by this update
+  int cliques_reeliminated = 0;  ///< cliques built by this update
   int variables_relinearized = 0;
-  int factors_linearized = 0;     ///< new factors plus those touching relinearized variables
-  int cliques_solved = 0;         ///< cliques back-substituted (last trial)
-  int trials = 0;                 ///< numeric eliminations (GN) or dogleg steps tried
-  double lambda = 0;              ///< damping of the accepted GN trial
-  double trust_radius = 0;        ///< Dogleg radius after the update
+  int factors_linearized = 0;  ///< new factors plus those touching relinearized variables
+  int cliques_solved = 0;      ///< cliques back-substituted (last trial)
+  int trials = 0;              ///< numeric eliminations (GN) or dogleg steps tried
+  double lambda = 0;           ///< damping of the accepted GN trial
+  double trust_radius = 0;     ///< Dogleg radius after the update
   double linearize_s = 0, eliminate_s = 0, solve_s = 0, total_s = 0;
 
   bool ok() const { return status == ISAM2Status::kOk; }
@@ -145,12 +145,12 @@ class ISAM2 {
   Eigen::VectorXd delta_;     // applied step (θ + delta_ = estimate)
   Eigen::VectorXd delta_gn_;  // Bayes tree solution (equals delta_ with Gauss–Newton)
   BayesTree tree_;
-  std::vector<LinearizedFactor> linearized_;   // per factor index
-  std::vector<std::vector<int>> factor_slots_; // per factor: Values slot per key
-  std::vector<double> factor_error_;           // per factor: error at the estimate
-  std::vector<std::vector<int>> var_factors_;  // per slot: factor indices touching it
-  std::vector<int> damped_vars_;               // eliminated with damping last time
-  std::vector<int> stamp_;                     // per slot scratch
+  std::vector<LinearizedFactor> linearized_;    // per factor index
+  std::vector<std::vector<int>> factor_slots_;  // per factor: Values slot per key
+  std::vector<double> factor_error_;            // per factor: error at the estimate
+  std::vector<std::vector<int>> var_factors_;   // per slot: factor indices touching it
+  std::vector<int> damped_vars_;                // eliminated with damping last time
+  std::vector<int> stamp_;                      // per slot scratch
   int stamp_counter_ = 0;
   std::vector<int> factor_stamp_;
   int factor_stamp_counter_ = 0;
