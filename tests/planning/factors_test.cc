@@ -1,0 +1,206 @@
+// Jacobians of every planning factor against central differences, the GP covariance against a
+// numerical integral, collocation consistency, and the augmented-Lagrangian row algebra.
+#include <gtest/gtest.h>
+
+#include <Eigen/LU>
+#include <random>
+#include <unsupported/Eigen/MatrixFunctions>
+
+#include "kinograph/dynamics/inverse_dynamics.h"
+#include "kinograph/dynamics/payload.h"
+#include "kinograph/graph/testing/numerical_jacobian.h"
+#include "kinograph/planning/collision_factors.h"
+#include "kinograph/planning/dynamics_factors.h"
+#include "kinograph/planning/pose_factors.h"
+#include "kinograph/planning/trajectory_factors.h"
+
+namespace kinograph::planning {
+namespace {
+
+using graph::testing::check_jacobians;
+using graph::testing::JacobianCheckOptions;
+
+std::shared_ptr<const dynamics::Model> load(const std::string& rel) {
+  return std::make_shared<const dynamics::Model>(
+      dynamics::Model::from_urdf_file(std::string(KINOGRAPH_SOURCE_DIR) + "/" + rel));
+}
+
+// Random q, q̇, q̈ for states 0..steps.
+graph::Values random_states(int n, int steps, std::mt19937& rng, double scale = 1.0) {
+  std::uniform_real_distribution<double> u(-scale, scale);
+  graph::Values v;
+  for (int k = 0; k <= steps; ++k) {
+    Eigen::VectorXd q(n), qd(n), qdd(n);
+    for (int j = 0; j < n; ++j) {
+      q[j] = u(rng);
+      qd[j] = u(rng);
+      qdd[j] = u(rng);
+    }
+    v.insert(q_key(k), q);
+    v.insert(v_key(k), qd);
+    v.insert(a_key(k), qdd);
+  }
+  return v;
+}
+
+TEST(GpPrior, CovarianceIsTheIntegralOfTheWhiteNoiseJerkModel) {
+  // Q = ∫₀^Δt e^{As} L Qc Lᵀ e^{Aᵀs} ds by Simpson's rule on the matrix exponential.
+  Eigen::Matrix3d A;
+  A << 0, 1, 0, 0, 0, 1, 0, 0, 0;
+  const Eigen::Vector3d L(0, 0, 1);
+  for (double dt : {0.1, 0.37, 1.3}) {
+    const double qc = 2.5;
+    const int m = 2000;
+    Eigen::Matrix3d Q = Eigen::Matrix3d::Zero();
+    for (int i = 0; i <= m; ++i) {
+      const double s = dt * i / m;
+      const double w = (i == 0 || i == m) ? 1 : (i % 2 == 1 ? 4 : 2);
+      const Eigen::Matrix3d E = (A * s).exp();
+      Q += w * E * L * qc * L.transpose() * E.transpose();
+    }
+    Q *= dt / (3 * m);
+    EXPECT_TRUE(Q.isApprox(gp_covariance(dt, qc), 1e-9)) << Q << "\n" << gp_covariance(dt, qc);
+    EXPECT_TRUE(gp_transition(dt).isApprox((A * dt).exp(), 1e-12));
+    // The corner is Δt⁵/20, not the ½Δt⁵ printed in the paper.
+    EXPECT_NEAR(gp_covariance(dt, 1.0)(0, 0), std::pow(dt, 5) / 20, 1e-15);
+  }
+}
+
+TEST(GpPrior, CostUnderCollocationIsIntegratedSquaredJerk) {
+  // A piecewise-linear acceleration satisfies the collocation exactly; its GP cost must be
+  // ½·jerk²·Δt/Qc per joint and interval.
+  const double dt = 0.2, qc = 0.7, jerk = 1.9;
+  graph::Values v;
+  const Eigen::VectorXd a0 = Eigen::VectorXd::Constant(1, 0.3);
+  const Eigen::VectorXd a1 = a0.array() + jerk * dt;
+  const Eigen::VectorXd q0 = Eigen::VectorXd::Constant(1, 0.1);
+  const Eigen::VectorXd v0 = Eigen::VectorXd::Constant(1, -0.4);
+  v.insert(q_key(0), q0);
+  v.insert(v_key(0), v0);
+  v.insert(a_key(0), a0);
+  v.insert(q_key(1), q0 + v0 * dt + dt * dt / 6 * (2 * a0 + a1));
+  v.insert(v_key(1), v0 + dt / 2 * (a0 + a1));
+  v.insert(a_key(1), a1);
+  CollocationFactor col(0, 1, dt);
+  Eigen::VectorXd z;
+  col.values_at(v, z);
+  EXPECT_LT(z.cwiseAbs().maxCoeff(), 1e-15);
+  GpPriorFactor gp(0, 1, dt, qc);
+  EXPECT_NEAR(gp.error(v), 0.5 * jerk * jerk * dt / qc, 1e-9);
+}
+
+TEST(TrajectoryFactors, Jacobians) {
+  std::mt19937 rng(1);
+  const int n = 3;
+  graph::Values v = random_states(n, 1, rng);
+  GpPriorFactor gp(0, n, 0.1, 1.3);
+  auto c = check_jacobians(gp, v);
+  EXPECT_TRUE(c.ok) << c.report();
+  CollocationFactor col(0, n, 0.1);
+  col.set_penalty(7.0);
+  c = check_jacobians(col, v, {1e-6, 1e-5, true});
+  EXPECT_TRUE(c.ok) << c.report();
+  c = check_jacobians(col, v);
+  EXPECT_TRUE(c.ok) << c.report();
+  // Limits with some rows active (beyond a bound) and some inactive, away from the kinks.
+  std::vector<StateLimitFactor::Limit> limits = {
+      {0, 0, -0.5, 0.5}, {1, 1, -2, 2}, {2, 2, -0.1, 0.1}, {0, 2, -3, 3}};
+  StateLimitFactor lim(0, n, limits, 0.5);
+  lim.set_penalty(3);
+  Eigen::VectorXd lam = Eigen::VectorXd::Zero(4), lam_u = Eigen::VectorXd::Zero(4);
+  lam[3] = 0.2;
+  lim.set_multipliers(lam, lam_u);
+  v.update(q_key(0), Eigen::Vector3d(0.8, 0.1, 0.2));
+  v.update(a_key(0), Eigen::Vector3d(0.1, 0.1, -0.4));
+  c = check_jacobians(lim, v, {1e-6, 1e-5, true});
+  EXPECT_TRUE(c.ok) << c.report();
+  Eigen::VectorXd r(4);
+  lim.whitened_residual(v, r);
+  EXPECT_GT(std::abs(r[0]), 0);  // q0 = 0.8 above 0.5
+  EXPECT_GT(std::abs(r[2]), 0);  // q̈2 = −0.4 below −0.1
+  EXPECT_EQ(r[1], 0);            // q̇1 inside
+  EXPECT_NEAR(lim.violation(v), 0.3, 1e-12);
+}
+
+TEST(ConstrainedFactor, MultiplierUpdateClipsInequalities) {
+  std::mt19937 rng(2);
+  graph::Values v = random_states(1, 0, rng);
+  v.update(q_key(0), Eigen::VectorXd::Constant(1, 0.2));
+  StateLimitFactor lim(0, 1, {{0, 0, -1, 1}});
+  lim.set_penalty(10);
+  lim.update_multipliers(v);  // inside: multipliers stay 0
+  EXPECT_EQ(lim.multipliers()[0], 0);
+  EXPECT_EQ(lim.multipliers_upper()[0], 0);
+  v.update(q_key(0), Eigen::VectorXd::Constant(1, 1.5));
+  lim.update_multipliers(v);
+  EXPECT_NEAR(lim.multipliers_upper()[0], 10 * 0.5, 1e-12);
+  EXPECT_EQ(lim.multipliers()[0], 0);
+}
+
+TEST(DynamicsStepFactor, JacobiansOnIiwaWithPayloadAndAcrobot) {
+  std::mt19937 rng(3);
+  auto iiwa = std::make_shared<const dynamics::Model>(dynamics::attach_box_payload(
+      *load("robots/iiwa14/iiwa14.urdf"), "iiwa_link_ee_kuka", 2.0, {0.1, 0.1, 0.1},
+      Eigen::Isometry3d(Eigen::Translation3d(0, 0, 0.05))));
+  for (auto model : {iiwa, load("robots/acrobot/acrobot.urdf")}) {
+    const int n = model->nq();
+    graph::Values v = random_states(n, 0, rng);
+    DynamicsStepOptions o;
+    o.min_torque = 0.3;
+    o.torque_scale = 2.0;
+    auto ws = std::make_shared<dynamics::Data>(*model);
+    DynamicsStepFactor f(0, model, ws, o);
+    f.set_penalty(5);
+    auto c = check_jacobians(f, v, {1e-6, 1e-5, false});
+    EXPECT_TRUE(c.ok) << c.report();
+    // Raw rows are the inverse-dynamics torques.
+    Eigen::VectorXd z;
+    f.values_at(v, z);
+    dynamics::Data d(*model);
+    const Eigen::VectorXd tau =
+        dynamics::rnea(*model, d, v.at(q_key(0)), v.at(v_key(0)), v.at(a_key(0)));
+    EXPECT_NEAR(z[z.size() - 1], tau[n - 1], 1e-12);
+  }
+}
+
+TEST(PoseFactor, Jacobians) {
+  std::mt19937 rng(4);
+  auto model = load("robots/iiwa14/iiwa14.urdf");
+  auto ws = std::make_shared<dynamics::Data>(*model);
+  graph::Values v = random_states(7, 0, rng);
+  Eigen::Isometry3d target = Eigen::Isometry3d::Identity();
+  target.linear() = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).matrix();
+  target.translation() = Eigen::Vector3d(0.4, 0.1, 0.6);
+  for (PoseParts parts : {PoseParts::kFull, PoseParts::kPosition, PoseParts::kOrientation}) {
+    PoseFactor f(0, model, ws, "iiwa_link_ee_kuka", target, parts, 0.01);
+    auto c = check_jacobians(f, v);
+    EXPECT_TRUE(c.ok) << c.report();
+  }
+}
+
+TEST(CollisionFactor, JacobiansAtAndBetweenSteps) {
+  std::mt19937 rng(5);
+  auto model = load("robots/rr/rr.urdf");
+  collision::Obstacle ball;
+  ball.id = 7;
+  ball.shape = collision::Shape::sphere(0.2);
+  ball.pose.translation() = Eigen::Vector3d(0.9, 0, 1.3);
+  auto ctx = std::make_shared<CollisionContext>(model, std::vector<collision::Obstacle>{ball}, 2.0);
+  graph::Values v;
+  v.insert(q_key(0), Eigen::Vector2d(0.5, 0.4));
+  v.insert(v_key(0), Eigen::Vector2d(0.3, -0.2));
+  v.insert(q_key(1), Eigen::Vector2d(0.7, 0.5));
+  v.insert(v_key(1), Eigen::Vector2d(0.1, 0.4));
+  for (double s : {0.0, 0.4}) {
+    CollisionFactor f(0, s, 0.5, 0.05, 0.01, ctx);
+    Eigen::VectorXd z;
+    f.values_at(v, z);
+    EXPECT_LT(z.minCoeff(), 2.0);  // some pair reported
+    // GJK/EPA distances carry ~1e-8 m of noise: a 1e-4 step keeps it out of the differences.
+    auto c = check_jacobians(f, v, {1e-4, 1e-3, false});
+    EXPECT_TRUE(c.ok) << c.report();
+  }
+}
+
+}  // namespace
+}  // namespace kinograph::planning
