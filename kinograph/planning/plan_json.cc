@@ -1,0 +1,341 @@
+#include "kinograph/planning/plan_json.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+
+namespace kinograph::planning {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+[[noreturn]] void fail(const std::string& source, const std::string& key,
+                       const std::string& message) {
+  std::string what = "plan '" + (source.empty() ? std::string("<json>") : source) + "'";
+  if (!key.empty()) what += ": '" + key + "'";
+  throw PlanFileError(what + ": " + message);
+}
+
+// Finite numbers as themselves; ±inf and NaN as null (JSON has neither).
+json number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+json vector(const Eigen::VectorXd& v) {
+  json out = json::array();
+  for (Eigen::Index i = 0; i < v.size(); ++i) out.push_back(number(v[i]));
+  return out;
+}
+
+json matrix_rows(const Eigen::MatrixXd& m) {
+  json out = json::array();
+  for (Eigen::Index k = 0; k < m.rows(); ++k) out.push_back(vector(m.row(k).transpose()));
+  return out;
+}
+
+json pose_json(const Eigen::Isometry3d& pose) {
+  const Eigen::Quaterniond q(pose.linear());
+  return {{"position", vector(pose.translation())}, {"quaternion", {q.w(), q.x(), q.y(), q.z()}}};
+}
+
+// A number, or null read as `null_value`.
+double read_number(const json& j, const std::string& source, const std::string& key,
+                   double null_value) {
+  if (j.is_null()) return null_value;
+  if (!j.is_number()) fail(source, key, "must be a number");
+  return j.get<double>();
+}
+
+// The URDF path as the plan file names it: relative to the repository root when inside it
+// (the renderer resolves that), absolute otherwise.
+std::string portable_path(const std::string& path) {
+  if (path.empty()) return path;
+  const fs::path root = fs::weakly_canonical(KINOGRAPH_SOURCE_DIR);
+  const fs::path p = fs::weakly_canonical(path);
+  const fs::path rel = p.lexically_relative(root);
+  if (!rel.empty() && *rel.begin() != "..") return rel.string();
+  return p.string();
+}
+
+std::string shape_name(collision::ShapeKind kind) {
+  switch (kind) {
+    case collision::ShapeKind::kSphere:
+      return "sphere";
+    case collision::ShapeKind::kBox:
+      return "box";
+    case collision::ShapeKind::kCylinder:
+      return "cylinder";
+    case collision::ShapeKind::kCapsule:
+      return "capsule";
+    case collision::ShapeKind::kMesh:
+      return "mesh";
+  }
+  return "box";
+}
+
+// Plan matrix `key` (rows × width) with columns picked by `column`.
+Eigen::MatrixXd read_rows(const json& j, const char* key, const std::string& source,
+                          std::size_t rows, const std::vector<int>& column, std::size_t width) {
+  if (!j.contains(key)) fail(source, key, "missing array");
+  const json& value = j.at(key);
+  if (!value.is_array()) fail(source, key, "must be an array of arrays");
+  if (value.size() != rows) {
+    fail(source, key,
+         "has " + std::to_string(value.size()) + " rows but 't' has " + std::to_string(rows));
+  }
+  Eigen::MatrixXd m(rows, column.size());
+  for (std::size_t k = 0; k < rows; ++k) {
+    const std::string row_key = std::string(key) + "[" + std::to_string(k) + "]";
+    const json& row = value[k];
+    if (!row.is_array() || row.size() != width) {
+      fail(source, row_key, "must be an array of " + std::to_string(width) + " numbers");
+    }
+    for (std::size_t i = 0; i < column.size(); ++i) {
+      m(k, i) = read_number(row[column[i]], source, row_key + "[" + std::to_string(column[i]) + "]",
+                            std::numeric_limits<double>::quiet_NaN());
+    }
+  }
+  return m;
+}
+
+}  // namespace
+
+json to_json(const SolveStats& s) {
+  return {{"method", s.method},
+          {"status", s.status},
+          {"reason", s.reason},
+          {"iterations", s.iterations},
+          {"outer_iterations", s.outer_iterations},
+          {"linear_solves", s.linear_solves},
+          {"solve_time_s", number(s.solve_time_s)},
+          {"cost", number(s.cost)},
+          {"max_constraint_violation", number(s.max_constraint_violation)}};
+}
+
+json to_json(const Validation& v) {
+  return {{"valid", v.valid},
+          {"failures", v.failures},
+          {"max_dynamics_residual", number(v.max_dynamics_residual)},
+          {"max_position_consistency", number(v.max_position_consistency)},
+          {"max_velocity_consistency", number(v.max_velocity_consistency)},
+          {"max_q_violation", number(v.max_q_violation)},
+          {"max_qd_violation", number(v.max_qd_violation)},
+          {"max_qdd_violation", number(v.max_qdd_violation)},
+          {"max_tau_violation", number(v.max_tau_violation)},
+          {"min_clearance", number(v.min_clearance)},
+          {"goal_error", number(v.goal_error)},
+          {"max_task_error", number(v.max_task_error)},
+          {"max_unactuated_torque", number(v.max_unactuated_torque)},
+          {"start_error", number(v.start_error)},
+          {"final_velocity", number(v.final_velocity)}};
+}
+
+SolveStats stats_from_json(const json& j, const std::string& source) {
+  SolveStats s;
+  if (!j.is_object()) fail(source, "stats", "must be an object");
+  const auto str = [&](const char* key, std::string& out) {
+    if (!j.contains(key)) return;
+    if (!j[key].is_string()) fail(source, std::string("stats.") + key, "must be a string");
+    out = j[key].get<std::string>();
+  };
+  const auto integer = [&](const char* key, int& out) {
+    if (!j.contains(key)) return;
+    if (!j[key].is_number_integer())
+      fail(source, std::string("stats.") + key, "must be an integer");
+    out = j[key].get<int>();
+  };
+  const auto real = [&](const char* key, double& out) {
+    if (j.contains(key)) out = read_number(j[key], source, std::string("stats.") + key, kInf);
+  };
+  str("method", s.method);
+  str("status", s.status);
+  str("reason", s.reason);
+  integer("iterations", s.iterations);
+  integer("outer_iterations", s.outer_iterations);
+  integer("linear_solves", s.linear_solves);
+  real("solve_time_s", s.solve_time_s);
+  real("cost", s.cost);
+  real("max_constraint_violation", s.max_constraint_violation);
+  return s;
+}
+
+Validation validation_from_json(const json& j, const std::string& source) {
+  Validation v;
+  if (!j.is_object()) fail(source, "validation", "must be an object");
+  if (j.contains("valid")) {
+    if (!j["valid"].is_boolean()) fail(source, "validation.valid", "must be true or false");
+    v.valid = j["valid"].get<bool>();
+  }
+  if (j.contains("failures")) {
+    if (!j["failures"].is_array()) fail(source, "validation.failures", "must be a list of strings");
+    for (const json& f : j["failures"]) {
+      if (!f.is_string()) fail(source, "validation.failures", "must be a list of strings");
+      v.failures.push_back(f.get<std::string>());
+    }
+  }
+  const std::pair<const char*, double*> figures[] = {
+      {"max_dynamics_residual", &v.max_dynamics_residual},
+      {"max_position_consistency", &v.max_position_consistency},
+      {"max_velocity_consistency", &v.max_velocity_consistency},
+      {"max_q_violation", &v.max_q_violation},
+      {"max_qd_violation", &v.max_qd_violation},
+      {"max_qdd_violation", &v.max_qdd_violation},
+      {"max_tau_violation", &v.max_tau_violation},
+      {"min_clearance", &v.min_clearance},
+      {"goal_error", &v.goal_error},
+      {"max_task_error", &v.max_task_error},
+      {"max_unactuated_torque", &v.max_unactuated_torque},
+      {"start_error", &v.start_error},
+      {"final_velocity", &v.final_velocity}};
+  for (const auto& [key, out] : figures) {
+    if (j.contains(key)) *out = read_number(j[key], source, std::string("validation.") + key, kInf);
+  }
+  return v;
+}
+
+json plan_to_json(const Plan& plan, const Scene& scene) {
+  const Problem& problem = scene.problem;
+  json j;
+  j["name"] = problem.name;
+  j["robot"]["urdf"] = portable_path(scene.urdf_path);
+  if (scene.payload) {
+    const PayloadSpec& p = *scene.payload;
+    j["robot"]["payload"] = {{"frame", p.frame},
+                             {"mass", p.mass},
+                             {"size", vector(p.size)},
+                             {"offset", vector(p.offset)}};
+  }
+  j["obstacles"] = json::array();
+  for (std::size_t i = 0; i < problem.obstacles.size(); ++i) {
+    const collision::Obstacle& o = problem.obstacles[i];
+    json oj;
+    oj["id"] = i < scene.obstacle_names.size() ? scene.obstacle_names[i] : std::to_string(o.id);
+    oj["shape"] = shape_name(o.shape.kind);
+    switch (o.shape.kind) {
+      case collision::ShapeKind::kBox:
+        oj["size"] = vector(o.shape.size);
+        break;
+      case collision::ShapeKind::kSphere:
+        oj["size"] = {o.shape.size.x()};
+        break;
+      case collision::ShapeKind::kCylinder:
+      case collision::ShapeKind::kCapsule:
+        oj["size"] = {o.shape.size.x(), o.shape.size.y()};
+        break;
+      case collision::ShapeKind::kMesh:
+        // The renderer reads a mesh's "size" as its scale.
+        oj["size"] = vector(o.shape.mesh_scale);
+        oj["mesh"] = o.shape.mesh_path;
+        break;
+    }
+    const json pose = pose_json(o.pose);
+    oj["position"] = pose["position"];
+    oj["quaternion"] = pose["quaternion"];
+    if (o.is_moving()) {
+      oj["motion"] = json::array();
+      for (std::size_t k = 0; k < o.trajectory.times().size(); ++k) {
+        json sample = pose_json(o.trajectory.poses()[k]);
+        sample["t"] = o.trajectory.times()[k];
+        oj["motion"].push_back(sample);
+      }
+    }
+    j["obstacles"].push_back(oj);
+  }
+  json names = json::array();
+  json lower = json::array(), upper = json::array(), velocity = json::array(),
+       acceleration = json::array(), effort = json::array();
+  bool finite_effort = true;
+  if (problem.model) {
+    for (const dynamics::Body& b : problem.model->bodies) {
+      names.push_back(b.joint_name);
+      lower.push_back(number(b.limits.lower));
+      upper.push_back(number(b.limits.upper));
+      velocity.push_back(number(b.limits.velocity));
+      acceleration.push_back(number(b.limits.acceleration));
+      effort.push_back(number(b.limits.effort));
+      finite_effort = finite_effort && std::isfinite(b.limits.effort);
+    }
+  }
+  j["joint_names"] = names;
+  j["t"] = plan.t;
+  j["q"] = matrix_rows(plan.q);
+  j["qd"] = matrix_rows(plan.qd);
+  j["qdd"] = matrix_rows(plan.qdd);
+  j["tau"] = matrix_rows(plan.tau);
+  j["limits"] = {
+      {"lower", lower}, {"upper", upper}, {"velocity", velocity}, {"acceleration", acceleration}};
+  if (finite_effort) j["limits"]["effort"] = effort;
+  j["stats"] = to_json(plan.stats);
+  j["validation"] = to_json(plan.validation);
+  return j;
+}
+
+void write_plan(const Plan& plan, const Scene& scene, const std::string& path) {
+  const fs::path p(path);
+  if (p.has_parent_path()) {
+    std::error_code ec;
+    fs::create_directories(p.parent_path(), ec);
+  }
+  std::ofstream out(path);
+  if (!out) throw PlanFileError("cannot write plan file '" + path + "'");
+  out << plan_to_json(plan, scene).dump(1) << "\n";
+  if (!out) throw PlanFileError("error while writing plan file '" + path + "'");
+}
+
+Plan plan_from_json(const json& j, const dynamics::Model& model, const std::string& source) {
+  if (!j.is_object()) fail(source, "", "the top level must be a JSON object");
+  const int n = model.nq();
+  std::vector<int> column(n);
+  std::size_t width = n;
+  if (j.contains("joint_names")) {
+    const json& names = j["joint_names"];
+    if (!names.is_array()) fail(source, "joint_names", "must be an array of strings");
+    width = names.size();
+    for (int i = 0; i < n; ++i) {
+      column[i] = -1;
+      for (std::size_t c = 0; c < names.size(); ++c) {
+        if (!names[c].is_string()) fail(source, "joint_names", "must be an array of strings");
+        if (names[c].get<std::string>() == model.bodies[i].joint_name)
+          column[i] = static_cast<int>(c);
+      }
+      if (column[i] < 0) {
+        fail(source, "joint_names",
+             "has no joint '" + model.bodies[i].joint_name + "' of the robot");
+      }
+    }
+  } else {
+    for (int i = 0; i < n; ++i) column[i] = i;
+  }
+  Plan plan;
+  if (!j.contains("t") || !j["t"].is_array()) fail(source, "t", "missing array of times");
+  for (std::size_t k = 0; k < j["t"].size(); ++k) {
+    const std::string key = "t[" + std::to_string(k) + "]";
+    if (!j["t"][k].is_number()) fail(source, key, "must be a number");
+    plan.t.push_back(j["t"][k].get<double>());
+    if (k > 0 && !(plan.t[k] > plan.t[k - 1])) fail(source, key, "times must increase");
+  }
+  const std::size_t rows = plan.t.size();
+  plan.q = read_rows(j, "q", source, rows, column, width);
+  plan.qd = read_rows(j, "qd", source, rows, column, width);
+  plan.qdd = read_rows(j, "qdd", source, rows, column, width);
+  plan.tau = read_rows(j, "tau", source, rows, column, width);
+  if (j.contains("stats")) plan.stats = stats_from_json(j["stats"], source);
+  if (j.contains("validation")) plan.validation = validation_from_json(j["validation"], source);
+  return plan;
+}
+
+Plan read_plan(const std::string& path, const dynamics::Model& model) {
+  std::ifstream in(path);
+  if (!in) throw PlanFileError("cannot open plan file '" + path + "'");
+  json j;
+  try {
+    j = json::parse(in);
+  } catch (const json::parse_error& e) {
+    throw PlanFileError("plan '" + path + "' is not valid JSON: " + e.what());
+  }
+  return plan_from_json(j, model, path);
+}
+
+}  // namespace kinograph::planning
