@@ -3,7 +3,6 @@
 #include "kinograph/graph/isam2.h"
 
 #include <gtest/gtest.h>
-#include <spdlog/spdlog.h>
 
 #include <Eigen/Dense>
 #include <cmath>
@@ -71,7 +70,6 @@ FactorPtr random_linear(const std::vector<Key>& keys, const Values& values, std:
 }
 
 TEST(ISAM2, RandomAddsAndRemovesMatchDenseSolveAfterEveryUpdate) {
-  if (getenv("DBG")) spdlog::set_level(spdlog::level::debug);
   std::mt19937 rng(42);
   std::normal_distribution<double> n01;
   ISAM2Options opt;
@@ -140,10 +138,6 @@ TEST(ISAM2, RandomAddsAndRemovesMatchDenseSolveAfterEveryUpdate) {
     }
     const auto res = isam.update(nf, removed, nv);
     ASSERT_TRUE(res.ok()) << "step " << step << ": " << res.reason;
-    if (getenv("DBG"))
-      printf("step %d full %d lambda %g trials %d before %g after %g relin %d re %d\n", step,
-             res.full_reelimination, res.lambda, res.trials, res.error_before, res.error_after,
-             res.variables_relinearized, res.variables_reeliminated);
     if (!res.full_reelimination) ++partial;
     // Anchors of new variables stay; every other factor may be removed later.
     removable.insert(removable.end(), res.new_factor_indices.begin() + (grows ? 1 : 0),
@@ -152,14 +146,6 @@ TEST(ISAM2, RandomAddsAndRemovesMatchDenseSolveAfterEveryUpdate) {
     ASSERT_EQ(isam.check_invariants(), "") << "step " << step;
     const Eigen::VectorXd expected = dense_solve(isam.graph(), isam.estimate());
     const double err = (isam.estimate().vector() - expected).cwiseAbs().maxCoeff();
-    if (getenv("DBG") && err > 1e-9) {
-      Values e = isam.estimate();
-      e.vector() = expected;
-      printf("dense err %g isam err %g\n", isam.graph().error(e), isam.error());
-      for (int s = 0; s < e.size(); ++s)
-        printf("%s %g\n", e.key(s).to_string().c_str(),
-               (isam.estimate().at_slot(s) - e.at_slot(s)).norm());
-    }
     ASSERT_LT(err, 1e-9) << "step " << step;
   }
   EXPECT_GT(partial, 60);  // most updates really were incremental
@@ -308,9 +294,7 @@ TEST(ISAM2, NonlinearUpdatesConvergeToTheBatchOptimum) {
   // previous two points and a weak prior on each.
   std::mt19937 rng(3);
   std::normal_distribution<double> noise(0, 0.05);
-  ISAM2Options dbg_opt;
-  if (getenv("NOSAFE")) dbg_opt.safeguard = false;
-  ISAM2 isam(dbg_opt);  // defaults: relinearize at 0.1, wildfire 1e-7, safeguard on
+  ISAM2 isam;  // defaults: relinearize at 0.1, wildfire 1e-7, safeguard on
   FactorGraph reference;
   Values initial;
   for (int i = 0; i < 30; i += 3) {
@@ -342,14 +326,9 @@ TEST(ISAM2, NonlinearUpdatesConvergeToTheBatchOptimum) {
   for (int it = 0; it < 30; ++it) {
     const auto res = isam.update({}, {}, {}, force);
     ASSERT_TRUE(res.ok()) << res.reason;
-    if (getenv("DBG"))
-      printf("it %d full %d lambda %g trials %d before %.12g after %.12g relin %d re %d\n", it,
-             res.full_reelimination, res.lambda, res.trials, res.error_before, res.error_after,
-             res.variables_relinearized, res.variables_reeliminated);
     EXPECT_FALSE(res.error_increased);
   }
   const Values optimum = batch_optimum(reference, initial);
-  if (getenv("DBG")) printf("final %.12g LM %.12g\n", isam.error(), reference.error(optimum));
   EXPECT_LT((isam.estimate().vector() - optimum.vector()).cwiseAbs().maxCoeff(), 1e-6);
   EXPECT_NEAR(isam.error(), reference.error(optimum), 1e-8 * reference.error(optimum));
 }
@@ -377,10 +356,6 @@ TEST(ISAM2, ThresholdRelinearizationReachesTheOptimumWithoutForcing) {
   for (int it = 0; it < 30; ++it) {
     const auto res = isam.update();
     ASSERT_TRUE(res.ok());
-    if (getenv("DBG"))
-      printf("it %d full %d lambda %g trials %d before %g after %g relin %d re %d\n", it,
-             res.full_reelimination, res.lambda, res.trials, res.error_before, res.error_after,
-             res.variables_relinearized, res.variables_reeliminated);
   }
   // One more update that relinearizes everything is exactly one Gauss–Newton step.
   ISAM2UpdateOptions force;
@@ -392,7 +367,6 @@ TEST(ISAM2, ThresholdRelinearizationReachesTheOptimumWithoutForcing) {
   const Eigen::VectorXd step = dense_solve(isam.graph(), theta, &theta);
   EXPECT_LT((isam.estimate().vector() - theta.vector() - step).cwiseAbs().maxCoeff(), 1e-9);
   const Values optimum = batch_optimum(reference, initial);
-  if (getenv("DBG")) printf("LM error %g isam %g\n", reference.error(optimum), isam.error());
   EXPECT_LT((isam.estimate().vector() - optimum.vector()).cwiseAbs().maxCoeff(), 1e-7);
 }
 
@@ -462,10 +436,6 @@ TEST(ISAM2, SafeguardedGaussNewtonMakesProgressOnAStiffProblem) {
   for (int it = 0; it < 120; ++it) {
     res = isam.update();
     ASSERT_TRUE(res.ok()) << res.reason;
-    if (getenv("DBG"))
-      printf("it %d full %d lambda %g trials %d before %.12g after %.12g relin %d re %d\n", it,
-             res.full_reelimination, res.lambda, res.trials, res.error_before, res.error_after,
-             res.variables_relinearized, res.variables_reeliminated);
     EXPECT_FALSE(res.error_increased) << "update " << it;
     EXPECT_LE(res.error_after, last * (1 + 1e-9)) << "update " << it;
     EXPECT_NEAR(isam.error(), res.error_after, 1e-8 * std::max(1.0, res.error_after));
@@ -488,6 +458,7 @@ TEST(ISAM2, DoglegNeverRisesSilentlyAndConvergesOnAStiffProblem) {
   ISAM2 isam(opt);
   auto res = isam.update(s.factors, {}, s.initial);
   ASSERT_TRUE(res.ok()) << res.reason;
+  int retried = res.trials > 1 ? 1 : 0;  // updates whose first dogleg step was rejected
   for (int it = 0; it < 300 && res.error_after > 0; ++it) {
     if (!res.error_increased) {
       EXPECT_LE(res.error_after, res.error_before * (1 + 1e-9));
@@ -495,6 +466,18 @@ TEST(ISAM2, DoglegNeverRisesSilentlyAndConvergesOnAStiffProblem) {
     EXPECT_NEAR(isam.error(), res.error_after, 1e-8 * std::max(1.0, res.error_after));
     res = isam.update();
     ASSERT_TRUE(res.ok()) << res.reason;
+    retried += res.trials > 1 ? 1 : 0;
+  }
+  EXPECT_GT(retried, 0);  // the trust region really shrank within an update
+  // Below the relinearization threshold the estimate is θ + δ; relinearizing closes the gap.
+  ISAM2UpdateOptions force;
+  force.force_relinearize = true;
+  for (int it = 0; it < 20; ++it) {
+    res = isam.update({}, {}, {}, force);
+    ASSERT_TRUE(res.ok());
+    if (!res.error_increased) {
+      EXPECT_LE(res.error_after, res.error_before * (1 + 1e-9));
+    }
   }
   const Values optimum = batch_optimum(reference, s.initial);
   EXPECT_NEAR(isam.error(), reference.error(optimum), 1e-4 * reference.error(optimum));
