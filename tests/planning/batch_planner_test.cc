@@ -52,5 +52,117 @@ TEST(BatchPlanner, AcrobotSwingUpValidates) {
       v.max_unactuated_torque, plan.tau.col(1).cwiseAbs().maxCoeff());
 }
 
+Problem rr_reach() {
+  Problem p;
+  p.name = "rr_reach";
+  p.model = load("robots/rr/rr.urdf");
+  p.horizon = 3;
+  p.steps = 30;
+  p.start_q = Eigen::Vector2d(-1.2, 0);
+  p.start_qd = Eigen::Vector2d(0, 0);
+  p.goal.q = Eigen::Vector2d(1.2, 0);
+  // A ball the straight line's upright arm would hit with its tip: the arm must bend past it.
+  collision::Obstacle ball;
+  ball.id = 1;
+  ball.shape = collision::Shape::sphere(0.12);
+  ball.pose.translation() = Eigen::Vector3d(0.1, 0, 1.9);
+  p.obstacles.push_back(ball);
+  return p;
+}
+
+TEST(BatchPlanner, RrReachAvoidsTheBall) {
+  const Problem p = rr_reach();
+  const Plan plan = BatchPlanner().plan(p);
+  for (const auto& f : plan.validation.failures) ADD_FAILURE() << f;
+  EXPECT_TRUE(plan.success()) << plan.stats.reason;
+  EXPECT_GE(plan.validation.min_clearance, 0.0);
+  // The straight line would have collided: the elbow moved.
+  EXPECT_GT(plan.q.col(1).cwiseAbs().maxCoeff(), 0.05);
+  std::printf("rr: %s its=%d outer=%d time=%.3f s clearance=%.4f\n", plan.stats.status.c_str(),
+              plan.stats.iterations, plan.stats.outer_iterations, plan.stats.solve_time_s,
+              plan.validation.min_clearance);
+}
+
+std::shared_ptr<const dynamics::Model> iiwa_with_block() {
+  return std::make_shared<const dynamics::Model>(dynamics::attach_box_payload(
+      *load("robots/iiwa14/iiwa14.urdf"), "iiwa_link_ee_kuka", 2.0, {0.1, 0.1, 0.1},
+      Eigen::Isometry3d(Eigen::Translation3d(0, 0, 0.05))));
+}
+
+Problem iiwa_desk() {
+  Problem p;
+  p.name = "iiwa_desk";
+  p.model = iiwa_with_block();
+  p.horizon = 2;
+  p.steps = 40;
+  Eigen::VectorXd qs(7), qg(7);
+  qs << -0.9, 0.7, 0, -1.2, 0, 0.9, 0;
+  qg << 0.9, 0.7, 0, -1.2, 0, 0.9, 0;
+  p.start_q = qs;
+  p.start_qd = Eigen::VectorXd::Zero(7);
+  p.goal.q = qg;
+  // A box where the straight line carries the block (joint 1 sweeps it through x > 0, y = 0).
+  Eigen::VectorXd mid = 0.5 * (qs + qg);
+  dynamics::Data d(*p.model);
+  dynamics::forward_kinematics(*p.model, d, mid);
+  const Eigen::Vector3d tip =
+      dynamics::frame_pose(*p.model, d, p.model->frame_index("payload")).translation();
+  collision::Obstacle desk;
+  desk.id = 3;
+  desk.shape = collision::Shape::box(0.3, 0.3, 0.3);
+  desk.pose.translation() = tip + Eigen::Vector3d(0.1, 0, 0);
+  p.obstacles.push_back(desk);
+  return p;
+}
+
+TEST(BatchPlanner, IiwaCarriesTheBlockPastTheBox) {
+  const Problem p = iiwa_desk();
+  const Plan plan = BatchPlanner().plan(p);
+  for (const auto& f : plan.validation.failures) ADD_FAILURE() << f;
+  EXPECT_TRUE(plan.success()) << plan.stats.reason;
+  EXPECT_GE(plan.validation.min_clearance, 0.0);
+  std::printf("iiwa: %s its=%d outer=%d time=%.3f s clearance=%.4f maxtau_excess=%.3g\n",
+              plan.stats.status.c_str(), plan.stats.iterations, plan.stats.outer_iterations,
+              plan.stats.solve_time_s, plan.validation.min_clearance,
+              plan.validation.max_tau_violation);
+}
+
+TEST(BatchPlanner, ImpossibleProblemsFailCleanly) {
+  BatchPlanner planner;
+  {  // goal outside the joint limits
+    Problem p = rr_reach();
+    p.goal.q[0] = 4.0;
+    const Plan plan = planner.plan(p);
+    EXPECT_FALSE(plan.success());
+    EXPECT_EQ(plan.stats.status, "invalid_problem");
+    EXPECT_NE(plan.stats.reason.find("joint1"), std::string::npos) << plan.stats.reason;
+  }
+  {  // start in collision
+    Problem p = rr_reach();
+    p.start_q = Eigen::Vector2d(0, 0);
+    const Plan plan = planner.plan(p);
+    EXPECT_EQ(plan.stats.status, "invalid_problem");
+    EXPECT_NE(plan.stats.reason.find("collision"), std::string::npos) << plan.stats.reason;
+  }
+  {  // NaN input
+    Problem p = rr_reach();
+    p.start_q[1] = std::numeric_limits<double>::quiet_NaN();
+    EXPECT_EQ(planner.plan(p).stats.status, "invalid_problem");
+  }
+  {  // elbow torque far too low to swing up: bounded iterations, "infeasible", never valid
+    Problem p = acrobot_swingup();
+    auto weak = std::make_shared<dynamics::Model>(*p.model);
+    weak->bodies[1].limits.effort = 0.2;
+    p.model = weak;
+    BatchPlannerOptions o;
+    o.max_total_iterations = 150;
+    const Plan plan = BatchPlanner(o).plan(p);
+    EXPECT_FALSE(plan.success());
+    EXPECT_EQ(plan.stats.status, "infeasible");
+    EXPECT_LE(plan.stats.iterations, 150);
+    EXPECT_FALSE(plan.stats.reason.empty());
+  }
+}
+
 }  // namespace
 }  // namespace kinograph::planning

@@ -1,0 +1,127 @@
+// validate() passes a consistent plan and catches each kind of violation on doctored copies.
+#include "kinograph/planning/validate.h"
+
+#include <gtest/gtest.h>
+
+#include "kinograph/dynamics/inverse_dynamics.h"
+
+namespace kinograph::planning {
+namespace {
+
+// The RR arm holding still at q* for 1 s: consistent, within limits, τ = gravity torque.
+struct Fixture {
+  Problem problem;
+  Plan plan;
+  Fixture() {
+    problem.model = std::make_shared<const dynamics::Model>(
+        dynamics::Model::from_urdf_file(std::string(KINOGRAPH_SOURCE_DIR) + "/robots/rr/rr.urdf"));
+    problem.horizon = 1;
+    problem.steps = 10;
+    const Eigen::Vector2d q(0.5, -0.3);
+    problem.start_q = q;
+    problem.start_qd = Eigen::Vector2d::Zero();
+    problem.goal.q = q;
+    const int rows = problem.steps + 1;
+    plan.q = q.transpose().replicate(rows, 1);
+    plan.qd = Eigen::MatrixXd::Zero(rows, 2);
+    plan.qdd = Eigen::MatrixXd::Zero(rows, 2);
+    dynamics::Data d(*problem.model);
+    const Eigen::VectorXd tau =
+        dynamics::rnea(*problem.model, d, q, Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero());
+    plan.tau = tau.transpose().replicate(rows, 1);
+    for (int k = 0; k < rows; ++k) plan.t.push_back(0.1 * k);
+  }
+};
+
+bool mentions(const Validation& v, const std::string& what) {
+  for (const auto& f : v.failures) {
+    if (f.find(what) != std::string::npos) return true;
+  }
+  return false;
+}
+
+TEST(Validate, AcceptsAConsistentPlan) {
+  Fixture f;
+  const Validation v = validate(f.problem, f.plan);
+  EXPECT_TRUE(v.valid) << (v.failures.empty() ? "" : v.failures.front());
+  EXPECT_LT(v.max_dynamics_residual, 1e-9);
+  EXPECT_EQ(v.goal_error, 0);
+}
+
+TEST(Validate, CatchesEachViolation) {
+  {
+    Fixture f;
+    f.plan.tau(4, 1) += 0.1;
+    const Validation v = validate(f.problem, f.plan);
+    EXPECT_FALSE(v.valid);
+    EXPECT_TRUE(mentions(v, "dynamics"));
+    EXPECT_NEAR(v.max_dynamics_residual, 0.1, 1e-9);
+  }
+  {
+    Fixture f;
+    f.plan.q(5, 0) += 0.1;  // a jump in q alone breaks the position trapezoid
+    const Validation v = validate(f.problem, f.plan);
+    EXPECT_TRUE(mentions(v, "position consistency"));
+  }
+  {
+    Fixture f;
+    f.plan.qd(5, 1) = 0.5;
+    const Validation v = validate(f.problem, f.plan);
+    EXPECT_TRUE(mentions(v, "consistency"));
+  }
+  {
+    Fixture f;
+    f.problem.goal.q[1] += 0.2;
+    const Validation v = validate(f.problem, f.plan);
+    EXPECT_TRUE(mentions(v, "goal"));
+    EXPECT_NEAR(v.goal_error, 0.2, 1e-12);
+  }
+  {
+    Fixture f;  // effort limit of joint 1 is 60 N·m
+    f.plan.tau(3, 0) = 70;
+    const Validation v = validate(f.problem, f.plan);
+    EXPECT_TRUE(mentions(v, "effort"));
+    EXPECT_NEAR(v.max_tau_violation, 10, 1e-9);
+  }
+  {
+    Fixture f;  // velocity limit 3 rad/s
+    f.plan.qd(2, 0) = 3.5;
+    const Validation v = validate(f.problem, f.plan);
+    EXPECT_TRUE(mentions(v, "velocity limit"));
+    EXPECT_NEAR(v.max_qd_violation, 0.5, 1e-12);
+  }
+  {
+    Fixture f;  // position limit ±π
+    f.plan.q.col(0).setConstant(3.5);
+    const Validation v = validate(f.problem, f.plan);
+    EXPECT_TRUE(mentions(v, "position limit"));
+  }
+  {
+    Fixture f;
+    auto m = std::make_shared<dynamics::Model>(*f.problem.model);
+    m->bodies[0].actuated = false;
+    f.problem.model = m;
+    const Validation v = validate(f.problem, f.plan);
+    EXPECT_TRUE(mentions(v, "unactuated"));
+  }
+  {
+    Fixture f;  // a ball on the arm
+    collision::Obstacle ball;
+    ball.shape = collision::Shape::sphere(0.1);
+    ball.pose.translation() = Eigen::Vector3d(std::sin(0.5) * 0.5, 0, std::cos(0.5) * 0.5);
+    f.problem.obstacles.push_back(ball);
+    const Validation v = validate(f.problem, f.plan);
+    EXPECT_TRUE(mentions(v, "collision"));
+    EXPECT_LT(v.min_clearance, 0);
+  }
+  {
+    Fixture f;
+    f.plan.qdd(1, 1) = std::numeric_limits<double>::quiet_NaN();
+    EXPECT_FALSE(validate(f.problem, f.plan).valid);
+    f.plan.q.resize(3, 2);
+    EXPECT_FALSE(validate(f.problem, f.plan).valid);
+  }
+}
+
+}  // namespace
+}  // namespace kinograph::planning
