@@ -55,9 +55,11 @@ class Reader {
   void expect_map(const YAML::Node& node, const std::string& key,
                   std::initializer_list<const char*> allowed) const {
     if (!node.IsMap()) fail(node, key, "must be a map");
+    std::set<std::string> seen;
     for (const auto& entry : node) {
       if (!entry.first.IsScalar()) fail(entry.first, key, "has a key that is not a string");
       const std::string name = entry.first.Scalar();
+      if (!seen.insert(name).second) fail(entry.first, join(key, name), "duplicate key");
       bool known = false;
       for (const char* a : allowed) known = known || name == a;
       if (!known) {
@@ -298,9 +300,11 @@ class SceneParser {
 
   void parse_limits(const YAML::Node& limits, Scene& scene, dynamics::Model& model) {
     if (!limits.IsMap()) r_.fail(limits, "limits", "must be a map from joint name to limits");
+    std::set<std::string> seen;
     for (const auto& entry : limits) {
       const std::string joint = entry.first.Scalar();
       const std::string key = join("limits", joint);
+      if (!seen.insert(joint).second) r_.fail(entry.first, key, "duplicate joint");
       int body = -1;
       for (int i = 0; i < model.nq(); ++i) {
         if (model.bodies[i].joint_name == joint) body = i;
