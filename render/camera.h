@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <optional>
+#include <vector>
 
 namespace kinograph::render {
 
@@ -29,5 +30,11 @@ struct Camera {
 Camera frame_bounds(const Eigen::AlignedBox3d& bounds, const Eigen::Vector3d& view_dir,
                     double aspect, const Eigen::Vector3d& up = Eigen::Vector3d::UnitZ(),
                     double fov_y_deg = 30.0, double margin = 0.08);
+
+/// Camera that sees every point of `points` from direction `view_dir`, with the points'
+/// projection centred in the frame (tighter than framing their bounding box).
+Camera frame_points(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& view_dir,
+                    double aspect, const Eigen::Vector3d& up = Eigen::Vector3d::UnitZ(),
+                    double fov_y_deg = 30.0, double margin = 0.06);
 
 }  // namespace kinograph::render

@@ -19,15 +19,6 @@ Eigen::Isometry3d geometry_pose(const Geometry& g, const dynamics::Data& data) {
   return g.body < 0 ? g.origin : data.body_pose[g.body] * g.origin;
 }
 
-Eigen::AlignedBox3d transformed(const Eigen::AlignedBox3d& box, const Eigen::Isometry3d& pose) {
-  Eigen::AlignedBox3d out;
-  if (box.isEmpty()) return out;
-  for (int i = 0; i < 8; ++i) {
-    out.extend(pose * box.corner(static_cast<Eigen::AlignedBox3d::CornerType>(i)));
-  }
-  return out;
-}
-
 // A round cell size near extent / 8 (1, 2 or 5 times a power of ten) for the checker floor.
 double nice_cell(double extent) {
   const double raw = std::max(extent / 8.0, 1e-3);
@@ -121,23 +112,34 @@ std::vector<DrawItem> SceneRenderer::obstacle_items(const RenderScene& scene) {
   return items;
 }
 
-Eigen::AlignedBox3d SceneRenderer::motion_bounds(const RenderScene& scene) {
+std::vector<Eigen::Vector3d> SceneRenderer::motion_points(const RenderScene& scene) {
   scene.check();
   const dynamics::Model& model = *scene.model;
   dynamics::Data data(model);
-  Eigen::AlignedBox3d bounds;
+  std::vector<Eigen::Vector3d> points;
+  const auto add_box = [&](const Eigen::AlignedBox3d& box, const Eigen::Isometry3d& pose) {
+    if (box.isEmpty()) return;
+    for (int i = 0; i < 8; ++i) {
+      points.push_back(pose * box.corner(static_cast<Eigen::AlignedBox3d::CornerType>(i)));
+    }
+  };
   const int samples = std::min<int>(static_cast<int>(scene.trajectory.t.size()), 60);
   for (double t : scene.trajectory.even_times(samples)) {
     dynamics::forward_kinematics(model, data, scene.trajectory.at(t));
     for (const Geometry& g : model.visual) {
-      bounds.extend(transformed(renderer_.mesh_bounds(geometry_mesh(g)), geometry_pose(g, data)));
+      add_box(renderer_.mesh_bounds(geometry_mesh(g)), geometry_pose(g, data));
     }
-    for (const Eigen::Isometry3d& pose : data.body_pose) bounds.extend(pose.translation());
+    for (const Eigen::Isometry3d& pose : data.body_pose) points.push_back(pose.translation());
   }
-  for (const Geometry& g : scene.obstacles) {
-    bounds.extend(transformed(renderer_.mesh_bounds(geometry_mesh(g)), g.origin));
-  }
-  if (bounds.isEmpty()) bounds.extend(Eigen::Vector3d::Zero());
+  for (const Geometry& g : scene.obstacles)
+    add_box(renderer_.mesh_bounds(geometry_mesh(g)), g.origin);
+  if (points.empty()) points.push_back(Eigen::Vector3d::Zero());
+  return points;
+}
+
+Eigen::AlignedBox3d SceneRenderer::motion_bounds(const RenderScene& scene) {
+  Eigen::AlignedBox3d bounds;
+  for (const Eigen::Vector3d& p : motion_points(scene)) bounds.extend(p);
   // A robot with no visual geometry (or a point) still gets a finite frame.
   const Eigen::Vector3d pad = (Eigen::Vector3d::Constant(0.1) - bounds.sizes()).cwiseMax(0.0) / 2;
   bounds.min() -= pad;
@@ -147,7 +149,6 @@ Eigen::AlignedBox3d SceneRenderer::motion_bounds(const RenderScene& scene) {
 
 Camera SceneRenderer::auto_camera(const RenderScene& scene, double aspect) {
   if (scene.camera) return *scene.camera;
-  const Eigen::AlignedBox3d bounds = motion_bounds(scene);
   Eigen::Vector3d view_dir(1.0, -1.25, 0.7);  // front-right, above: shows depth of 3-D arms
   Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
   if (auto axis = planar_axis(*scene.model, scene.trajectory.q.front())) {
@@ -162,7 +163,7 @@ Camera SceneRenderer::auto_camera(const RenderScene& scene, double aspect) {
       view_dir = -a;
     }
   }
-  return frame_bounds(bounds, view_dir.normalized(), aspect, up);
+  return frame_points(motion_points(scene), view_dir.normalized(), aspect, up);
 }
 
 SceneRenderer::Floor SceneRenderer::make_floor(const RenderScene& scene, const Camera& camera) {
@@ -170,13 +171,17 @@ SceneRenderer::Floor SceneRenderer::make_floor(const RenderScene& scene, const C
   const double extent = bounds.sizes().maxCoeff();
   const double cell = nice_cell(extent);
   const int cells = 2 * static_cast<int>(std::ceil(2.5 * extent / cell / 2.0)) + 8;
-  const Eigen::Vector4f light(0.95f, 0.95f, 0.95f, 1.f), dark(0.80f, 0.81f, 0.84f, 1.f);
-  Floor floor;
-  floor.mesh = renderer_.mesh(fmt::format("checker:{}:{}", cells, cell),
-                              [&] { return make_checker(cells, cell, light, dark); });
   const Eigen::Vector3d view_dir = (camera.eye - camera.target).normalized();
+  const bool backdrop = std::abs(view_dir.z()) < 0.2;
+  // A backdrop faces the camera and would dominate the picture at full contrast.
+  const Eigen::Vector4f light(0.96f, 0.96f, 0.96f, 1.f);
+  const Eigen::Vector4f dark = backdrop ? Eigen::Vector4f(0.89f, 0.90f, 0.92f, 1.f)
+                                        : Eigen::Vector4f(0.80f, 0.81f, 0.84f, 1.f);
+  Floor floor;
+  floor.mesh = renderer_.mesh(fmt::format("checker:{}:{}:{}", cells, cell, backdrop),
+                              [&] { return make_checker(cells, cell, light, dark); });
   const auto snap = [&](double v) { return 2.0 * cell * std::round(v / (2.0 * cell)); };
-  if (std::abs(view_dir.z()) < 0.2) {
+  if (backdrop) {
     // Seen from the side (planar robots): a backdrop behind the motion instead of a floor
     // that would show edge-on.
     const Eigen::Vector3d c = bounds.center();

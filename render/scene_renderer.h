@@ -56,9 +56,12 @@ class SceneRenderer {
   /// path drawn as a tube. Throws as strip() does.
   RenderResult ghost(const RenderScene& scene, const FrameOptions& options = {});
 
-  /// World bounds of the robot over the whole trajectory plus the obstacles.
+  /// Corners of every shape's box over the trajectory (60 samples at most) and of the
+  /// obstacles: the points a camera must see.
+  std::vector<Eigen::Vector3d> motion_points(const RenderScene& scene);
+  /// World bounds of motion_points (at least 0.1 m on a side).
   Eigen::AlignedBox3d motion_bounds(const RenderScene& scene);
-  /// Camera framing motion_bounds for a viewport of ratio `aspect`: along the joint axis for
+  /// Camera framing motion_points for a viewport of ratio `aspect`: along the joint axis for
   /// planar robots, from the front-right and above otherwise.
   Camera auto_camera(const RenderScene& scene, double aspect);
 

@@ -1,0 +1,72 @@
+// `kinograph plot plan.json [other.json] --out torque.png`: joint torques over time, one
+// subplot per joint, effort limits dashed, a second plan overlaid for comparison.
+#include <spdlog/spdlog.h>
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "render/image.h"
+#include "render/plan_json.h"
+#include "render/plot.h"
+#include "tools/command_registry.h"
+
+namespace kinograph::tools {
+namespace {
+
+struct PlotArgs {
+  std::vector<std::string> plans;
+  std::vector<std::string> labels;
+  std::string out = "torque.png";
+  std::string title = "Joint torques";
+  int width = 1200;
+  int height = 0;
+};
+
+void run_plot(const PlotArgs& args) {
+  try {
+    std::vector<render::PlotSeries> series;
+    render::TorquePlotOptions options;
+    options.title = args.title;
+    options.width = args.width;
+    options.height = args.height;
+    for (std::size_t i = 0; i < args.plans.size(); ++i) {
+      const render::PlanFile plan = render::read_plan_json(args.plans[i]);
+      if (plan.tau.empty()) {
+        throw std::runtime_error("plan '" + args.plans[i] + "' has no 'tau' to plot");
+      }
+      render::PlotSeries s;
+      s.label = i < args.labels.size() ? args.labels[i]
+                                       : std::filesystem::path(args.plans[i]).stem().string();
+      s.t = plan.t;
+      s.values = plan.tau;
+      series.push_back(std::move(s));
+      if (i == 0) {
+        options.joint_names = plan.joint_names;
+        options.limits = plan.effort_limits;
+      }
+    }
+    render::write_png(render::plot_torques(series, options), args.out);
+  } catch (const std::exception& e) {
+    throw CommandFailure(e.what());
+  }
+  spdlog::info("plot: wrote {}", args.out);
+}
+
+const bool kRegistered = register_command([](CLI::App& root) {
+  auto args = std::make_shared<PlotArgs>();
+  CLI::App* cmd = root.add_subcommand(
+      "plot", "Plot a plan's joint torques (and overlay a second plan) as a PNG");
+  cmd->add_option("plans", args->plans, "One or two plan files (JSON)")->required()->expected(1, 2);
+  cmd->add_option("--out", args->out, "Output PNG")->capture_default_str();
+  cmd->add_option("--label", args->labels,
+                  "Legend name of each plan, in order (default: the file names)");
+  cmd->add_option("--title", args->title, "Plot title")->capture_default_str();
+  cmd->add_option("--width", args->width, "Picture width, pixels")->capture_default_str();
+  cmd->add_option("--height", args->height, "Picture height, pixels (0: from the joint count)")
+      ->capture_default_str();
+  cmd->callback([args] { run_plot(*args); });
+});
+
+}  // namespace
+}  // namespace kinograph::tools
