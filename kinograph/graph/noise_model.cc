@@ -91,11 +91,20 @@ void GaussianNoise::whiten_system(Eigen::Ref<Eigen::VectorXd> e,
                                   Eigen::Ref<Eigen::MatrixXd> J) const {
   whiten_residual(e);
   const Eigen::Index n = R_.rows();
-  for (Eigen::Index k = 0; k < J.cols(); ++k) {
-    for (Eigen::Index i = 0; i < n; ++i) {
-      J(i, k) = R_.row(i).tail(n - i).dot(J.col(k).tail(n - i));
+  if (n < 8) {  // small: in place, as whiten_residual, column by column
+    for (Eigen::Index k = 0; k < J.cols(); ++k) {
+      for (Eigen::Index i = 0; i < n; ++i) {
+        J(i, k) = R_.row(i).tail(n - i).dot(J.col(k).tail(n - i));
+      }
     }
+    return;
   }
+  // Large (e.g. the GP prior's 3n×3n): a dense product, whose blocking lives on the stack at
+  // these sizes, into a per-thread buffer, so the hot loop allocates nothing after first use.
+  thread_local Eigen::MatrixXd RJ;
+  RJ.resize(J.rows(), J.cols());
+  RJ.noalias() = R_ * J;
+  J = RJ;
 }
 
 HingeNoise::HingeNoise(const Eigen::Ref<const Eigen::VectorXd>& lower,

@@ -6,6 +6,12 @@
 
 namespace kinograph::graph {
 
+namespace {
+// From this many Jacobian columns on, JᵀJ is formed by a symmetric rank update (upper triangle
+// only); below it the plain small product is cheaper.
+constexpr int kRankUpdateColumns = 16;
+}  // namespace
+
 NormalEquations::NormalEquations(const FactorGraph& graph, const Values& values,
                                  OrderingMethod ordering)
     : graph_id_(graph.structure_id()), layout_id_(values.layout_id()) {
@@ -186,7 +192,14 @@ bool NormalEquations::run(const FactorGraph& graph, const Values& values, double
       total += 0.5 * r.squaredNorm();
       if (info.num_pairs == 0) continue;
       auto JtJ = JtJ_.topLeftCorner(nc, nc);
-      JtJ.noalias() = J.transpose() * J;
+      if (nc >= kRankUpdateColumns) {
+        // Large factors (e.g. the GP prior): a symmetric rank update fills the upper triangle
+        // with half the flops of the full product.
+        JtJ.triangularView<Eigen::Upper>().setZero();
+        JtJ.selfadjointView<Eigen::Upper>().rankUpdate(J.transpose());
+      } else {
+        JtJ.noalias() = J.transpose() * J;
+      }
       auto Jtr = Jtr_.head(nc);
       Jtr.noalias() = J.transpose() * r;
       const auto& offsets = f.block_offsets();
@@ -200,11 +213,20 @@ bool NormalEquations::run(const FactorGraph& graph, const Values& values, double
         const Pair& pair = pairs_[p];
         const int ro = offsets[pair.row_key], co = offsets[pair.col_key];
         const int dr = dims[pair.row_key], dc = dims[pair.col_key];
-        for (int k = 0; k < dc; ++k) {
-          double* dst = h + col_ptr_[pair.first_col + k] + pair.within;
-          const double* src = JtJ.data() + (co + k) * JtJ.outerStride() + ro;
-          const int rows = pair.diagonal ? k + 1 : dr;
-          for (int i = 0; i < rows; ++i) dst[i] += src[i];
+        const Eigen::Index stride = JtJ.outerStride();
+        if (ro <= co) {  // the block lies in JᵀJ's upper triangle
+          for (int k = 0; k < dc; ++k) {
+            double* dst = h + col_ptr_[pair.first_col + k] + pair.within;
+            const double* src = JtJ.data() + (co + k) * stride + ro;
+            const int rows = pair.diagonal ? k + 1 : dr;
+            for (int i = 0; i < rows; ++i) dst[i] += src[i];
+          }
+        } else {  // below the diagonal of JᵀJ: read the mirrored entries from the upper triangle
+          for (int k = 0; k < dc; ++k) {
+            double* dst = h + col_ptr_[pair.first_col + k] + pair.within;
+            const double* src = JtJ.data() + ro * stride + co + k;
+            for (int i = 0; i < dr; ++i) dst[i] += src[i * stride];
+          }
         }
       }
     }
