@@ -24,6 +24,9 @@
 #include "kinograph/graph/values.h"
 #include "kinograph/planning/augmented_lagrangian.h"
 #include "kinograph/planning/dynamics_factors.h"
+#include "kinograph/planning/graph_builder.h"
+#include "kinograph/planning/initialization.h"
+#include "kinograph/planning/problem.h"
 
 namespace kinograph::planning {
 namespace {
@@ -326,6 +329,79 @@ TEST(DfgBuilder, ConstrainedSingleStepAgreesWithCondensed) {
   EXPECT_LT((dfg.qdd - condensed.qdd).cwiseAbs().maxCoeff(), 1e-5)
       << dfg.qdd.transpose() << " vs " << condensed.qdd.transpose();
   EXPECT_LT((dfg.tau - condensed.tau).cwiseAbs().maxCoeff(), 1e-5);
+}
+
+// Whole trajectories: the planner's condensed graph (build_graph) and the same graph with each
+// step's DynamicsStepFactor replaced by the DFG (add_dfg_constraints), solved by the same
+// augmented-Lagrangian loop from the same straight-line start, reach the same plan. The
+// minimum-torque term makes the optimum depend on the torques, so the DFG's τ must be right.
+TEST(DfgBuilder, WholeTrajectoryAgreesWithCondensed) {
+  Problem problem;
+  problem.name = "rr_dfg_vs_condensed";
+  problem.model = std::make_shared<const Model>(Model::from_urdf_file(robot("rr/rr.urdf")));
+  problem.horizon = 1.5;
+  problem.steps = 12;
+  problem.start_q = Eigen::Vector2d(0.2, -0.3);
+  problem.start_qd = Eigen::Vector2d::Zero();
+  problem.goal.q = Eigen::Vector2d(1.0, 0.6);
+  problem.objectives.min_torque = 0.01;
+  const GraphOptions graph_options;
+  const Model& model = *problem.model;
+
+  auto solve = [&](bool dfg) {
+    const Trajectory init = straight_line(problem, problem.goal.q);
+    PlanningGraph pg = build_graph(problem, init, graph_options);
+    if (dfg) {
+      std::vector<int> steps;
+      for (size_t i = 0; i < pg.graph.size(); ++i) {
+        const auto* f = dynamic_cast<const DynamicsStepFactor*>(pg.graph[i].get());
+        if (f == nullptr) continue;
+        steps.push_back(static_cast<int>(f->keys()[0].step()));
+        std::erase_if(pg.constraints, [f](const auto& c) { return c.get() == f; });
+        pg.graph.remove(i);
+      }
+      EXPECT_EQ(steps.size(), static_cast<size_t>(problem.steps + 1));
+      DynamicsStepOptions rows;
+      rows.limit_epsilon = problem.objectives.limit_epsilon;
+      rows.min_torque = problem.objectives.min_torque;
+      rows.torque_scale = graph_options.torque_scale;
+      for (int k : steps) {
+        for (auto& f :
+             add_dfg_constraints(pg.graph, pg.values, model, *pg.dynamics_workspace, k, rows)
+                 .factors) {
+          if (f->has_constraints()) pg.constraints.push_back(f);
+        }
+      }
+    }
+    AugmentedLagrangian al(pg.constraints);
+    graph::LevenbergMarquardtOptions lm_options;
+    lm_options.relative_error_tol = 1e-12;
+    lm_options.max_iterations = 100;
+    graph::LevenbergMarquardt lm(lm_options);
+    double violation = 1;
+    for (int outer = 0; outer < 30 && violation > 1e-9; ++outer) {
+      lm.optimize(pg.graph, pg.values);
+      violation = al.update(pg.values);
+    }
+    EXPECT_LT(violation, 1e-7) << (dfg ? "dfg" : "condensed");
+    if (dfg) {  // the DFG's torques are RNEA's at the solution
+      dynamics::Data data(model);
+      for (int k = 0; k <= problem.steps; ++k) {
+        const Eigen::VectorXd tau =
+            dynamics::rnea(model, data, pg.values.at(Key('q', 0, k)), pg.values.at(Key('v', 0, k)),
+                           pg.values.at(Key('a', 0, k)));
+        EXPECT_LT((dfg_torques(pg.values, model, k) - tau).cwiseAbs().maxCoeff(), 1e-5) << k;
+      }
+    }
+    return read_trajectory(pg.values, problem.steps, model.nq());
+  };
+  const Trajectory condensed = solve(false), dfg = solve(true);
+  EXPECT_LT((dfg.q - condensed.q).cwiseAbs().maxCoeff(), 1e-5);
+  EXPECT_LT((dfg.qd - condensed.qd).cwiseAbs().maxCoeff(), 1e-5);
+  EXPECT_LT((dfg.qdd - condensed.qdd).cwiseAbs().maxCoeff(), 1e-4);
+  // And the plan is not simply the initial straight line.
+  const Trajectory init = straight_line(problem, problem.goal.q);
+  EXPECT_GT((condensed.qdd - init.qdd).cwiseAbs().maxCoeff(), 1e-3);
 }
 
 TEST(DfgBuilder, RejectsExternalWrenchOnMissingBody) {
