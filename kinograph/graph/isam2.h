@@ -16,7 +16,11 @@ namespace kinograph::graph {
 /// How each update turns the linear solution into a new estimate.
 enum class ISAM2Step {
   kGaussNewton,  ///< δ from the Bayes tree (LM-damped on the re-eliminated part if unsafe)
-  kDogleg,       ///< Powell's dogleg between the Gauss–Newton and steepest-descent steps
+  /// Powell's dogleg between the Gauss–Newton and steepest-descent steps of the whole tree,
+  /// with a trust region that shrinks and retries within the update while the error rises; a
+  /// radius-limited step relinearizes every moved variable at the next update (GTSAM's ISAM2
+  /// Dogleg stalls there). Costs a pass over the whole tree and all factors per trial.
+  kDogleg,
 };
 
 /// Options of ISAM2 (fixed for its lifetime). Defaults suit planning problems in SI units.
@@ -33,9 +37,12 @@ struct ISAM2Options {
   double full_reelimination_fraction = 0.6;
   ISAM2Step step = ISAM2Step::kGaussNewton;
 
-  /// Safeguard: evaluate the nonlinear error after each update; with Gauss–Newton, if it rose,
-  /// re-eliminate the affected top with Marquardt damping λ·diag(H) (λ grows by lambda_factor)
-  /// until it no longer rises. Without it the update never evaluates the error.
+  /// Safeguard: evaluate the nonlinear error after each update (incrementally: only factors on
+  /// variables that moved); with Gauss–Newton, if it rose, re-eliminate the affected top with
+  /// Marquardt damping λ·diag(H) (λ grows by lambda_factor) until it no longer rises. A damped
+  /// step is taken in full: its variables are relinearized at the next update whatever the
+  /// threshold, so progress never stalls below it. Without the safeguard the error is not
+  /// evaluated (error_evaluated is false).
   bool safeguard = true;
   double lambda_initial = 1e-2;  ///< first damping after a rejected step (paper's λ₀)
   double lambda_factor = 10;     ///< λ grows by this after a rejection, shrinks after acceptance

@@ -222,6 +222,30 @@ TEST(ISAM2, ChangingTheLastFactorReeliminatesOnlyThePathToTheRoot) {
   }
 }
 
+TEST(ISAM2, ChangeAtTheLeavesFallsBackToFullReelimination) {
+  // With the goal's end eliminated last, the start prior sits at the bottom: changing it
+  // affects the whole path to the root, so the update re-eliminates everything from scratch.
+  const int n = 40;
+  Chain chain = make_chain(n, Eigen::Vector2d(3, 1));
+  ISAM2Options opt;
+  opt.wildfire_threshold = 0;
+  opt.relinearize_threshold = 1e9;
+  ISAM2 isam(opt);
+  ISAM2UpdateOptions first;
+  first.constrained_last = {X(n - 1)};
+  auto res = isam.update(chain.factors, {}, chain.values, first);
+  ASSERT_TRUE(res.ok());
+  res =
+      isam.update({std::make_shared<PriorFactor>(X(0), Eigen::Vector2d(1, -1), isotropic(2, 0.1))},
+                  {res.new_factor_indices[0]});
+  ASSERT_TRUE(res.ok());
+  EXPECT_TRUE(res.full_reelimination);
+  EXPECT_EQ(res.variables_reeliminated, n);
+  EXPECT_EQ(isam.check_invariants(), "");
+  const Eigen::VectorXd expected = dense_solve(isam.graph(), isam.estimate());
+  EXPECT_LT((isam.estimate().vector() - expected).cwiseAbs().maxCoeff(), 1e-9);
+}
+
 TEST(ISAM2, WildfireStopsWhereTheChangeDiesOut) {
   // Strong priors on every variable damp a goal change quickly along the chain, so with a
   // wildfire threshold the back-substitution visits only a few cliques yet stays accurate.
@@ -536,6 +560,31 @@ TEST(ISAM2, UnderdeterminedVariableIsReportedAndRecoverable) {
   ASSERT_TRUE(res.ok()) << res.reason;
   EXPECT_TRUE(res.full_reelimination);
   EXPECT_EQ(isam.check_invariants(), "");
+}
+
+TEST(ISAM2, RelinearizationIsCheckedOnlyEveryKthUpdate) {
+  ISAM2Options opt;
+  opt.relinearize_skip = 3;
+  opt.relinearize_threshold = 1e-12;
+  opt.safeguard = false;  // plain Gauss–Newton: no damped steps that force relinearization
+  ISAM2 isam(opt);
+  Values initial;
+  std::vector<FactorPtr> nf;
+  for (int j = 0; j < 6; ++j) {
+    initial.insert(X(j), Eigen::Vector2d(j * 0.5 + 0.1, 0.1));
+    nf.push_back(
+        std::make_shared<PriorFactor>(X(j), Eigen::Vector2d(j * 0.5, 0), isotropic(2, 2.0)));
+    if (j > 0) nf.push_back(std::make_shared<RangeFactor>(X(j), X(j - 1), 0.5, isotropic(1, 0.1)));
+  }
+  ASSERT_TRUE(isam.update(nf, {}, initial).ok());  // update 1 (checks, nothing to relinearize)
+  std::vector<int> relinearized;
+  for (int u = 2; u <= 7; ++u) relinearized.push_back(isam.update().variables_relinearized);
+  // Updates 4 and 7 check (every third); the others leave θ alone.
+  EXPECT_EQ(relinearized[0], 0);
+  EXPECT_EQ(relinearized[1], 0);
+  EXPECT_GT(relinearized[2], 0);
+  EXPECT_EQ(relinearized[3], 0);
+  EXPECT_EQ(relinearized[4], 0);
 }
 
 }  // namespace
