@@ -37,7 +37,8 @@ struct CollisionWorldOptions {
 // The collision scene of one robot: its collision geometry (from the Model, Bullet shapes made
 // once) and the obstacles around it, added, moved and removed by id. Queries read the body
 // poses of a Data after dynamics::forward_kinematics and allocate nothing after warm-up
-// (the output buffer is sized when obstacles are added).
+// (the output buffer is sized when obstacles are added). Queries write the world's pose caches
+// and output buffer, so a world belongs to one thread at a time.
 class CollisionWorld {
  public:
   // Builds a Bullet shape per Model::collision entry; throws std::invalid_argument for a bad
@@ -62,7 +63,9 @@ class CollisionWorld {
   bool has_moving_obstacles() const;
   // The robot's collision geometry as Bullet shapes, one per Model::collision entry.
   const ConvexShape& robot_shape(int geom) const { return robot_[geom].shape; }
+  // The options the world was built with.
   const CollisionWorldOptions& options() const { return options_; }
+  // The robot whose geometry this world holds.
   const dynamics::Model& model() const { return model_; }
 
   // Every pair within options().query_distance at the robot configuration of the last
@@ -81,7 +84,7 @@ class CollisionWorld {
     int body = -1;
     Eigen::Isometry3d origin;  // in its body's frame
     ConvexShape shape;
-    Eigen::Isometry3d world;  // after update_robot
+    Eigen::Isometry3d world;  // after update_poses
     Eigen::Vector3d centre;   // bounding sphere centre, world
   };
   struct ObstacleEntry {

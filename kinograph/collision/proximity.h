@@ -18,6 +18,7 @@ struct Proximity {
   // robot's witness point along it increases the distance.
   Eigen::Vector3d normal = Eigen::Vector3d::UnitX();
 
+  // True for a pair of two robot geometries (other_geom set, obstacle -1).
   bool is_self_collision() const { return other_geom >= 0; }
 };
 
