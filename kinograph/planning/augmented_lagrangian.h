@@ -14,7 +14,7 @@ namespace kinograph::planning {
 
 /// Penalty schedule of AugmentedLagrangian.
 struct AugmentedLagrangianOptions {
-  double initial_penalty = 10;      ///< μ₀
+  double initial_penalty = 100;     ///< μ₀
   double penalty_growth = 10;       ///< μ ← growth·μ when the violation did not shrink enough
   double max_penalty = 1e7;         ///< μ never exceeds this
   double required_decrease = 0.25;  ///< violation must fall below this fraction of the last one

@@ -16,9 +16,9 @@ struct BatchPlannerOptions {
   /// Stop when every constraint row's scaled violation |z/s| is below this.
   double constraint_tolerance = 1e-4;
   int max_outer_iterations = 15;          ///< augmented-Lagrangian updates
-  int max_inner_iterations = 40;          ///< LM linearizations per outer iteration
+  int max_inner_iterations = 15;          ///< LM linearizations per outer iteration
   int max_total_iterations = 400;         ///< LM linearizations over the whole plan
-  double inner_tolerance_initial = 1e-3;  ///< LM relative decrease in the first outer iteration
+  double inner_tolerance_initial = 1e-2;  ///< LM relative decrease in the first outer iteration
   double inner_tolerance_final = 1e-7;    ///< ... tightened by 10× per outer iteration to this
   ValidationThresholds validation;
 };

@@ -22,7 +22,7 @@ struct GraphOptions {
   double collision_scale = 0.01;   ///< m
   double pose_scale = 0.01;        ///< m and rad (goal pose and task constraints)
   /// Pairs farther than this (m, beyond ε) are not queried from Bullet.
-  double collision_query_margin = 0.25;
+  double collision_query_margin = 0.1;
 };
 
 /// A built planning graph with its variables and the handles the planner needs.

@@ -45,7 +45,7 @@ struct Objectives {
   double limit_epsilon = 0.0;
   /// Number of interpolated states checked for collision between consecutive steps by the
   /// planner's collision factors (0 = only at the steps).
-  int collision_substeps = 2;
+  int collision_substeps = 1;
 };
 
 /// A kinodynamic planning problem: move from (start_q, start_qd) to the goal in `horizon`
