@@ -17,8 +17,9 @@ struct SegmentCheckOptions {
   // Largest change of any one joint between samples (rad or m). Default 0.05.
   double max_joint_step = 0.05;
   // Largest distance any point of the robot's collision geometry can move between samples
-  // (m), from a configuration-independent bound of each joint's lever arm. Default 0.01: an
-  // obstacle thinner than this can still slip between two samples, by at most this much.
+  // (m), from a configuration-independent bound of each joint's lever arm. Default 0.01.
+  // Against fixed obstacles the true minimum along the segment is then at least the sampled
+  // minimum minus half of this, so no obstacle thicker than it is jumped over.
   double max_sweep_step = 0.01;
   // Largest time between samples (s) when the world has moving obstacles, whose own motion
   // the sweep bound does not cover. Default 0.02.

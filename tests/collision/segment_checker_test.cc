@@ -82,6 +82,30 @@ TEST_F(RrSegment, MovingObstacleAtInterpolatedTime) {
   EXPECT_LT(r.min_distance, -0.1);  // the upright link-1 cylinder is inside the sphere at t = 1
 }
 
+// The sampled minimum is within half a sweep step of the minimum found by dense sampling.
+TEST_F(RrSegment, CoarseMinimumWithinHalfASweepStepOfDenseMinimum) {
+  CollisionWorld world(model);
+  Obstacle o;
+  o.id = 1;
+  o.shape = Shape::sphere(0.05);
+  o.pose = at(0.9, 0, 1.3);
+  ASSERT_TRUE(world.add_obstacle(o));
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(-2, 2);
+  const SegmentCheckOptions coarse_opts{.max_joint_step = 10, .max_sweep_step = 0.2};
+  const SegmentCheckOptions dense_opts{.max_joint_step = 10, .max_sweep_step = 0.001};
+  SegmentChecker coarse(model, coarse_opts), dense(model, dense_opts);
+  for (int trial = 0; trial < 30; ++trial) {
+    Eigen::VectorXd q0(2), q1(2);
+    q0 << u(rng), u(rng);
+    q1 << u(rng), u(rng);
+    const SegmentCheckResult c = coarse.check(world, data, q0, q1);
+    const SegmentCheckResult d = dense.check(world, data, q0, q1);
+    EXPECT_LE(d.min_distance, c.min_distance + dense_opts.max_sweep_step / 2);
+    EXPECT_GE(d.min_distance, c.min_distance - coarse_opts.max_sweep_step / 2) << trial;
+  }
+}
+
 // Between consecutive samples no geometry point moves farther than max_sweep_step.
 TEST(SegmentChecker, ConsecutiveSamplesRespectSweepBoundOnIiwa) {
   const dynamics::Model model = dynamics::Model::from_urdf_file(kRobots + "iiwa14/iiwa14.urdf");
