@@ -101,8 +101,9 @@ void GaussianNoise::whiten_system(Eigen::Ref<Eigen::VectorXd> e,
   }
   // Large (e.g. the GP prior's 3n×3n): a dense product, whose blocking lives on the stack at
   // these sizes, into a per-thread buffer, so the hot loop allocates nothing after first use.
-  thread_local Eigen::MatrixXd RJ;
-  RJ.resize(J.rows(), J.cols());
+  thread_local Eigen::VectorXd buffer;  // grows only, so factors of other sizes reuse it
+  if (buffer.size() < J.size()) buffer.resize(J.size());
+  Eigen::Map<Eigen::MatrixXd> RJ(buffer.data(), J.rows(), J.cols());
   RJ.noalias() = R_ * J;
   J = RJ;
 }

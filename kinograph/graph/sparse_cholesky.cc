@@ -59,6 +59,9 @@ SparseCholesky::SparseCholesky(int n, const std::vector<int>& col_ptr,
                              std::to_string(common_->status) + ")");
   }
   B_ = cholmod_allocate_dense(n, 1, n, CHOLMOD_REAL, common_);
+  identity_perm_ = true;
+  const int* perm = static_cast<const int*>(L_->Perm);
+  for (int i = 0; perm != nullptr && i < n; ++i) identity_perm_ = identity_perm_ && perm[i] == i;
 }
 
 SparseCholesky::~SparseCholesky() {
@@ -103,6 +106,32 @@ bool SparseCholesky::factorize() {
 
 void SparseCholesky::solve(const Eigen::Ref<const Eigen::VectorXd>& b,
                            Eigen::Ref<Eigen::VectorXd> x) {
+  if (!L_->is_super && identity_perm_) {
+    // Simplicial factor in the caller's order: the two triangular solves directly on L's
+    // columns (cholmod_solve2 would allocate on every call).
+    const int* Lp = static_cast<const int*>(L_->p);
+    const int* Li = static_cast<const int*>(L_->i);
+    const int* Lnz = static_cast<const int*>(L_->nz);
+    const double* Lx = static_cast<const double*>(L_->x);
+    const bool ll = L_->is_ll != 0;
+    x = b;
+    for (int j = 0; j < n_; ++j) {  // L y = b (diagonal first in each column)
+      const int p0 = Lp[j];
+      if (ll) x[j] /= Lx[p0];
+      const double xj = x[j];
+      for (int p = p0 + 1; p < p0 + Lnz[j]; ++p) x[Li[p]] -= Lx[p] * xj;
+    }
+    if (!ll) {
+      for (int j = 0; j < n_; ++j) x[j] /= Lx[Lp[j]];  // D z = y
+    }
+    for (int j = n_ - 1; j >= 0; --j) {  // Lᵀ x = z
+      const int p0 = Lp[j];
+      double xj = x[j];
+      for (int p = p0 + 1; p < p0 + Lnz[j]; ++p) xj -= Lx[p] * x[Li[p]];
+      x[j] = ll ? xj / Lx[p0] : xj;
+    }
+    return;
+  }
   std::copy_n(b.data(), n_, static_cast<double*>(B_->x));
   cholmod_solve2(CHOLMOD_A, L_, B_, nullptr, &X_, nullptr, &Y_, &E_, common_);
   std::copy_n(static_cast<const double*>(X_->x), n_, x.data());

@@ -41,7 +41,8 @@ class SparseCholesky {
   /// failed_column() is the column where it broke down.
   bool factorize();
   int failed_column() const { return failed_column_; }
-  /// Solves A x = b with the last factorization.
+  /// Solves A x = b with the last factorization. Allocation-free for the simplicial form; CHOLMOD's
+  /// supernodal factorization and solve allocate internally on every call.
   void solve(const Eigen::Ref<const Eigen::VectorXd>& b, Eigen::Ref<Eigen::VectorXd> x);
 
   /// Whether CHOLMOD chose (or was told) the supernodal form, and nnz(L).
@@ -60,6 +61,7 @@ class SparseCholesky {
   cholmod_dense_struct* Y_ = nullptr;
   cholmod_dense_struct* E_ = nullptr;
   int failed_column_ = -1;
+  bool identity_perm_ = false;  // CHOLMOD kept the caller's order (no postordering)
 };
 
 }  // namespace kinograph::graph
