@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <sstream>
 
 namespace kinograph::planning {
 namespace {
@@ -193,6 +194,46 @@ Validation validation_from_json(const json& j, const std::string& source) {
     if (j.contains(key)) *out = read_number(j[key], source, std::string("validation.") + key, kInf);
   }
   return v;
+}
+
+std::string summarize(const Validation& v) {
+  std::ostringstream os;
+  os.precision(4);
+  const auto row = [&](const char* name, double value, const char* unit) {
+    os << "  " << name << ": " << value << (unit[0] ? " " : "") << unit << "\n";
+  };
+  os << "validation: " << (v.valid ? "valid" : "INVALID") << "\n";
+  row("max dynamics residual |tau - ID|", v.max_dynamics_residual, "N·m");
+  row("max position consistency", v.max_position_consistency, "rad");
+  row("max velocity consistency", v.max_velocity_consistency, "rad/s");
+  row("max q limit violation", v.max_q_violation, "rad");
+  row("max qd limit violation", v.max_qd_violation, "rad/s");
+  row("max qdd limit violation", v.max_qdd_violation, "rad/s²");
+  row("max tau limit violation", v.max_tau_violation, "N·m");
+  row("max unactuated torque", v.max_unactuated_torque, "N·m");
+  row("min clearance", v.min_clearance, "m");
+  row("goal error", v.goal_error, "");
+  row("max task error", v.max_task_error, "");
+  row("start error", v.start_error, "");
+  row("final velocity", v.final_velocity, "");
+  for (const std::string& f : v.failures) os << "  failed: " << f << "\n";
+  return os.str();
+}
+
+std::string summarize(const Plan& plan) {
+  std::ostringstream os;
+  const SolveStats& s = plan.stats;
+  os << "success: " << (plan.success() ? "yes" : "no") << "\n";
+  os << "solver: " << s.method << ", status " << s.status;
+  if (!s.reason.empty()) os << " (" << s.reason << ")";
+  os << "\n  iterations: " << s.iterations << " LM, " << s.outer_iterations << " outer, "
+     << s.linear_solves << " linear solves\n";
+  os.precision(4);
+  os << "  solve time: " << s.solve_time_s * 1e3 << " ms\n";
+  os << "  cost: " << s.cost << "\n";
+  os << "  max constraint violation: " << s.max_constraint_violation << "\n";
+  os << summarize(plan.validation);
+  return os.str();
 }
 
 json plan_to_json(const Plan& plan, const Scene& scene) {

@@ -40,6 +40,12 @@ SolveStats stats_from_json(const nlohmann::json& json, const std::string& source
 /// Reads back to_json(Validation); absent keys keep their defaults. Throws PlanFileError.
 Validation validation_from_json(const nlohmann::json& json, const std::string& source = "");
 
+/// A human-readable report of a plan: success, the solver statistics (status, iterations,
+/// solve time, cost) and every validation figure, one per line, then the failures.
+std::string summarize(const Plan& plan);
+/// The validation part of summarize().
+std::string summarize(const Validation& validation);
+
 /// The plan file of `plan`, solved for `scene` (robot, payload and obstacles come from it).
 nlohmann::json plan_to_json(const Plan& plan, const Scene& scene);
 /// Writes plan_to_json to `path`; throws PlanFileError if it cannot be written.
