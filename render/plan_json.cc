@@ -71,6 +71,7 @@ PlanFile parse_plan_json(const json& j, const std::string& source) {
   PlanFile plan;
   plan.source = source;
   if (!j.is_object()) fail(source, "the top level must be a JSON object");
+  if (j.contains("name") && j["name"].is_string()) plan.name = j["name"].get<std::string>();
   if (!j.contains("robot") || !j["robot"].is_object()) fail(source, "missing object 'robot'");
   const json& robot = j["robot"];
   if (!robot.contains("urdf") || !robot["urdf"].is_string()) {
@@ -190,6 +191,7 @@ PlanFile read_plan_json(const std::string& path) {
 
 json to_json(const PlanFile& plan) {
   json j;
+  if (!plan.name.empty()) j["name"] = plan.name;
   j["robot"]["urdf"] = plan.urdf;
   if (plan.payload) {
     const PlanPayload& p = *plan.payload;

@@ -2,13 +2,14 @@
 // The plan file (JSON) the planner writes and the renderer reads: robot, obstacles and the
 // sampled trajectory with its torques. Field names are the contract with planning/.
 //
-// {"robot": {"urdf": "robots/iiwa14/iiwa14.urdf",
+// {"name": "...", "robot": {"urdf": "robots/iiwa14/iiwa14.urdf",
 //            "payload": {"frame": "...", "mass": 2.0, "size": [x,y,z], "offset": [x,y,z]}},
 //  "obstacles": [{"id": "desk", "shape": "box"|"sphere"|"cylinder"|"capsule"|"mesh",
 //                 "size": [..], "mesh": "path", "position": [x,y,z], "quaternion": [w,x,y,z],
 //                 "rgba": [r,g,b,a] (optional)}],
 //  "joint_names": [...], "t": [...], "q": [[...],...], "qd": [[...]], "qdd": [[...]],
 //  "tau": [[...]], "limits": {"effort": [...]}, "stats": {...}, "validation": {...}}
+// Obstacles' "motion" (moving obstacles) is not read: they are drawn where "position" puts them.
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
@@ -44,6 +45,7 @@ struct PlanObstacle {
 /// A plan file in memory. Vectors of joint values are indexed like `joint_names`.
 struct PlanFile {
   std::string source;  ///< file it was read from (for messages and relative paths)
+  std::string name;    ///< the plan's "name" (e.g. the problem's), empty when absent
   std::string urdf;    ///< as written: absolute, or relative to the repo root / plan file
   std::optional<PlanPayload> payload;
   std::vector<PlanObstacle> obstacles;

@@ -37,7 +37,11 @@ void run_plot(const PlotArgs& args) {
       }
       render::PlotSeries s;
       s.label = i < args.labels.size() ? args.labels[i]
+                : !plan.name.empty()   ? plan.name
                                        : std::filesystem::path(args.plans[i]).stem().string();
+      if (args.plans.size() == 2 && i == 1 && s.label == series.front().label) {
+        s.label = std::filesystem::path(args.plans[i]).stem().string();  // keep legends apart
+      }
       s.t = plan.t;
       s.values = plan.tau;
       series.push_back(std::move(s));
@@ -59,8 +63,9 @@ const bool kRegistered = register_command([](CLI::App& root) {
       "plot", "Plot a plan's joint torques (and overlay a second plan) as a PNG");
   cmd->add_option("plans", args->plans, "One or two plan files (JSON)")->required()->expected(1, 2);
   cmd->add_option("--out", args->out, "Output PNG")->capture_default_str();
-  cmd->add_option("--label", args->labels,
-                  "Legend name of each plan, in order (default: the file names)");
+  cmd->add_option(
+      "--label", args->labels,
+      "Legend name of each plan, in order (default: the plan's name, else the file name)");
   cmd->add_option("--title", args->title, "Plot title")->capture_default_str();
   cmd->add_option("--width", args->width, "Picture width, pixels")->capture_default_str();
   cmd->add_option("--height", args->height, "Picture height, pixels (0: from the joint count)")

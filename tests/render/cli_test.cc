@@ -17,14 +17,14 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Run {
+struct CliRun {
   int status = -1;
   std::string output;
 };
 
-Run run(const std::string& args) {
+CliRun run(const std::string& args) {
   const std::string command = std::string(KINOGRAPH_CLI) + " " + args + " 2>&1";
-  Run result;
+  CliRun result;
   FILE* pipe = popen(command.c_str(), "r");
   if (pipe == nullptr) return result;
   std::array<char, 512> buffer;
@@ -48,7 +48,7 @@ class Cli : public ::testing::Test {
 
 TEST_F(Cli, RenderStripAndGhostWritePicturesOfTheAskedSize) {
   const std::string out = (dir_ / "strip.png").string();
-  Run r = run("render " + plan_ + " --frames 3 --width 600 --height 200 --out " + out);
+  CliRun r = run("render " + plan_ + " --frames 3 --width 600 --height 200 --out " + out);
   ASSERT_EQ(r.status, 0) << r.output;
   Image image = read_png(out);
   EXPECT_EQ(image.width, 600);
@@ -63,13 +63,13 @@ TEST_F(Cli, RenderStripAndGhostWritePicturesOfTheAskedSize) {
 
 TEST_F(Cli, PlotOverlaysTwoPlans) {
   const std::string out = (dir_ / "torque.png").string();
-  const Run r = run("plot " + plan_ + " " + plan_ + " --width 800 --out " + out);
+  const CliRun r = run("plot " + plan_ + " " + plan_ + " --width 800 --out " + out);
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_EQ(read_png(out).width, 800);
 }
 
 TEST_F(Cli, BadInputFailsWithAMessage) {
-  Run r = run("render " + (dir_ / "nope.json").string() + " --out " + (dir_ / "x.png").string());
+  CliRun r = run("render " + (dir_ / "nope.json").string() + " --out " + (dir_ / "x.png").string());
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.output.find("nope.json"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(dir_ / "x.png"));

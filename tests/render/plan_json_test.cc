@@ -48,10 +48,12 @@ TEST_F(PlanJson, RoundTripKeepsEveryField) {
   plan.obstacles.push_back(ball);
   plan.qd = plan.q;
   plan.stats = {{"iterations", 12}};
+  plan.name = "iiwa desk";
   const std::string path = (dir_ / "plan.json").string();
   write_plan_json(plan, path);
   const PlanFile back = read_plan_json(path);
   EXPECT_EQ(back.urdf, plan.urdf);
+  EXPECT_EQ(back.name, "iiwa desk");
   ASSERT_TRUE(back.payload.has_value());
   EXPECT_EQ(back.payload->frame, "iiwa_link_ee");
   EXPECT_DOUBLE_EQ(back.payload->mass, 2.0);
