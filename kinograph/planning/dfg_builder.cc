@@ -1,6 +1,7 @@
 #include "kinograph/planning/dfg_builder.h"
 
 #include <algorithm>
+#include <memory>
 #include <stdexcept>
 #include <string>
 
@@ -226,6 +227,37 @@ DfgConstraintStep add_dfg_constraints(graph::FactorGraph& graph, graph::Values& 
   }
   if (!DynamicsStepFactor::rows_for(model, torque_rows).empty()) {
     add(std::make_shared<DfgTorqueRowsFactor>(model, step, torque_rows, k));
+  }
+  return out;
+}
+
+std::vector<DfgConstraintStep> use_dfg_dynamics(PlanningGraph& pg, const Problem& problem,
+                                                const GraphOptions& graph_options,
+                                                const DfgOptions& options) {
+  if (!problem.model) throw std::invalid_argument("use_dfg_dynamics: problem has no model");
+  std::vector<int> steps;
+  for (size_t i = 0; i < pg.graph.size(); ++i) {
+    const auto* f = dynamic_cast<const DynamicsStepFactor*>(pg.graph[i].get());
+    if (f == nullptr) continue;
+    steps.push_back(static_cast<int>(f->keys()[0].step()));
+    std::erase_if(pg.constraints, [f](const auto& c) { return c.get() == f; });
+    pg.graph.remove(i);
+  }
+  // The rows build_graph gives the condensed factor.
+  DynamicsStepOptions rows;
+  rows.limit_epsilon = problem.objectives.limit_epsilon;
+  rows.min_torque = problem.objectives.min_torque;
+  rows.torque_scale = graph_options.torque_scale;
+  if (!pg.dynamics_workspace) {
+    pg.dynamics_workspace = std::make_shared<dynamics::Data>(*problem.model);
+  }
+  std::vector<DfgConstraintStep> out;
+  for (int k : steps) {
+    out.push_back(add_dfg_constraints(pg.graph, pg.values, *problem.model, *pg.dynamics_workspace,
+                                      k, rows, options));
+    for (const auto& f : out.back().factors) {
+      if (f->has_constraints()) pg.constraints.push_back(f);
+    }
   }
   return out;
 }

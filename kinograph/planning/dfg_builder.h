@@ -15,6 +15,8 @@
 #include "kinograph/planning/constrained_factor.h"
 #include "kinograph/planning/dfg_factors.h"
 #include "kinograph/planning/dynamics_factors.h"
+#include "kinograph/planning/graph_builder.h"
+#include "kinograph/planning/problem.h"
 
 namespace kinograph::planning {
 
@@ -149,6 +151,15 @@ DfgConstraintStep add_dfg_constraints(graph::FactorGraph& graph, graph::Values& 
                                       const dynamics::Model& model, dynamics::Data& data, int step,
                                       const DynamicsStepOptions& torque_rows,
                                       const DfgOptions& options = {});
+
+/// Switches a planning graph built by build_graph (condensed formulation) to the full DFG: every
+/// DynamicsStepFactor is removed from the graph and from pg.constraints, and its step gets the
+/// DFG (add_dfg_constraints) with the same torque rows, built from problem.objectives and
+/// graph_options exactly as build_graph builds them. Variables are initialised by RNEA from the
+/// graph's current q, q̇, q̈. Returns the added steps (empty if the graph had no dynamics rows).
+std::vector<DfgConstraintStep> use_dfg_dynamics(PlanningGraph& pg, const Problem& problem,
+                                                const GraphOptions& graph_options = {},
+                                                const DfgOptions& options = {});
 
 /// The torques of `step` read back from the graph (nq entries).
 Eigen::VectorXd dfg_torques(const graph::Values& values, const dynamics::Model& model, int step,

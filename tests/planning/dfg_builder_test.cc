@@ -352,26 +352,18 @@ TEST(DfgBuilder, WholeTrajectoryAgreesWithCondensed) {
     const Trajectory init = straight_line(problem, problem.goal.q);
     PlanningGraph pg = build_graph(problem, init, graph_options);
     if (dfg) {
-      std::vector<int> steps;
-      for (size_t i = 0; i < pg.graph.size(); ++i) {
-        const auto* f = dynamic_cast<const DynamicsStepFactor*>(pg.graph[i].get());
-        if (f == nullptr) continue;
-        steps.push_back(static_cast<int>(f->keys()[0].step()));
-        std::erase_if(pg.constraints, [f](const auto& c) { return c.get() == f; });
-        pg.graph.remove(i);
-      }
+      const auto steps = use_dfg_dynamics(pg, problem, graph_options);
       EXPECT_EQ(steps.size(), static_cast<size_t>(problem.steps + 1));
-      DynamicsStepOptions rows;
-      rows.limit_epsilon = problem.objectives.limit_epsilon;
-      rows.min_torque = problem.objectives.min_torque;
-      rows.torque_scale = graph_options.torque_scale;
-      for (int k : steps) {
-        for (auto& f :
-             add_dfg_constraints(pg.graph, pg.values, model, *pg.dynamics_workspace, k, rows)
-                 .factors) {
-          if (f->has_constraints()) pg.constraints.push_back(f);
-        }
+      for (size_t i = 0; i < pg.graph.size(); ++i) {
+        EXPECT_EQ(dynamic_cast<const DynamicsStepFactor*>(pg.graph[i].get()), nullptr);
       }
+      // 4·nq equation factors + the torque rows per step, all constraints.
+      size_t dfg_constraints = 0;
+      for (const auto& c : pg.constraints) {
+        dfg_constraints += dynamic_cast<const DfgConstraintFactor*>(c.get()) != nullptr ||
+                           dynamic_cast<const DfgTorqueRowsFactor*>(c.get()) != nullptr;
+      }
+      EXPECT_EQ(dfg_constraints, (problem.steps + 1) * (4u * model.nq() + 1));
     }
     AugmentedLagrangian al(pg.constraints);
     graph::LevenbergMarquardtOptions lm_options;
