@@ -24,7 +24,8 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const kinograph::tools::CommandFailure& e) {
-    std::cerr << "kinograph: error: " << e.what() << "\n";
+    // An empty message means the verb already printed why (e.g. a plan that did not validate).
+    if (std::string(e.what()).size() > 0) std::cerr << "kinograph: error: " << e.what() << "\n";
     return e.get_exit_code();
   } catch (const CLI::ParseError& e) {
     return app.exit(e);

@@ -1,0 +1,46 @@
+// kinographd: the kinograph planner daemon for one robot on an LCM network.
+//   kinographd SCENE.yaml [--prefix IIWA] [--lcm-url URL] [--status-period 1.0]
+// The scene gives the robot, default horizon and steps, start, fixed obstacles and objective
+// weights; goals, obstacle updates and measured states arrive over LCM.
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <atomic>
+#include <csignal>
+#include <iostream>
+
+#include "daemon/planner_node.h"
+
+namespace {
+std::atomic<bool> g_stop{false};
+void on_signal(int) { g_stop = true; }
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"kinographd: kinodynamic planner daemon (LCM)"};
+  std::string scene_path, level = "info";
+  kinograph::daemon::PlannerNodeOptions options;
+  app.add_option("scene", scene_path, "scene file (YAML) with the robot and defaults")->required();
+  app.add_option("--prefix", options.channel_prefix,
+                 "channel prefix (default: robot name upper-cased)");
+  app.add_option("--lcm-url", options.lcm_url, "LCM URL (default: $LCM_DEFAULT_URL or udpm)");
+  app.add_option("--status-period", options.status_period_s, "status heartbeat period (s)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--log-level", level, "trace, debug, info, warn, error");
+  CLI11_PARSE(app, argc, argv);
+  spdlog::set_level(spdlog::level::from_str(level));
+
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  try {
+    kinograph::daemon::PlannerNode node(kinograph::planning::load_scene(scene_path), options);
+    node.run(g_stop);
+    const auto c = node.counters();
+    spdlog::info("kinographd: stopped after {} goals, {} plans ({} failed), {} rejected messages",
+                 c.goals_received, c.plans_published, c.failures, c.messages_rejected);
+  } catch (const std::exception& e) {
+    std::cerr << "kinographd: error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,336 @@
+#include "daemon/planner_node.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cstring>
+#include <lcm/lcm-cpp.hpp>
+#include <stdexcept>
+#include <thread>
+
+#include "kinograph/planner_status_t.hpp"
+#include "lcmtypes/safe_decode.h"
+
+namespace kinograph::daemon {
+namespace {
+
+std::string upper(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
+  return s;
+}
+
+// plan_t.method names: "batch", "warm-start", "incremental", or "batch after warm-start".
+std::string method_name(std::string stats_method) {
+  for (auto [from, to] : {std::pair{"batch-L", "batch"}, std::pair{"batch-W", "warm-start"}}) {
+    if (stats_method.rfind(from, 0) == 0) stats_method.replace(0, std::strlen(from), to);
+  }
+  return stats_method;
+}
+
+}  // namespace
+
+PlannerNode::PlannerNode(planning::Scene scene, PlannerNodeOptions options, lcm::LCM* shared)
+    : scene_(std::move(scene)), options_(std::move(options)), planner_(options_.planner) {
+  if (!scene_.problem.model) throw std::invalid_argument("PlannerNode: the scene has no robot");
+  identity_.model_name = scene_.problem.model->name;
+  identity_.channel_prefix =
+      options_.channel_prefix.empty() ? upper(identity_.model_name) : options_.channel_prefix;
+  if (shared) {
+    lcm_ = shared;
+  } else {
+    owned_lcm_ = std::make_unique<lcm::LCM>(options_.lcm_url);
+    lcm_ = owned_lcm_.get();
+  }
+  if (!lcm_->good()) {
+    throw std::runtime_error(
+        "LCM could not start on \"" +
+        (options_.lcm_url.empty() ? std::string("default URL") : options_.lcm_url) +
+        "\" (for udpm a multicast route is needed, see DESIGN.md)");
+  }
+  next_obstacle_id_ = static_cast<int>(scene_.problem.obstacles.size());
+  for (const auto& o : scene_.problem.obstacles) {
+    next_obstacle_id_ = std::max(next_obstacle_id_, o.id + 1);
+  }
+  lcm_->subscribe(channel("GOAL"), &PlannerNode::on_goal, this);
+  lcm_->subscribe(channel("OBSTACLES"), &PlannerNode::on_obstacles, this);
+  lcm_->subscribe(channel("STATE"), &PlannerNode::on_state, this);
+}
+
+PlannerNode::~PlannerNode() = default;
+
+std::string PlannerNode::channel(const std::string& suffix) const {
+  return identity_.channel_prefix + "_" + suffix;
+}
+
+NodeCounters PlannerNode::counters() const {
+  std::lock_guard lock(mutex_);
+  return counters_;
+}
+
+int64_t PlannerNode::now_utime() const {
+  using namespace std::chrono;
+  return duration_cast<microseconds>(system_clock::now().time_since_epoch()).count();
+}
+
+void PlannerNode::reject(const std::string& reason) {
+  spdlog::warn("rejected: {}", reason);
+  {
+    std::lock_guard lock(mutex_);
+    ++counters_.messages_rejected;
+    last_message_ = reason;
+  }
+  publish_status();
+}
+
+void PlannerNode::on_goal(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+  goal_t msg;
+  if (auto s = lcmtypes::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), msg); !s.ok) {
+    reject(channel + ": malformed goal_t: " + s.reason);
+    return;
+  }
+  GoalRequest request;
+  if (Check c = goal_from_message(msg, *scene_.problem.model, identity_, request); !c.ok) {
+    reject(channel + ": " + c.reason);
+    // The sender named a goal: answer it, so no goal ever goes unanswered.
+    if (msg.goal_id >= 0) {
+      int64_t plan_id;
+      {
+        std::lock_guard lock(mutex_);
+        plan_id = next_plan_id_++;
+        ++counters_.plans_published;
+        ++counters_.failures;
+      }
+      plan_t answer = failure_message(plan_t::INVALID_GOAL, c.reason, identity_.model_name, plan_id,
+                                      msg.goal_id, now_utime());
+      lcm_->publish(this->channel("PLAN"), &answer);
+    }
+    return;
+  }
+  std::optional<GoalRequest> superseded;
+  {
+    std::lock_guard lock(mutex_);
+    ++counters_.goals_received;
+    last_goal_id_ = request.goal_id;
+    if (pending_goal_) {
+      superseded = std::move(pending_goal_);
+      ++counters_.goals_cancelled;
+    }
+    pending_goal_ = std::move(request);
+  }
+  wake_.notify_one();
+  if (superseded) {
+    int64_t plan_id;
+    {
+      std::lock_guard lock(mutex_);
+      plan_id = next_plan_id_++;
+      ++counters_.plans_published;
+      ++counters_.failures;
+    }
+    plan_t answer =
+        failure_message(plan_t::CANCELLED, "superseded by a newer goal before planning began",
+                        identity_.model_name, plan_id, superseded->goal_id, now_utime());
+    lcm_->publish(this->channel("PLAN"), &answer);
+  }
+}
+
+void PlannerNode::on_obstacles(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+  obstacle_list_t msg;
+  if (auto s = lcmtypes::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), msg); !s.ok) {
+    reject(channel + ": malformed obstacle_list_t: " + s.reason);
+    return;
+  }
+  std::vector<ObstacleUpdate> updates;
+  if (Check c = obstacles_from_message(msg, updates); !c.ok) {
+    reject(channel + ": " + c.reason);
+    return;
+  }
+  {
+    std::lock_guard lock(mutex_);
+    if (msg.replace_all) {
+      pending_obstacles_.clear();
+      pending_replace_all_ = true;
+    }
+    pending_obstacles_.insert(pending_obstacles_.end(), updates.begin(), updates.end());
+  }
+  wake_.notify_one();
+}
+
+void PlannerNode::on_state(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+  robot_state_t msg;
+  if (auto s = lcmtypes::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), msg); !s.ok) {
+    reject(channel + ": malformed robot_state_t: " + s.reason);
+    return;
+  }
+  MeasuredState state;
+  if (Check c = state_from_message(msg, *scene_.problem.model, identity_, state); !c.ok) {
+    reject(channel + ": " + c.reason);
+    return;
+  }
+  std::lock_guard lock(mutex_);
+  latest_state_ = std::move(state);
+}
+
+bool PlannerNode::apply_obstacles(const std::vector<ObstacleUpdate>& updates, bool replace_all) {
+  bool changed = false;
+  if (replace_all && !live_obstacles_.empty()) {
+    live_obstacles_.clear();
+    changed = true;
+  }
+  for (const auto& u : updates) {
+    auto it = live_obstacles_.find(u.id);
+    if (u.remove) {
+      if (it != live_obstacles_.end()) {
+        live_obstacles_.erase(it);
+        changed = true;
+      } else {
+        spdlog::info("obstacle \"{}\" to remove is not known; ignored", u.id);
+      }
+      continue;
+    }
+    collision::Obstacle o;
+    o.id = it != live_obstacles_.end() ? it->second.id : next_obstacle_id_++;
+    o.shape = u.shape;
+    o.pose = u.pose;
+    live_obstacles_[u.id] = std::move(o);
+    changed = true;
+  }
+  return changed;
+}
+
+void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan) {
+  planning::Problem problem = scene_.problem;
+  {
+    std::lock_guard lock(mutex_);
+    state_ = planner_status_t::PLANNING;
+    // A measured state, when there is one, is where the robot is: plan from it.
+    if (latest_state_) {
+      problem.start_q = latest_state_->q;
+      problem.start_qd = latest_state_->qd;
+    }
+  }
+  for (const auto& [name, obstacle] : live_obstacles_) problem.obstacles.push_back(obstacle);
+  problem.goal = goal.goal;
+  if (goal.duration_s > 0) problem.horizon = goal.duration_s;
+
+  planning::Plan plan;
+  bool threw = false;
+  std::string error;
+  try {
+    // An obstacle change keeps the goal: the previous plan is the natural starting point.
+    const bool warm = replan && last_plan_ && last_plan_->q.rows() == problem.steps + 1;
+    plan = planner_.plan(problem, warm ? &*last_plan_ : nullptr);
+    // A warm start can be trapped on the wrong side of a new obstacle; a plan from the
+    // straight line is the fallback, and its statistics say so.
+    if (warm && !plan.success()) {
+      spdlog::info("goal {}: warm-started replan did not validate ({}); planning from scratch",
+                   goal.goal_id, plan.stats.reason);
+      const double warm_time = plan.stats.solve_time_s;
+      plan = planner_.plan(problem);
+      plan.stats.solve_time_s += warm_time;
+      plan.stats.method += " after warm-start";
+    }
+  } catch (const std::exception& e) {
+    threw = true;
+    error = e.what();
+  }
+
+  int64_t plan_id;
+  {
+    std::lock_guard lock(mutex_);
+    plan_id = next_plan_id_++;
+    last_plan_id_ = plan_id;
+    ++counters_.plans_published;
+    if (replan) ++counters_.replans;
+    if (threw || !plan.success()) ++counters_.failures;
+    state_ = threw ? planner_status_t::ERROR : planner_status_t::IDLE;
+    last_message_ = threw ? error : (plan.success() ? "" : plan.stats.reason);
+  }
+  plan_t msg;
+  if (threw) {
+    spdlog::error("goal {}: planner error: {}", goal.goal_id, error);
+    msg = failure_message(plan_t::FAILED, "planner error: " + error, identity_.model_name, plan_id,
+                          goal.goal_id, now_utime());
+  } else {
+    msg = plan_to_message(plan, *problem.model, identity_.model_name, plan_id, goal.goal_id,
+                          now_utime());
+    msg.method = method_name(plan.stats.method);
+    spdlog::info("goal {}: plan {} {} ({}, {} iterations, {:.1f} ms)", goal.goal_id, plan_id,
+                 plan.success() ? "valid" : "INVALID", msg.method, plan.stats.iterations,
+                 plan.stats.solve_time_s * 1e3);
+    if (plan.success()) last_plan_ = std::move(plan);
+  }
+  lcm_->publish(channel("PLAN"), &msg);
+  publish_status();
+}
+
+void PlannerNode::worker_loop(const std::atomic<bool>& stop) {
+  while (true) {
+    std::optional<GoalRequest> goal;
+    std::vector<ObstacleUpdate> updates;
+    bool replace_all = false;
+    {
+      std::unique_lock lock(mutex_);
+      wake_.wait_for(lock, std::chrono::milliseconds(50), [&] {
+        return stop.load() || pending_goal_ || !pending_obstacles_.empty() || pending_replace_all_;
+      });
+      if (stop.load()) return;
+      goal = std::move(pending_goal_);
+      pending_goal_.reset();
+      updates.swap(pending_obstacles_);
+      replace_all = pending_replace_all_;
+      pending_replace_all_ = false;
+    }
+    const bool obstacles_changed =
+        (!updates.empty() || replace_all) && apply_obstacles(updates, replace_all);
+    if (goal) {
+      current_goal_ = goal;
+      plan_and_publish(*goal, /*replan=*/false);
+    } else if (obstacles_changed && current_goal_) {
+      plan_and_publish(*current_goal_, /*replan=*/true);
+    }
+  }
+}
+
+void PlannerNode::publish_status() {
+  planner_status_t msg;
+  {
+    std::lock_guard lock(mutex_);
+    msg.utime = now_utime();
+    msg.robot = identity_.model_name;
+    msg.state = state_;
+    msg.last_goal_id = last_goal_id_;
+    msg.last_plan_id = last_plan_id_;
+    msg.message = last_message_;
+    msg.num_plans = counters_.plans_published;
+    msg.num_failures = counters_.failures;
+  }
+  lcm_->publish(channel("PLANNER_STATUS"), &msg);
+}
+
+void PlannerNode::run(const std::atomic<bool>& stop) {
+  spdlog::info("kinographd: robot {} on channels {}_*", identity_.model_name,
+               identity_.channel_prefix);
+  // The worker stops on `done`, not on `stop`, so that an LCM failure also ends it.
+  std::atomic<bool> done{false};
+  std::thread worker([&] { worker_loop(done); });
+  auto next_status = std::chrono::steady_clock::now();
+  while (!stop.load()) {
+    if (std::chrono::steady_clock::now() >= next_status) {
+      publish_status();
+      next_status += std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+          std::chrono::duration<double>(options_.status_period_s));
+    }
+    if (lcm_->handleTimeout(50) < 0) {
+      spdlog::error("LCM handle failed; stopping");
+      break;
+    }
+  }
+  done = true;
+  wake_.notify_all();
+  worker.join();
+}
+
+}  // namespace kinograph::daemon

@@ -1,0 +1,110 @@
+#pragma once
+// kinographd's core: one planner for one robot on an LCM network. It listens for goals,
+// obstacle updates and measured states, plans off the LCM thread (the newest goal wins), and
+// answers every goal with a plan_t — a trajectory or a failure status with its reason.
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "daemon/message_convert.h"
+#include "kinograph/planning/batch_planner.h"
+#include "kinograph/planning/scene.h"
+
+namespace lcm {
+class LCM;
+class ReceiveBuffer;
+}  // namespace lcm
+
+namespace kinograph::daemon {
+
+/// Options of a PlannerNode, with defaults for a robot on the local LCM network.
+struct PlannerNodeOptions {
+  /// LCM provider URL; empty = $LCM_DEFAULT_URL, else LCM's default multicast group (ttl 0,
+  /// so nothing leaves the host). Plans of a 7-dof arm are ~25 kB: on udpm raise the receive
+  /// buffer, e.g. "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304".
+  std::string lcm_url;
+  /// Channel prefix, e.g. "IIWA" for IIWA_GOAL, IIWA_PLAN, ...; empty = the URDF robot name
+  /// upper-cased.
+  std::string channel_prefix;
+  /// Period of the planner_status_t heartbeat (s).
+  double status_period_s = 1.0;
+  /// Options of the batch planner used for every plan.
+  planning::BatchPlannerOptions planner;
+};
+
+/// What a node has done since it started (for its status and for tests).
+struct NodeCounters {
+  int goals_received = 0;     ///< goal_t messages that passed their checks
+  int messages_rejected = 0;  ///< messages of any type that failed to decode or check
+  int goals_cancelled = 0;    ///< goals superseded by a newer one before planning began
+  int plans_published = 0;    ///< plan_t messages sent (successes and failures)
+  int failures = 0;           ///< of which not SUCCESS
+  int replans = 0;            ///< plans triggered by an obstacle change for the current goal
+};
+
+/// The planner daemon's node: scene (robot, defaults, fixed obstacles) + LCM + worker thread.
+class PlannerNode {
+ public:
+  /// Throws std::runtime_error naming the URL when LCM cannot start (e.g. no multicast route).
+  /// With `shared`, the node uses that LCM instance instead of opening options.lcm_url (how
+  /// in-process tests share one memq:// queue with it); it must outlive the node.
+  PlannerNode(planning::Scene scene, PlannerNodeOptions options, lcm::LCM* shared = nullptr);
+  ~PlannerNode();
+  PlannerNode(const PlannerNode&) = delete;
+  PlannerNode& operator=(const PlannerNode&) = delete;
+
+  /// Handles LCM traffic and plans until `stop` becomes true (checked every 50 ms); the
+  /// planning thread is started and joined inside.
+  void run(const std::atomic<bool>& stop);
+
+  /// Full channel name for a suffix, e.g. channel("GOAL") = "IIWA_GOAL".
+  std::string channel(const std::string& suffix) const;
+  NodeCounters counters() const;
+  const RobotIdentity& identity() const { return identity_; }
+
+ private:
+  void on_goal(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void on_obstacles(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void on_state(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void reject(const std::string& reason);
+  void worker_loop(const std::atomic<bool>& stop);
+  bool apply_obstacles(const std::vector<ObstacleUpdate>& updates, bool replace_all);
+  void plan_and_publish(const GoalRequest& goal, bool replan);
+  void publish_status();
+  int64_t now_utime() const;
+
+  planning::Scene scene_;
+  PlannerNodeOptions options_;
+  RobotIdentity identity_;
+  std::unique_ptr<lcm::LCM> owned_lcm_;
+  lcm::LCM* lcm_ = nullptr;
+  planning::BatchPlanner planner_;
+
+  // Shared between the LCM thread and the worker, under mutex_.
+  mutable std::mutex mutex_;
+  std::condition_variable wake_;
+  std::optional<GoalRequest> pending_goal_;
+  std::vector<ObstacleUpdate> pending_obstacles_;
+  bool pending_replace_all_ = false;
+  std::optional<MeasuredState> latest_state_;
+  NodeCounters counters_;
+  int8_t state_ = 0;  // planner_status_t::IDLE / PLANNING / ERROR
+  int64_t last_goal_id_ = -1;
+  int64_t last_plan_id_ = -1;
+  std::string last_message_;
+  int64_t next_plan_id_ = 1;
+
+  // Owned by the worker thread.
+  std::map<std::string, collision::Obstacle> live_obstacles_;
+  int next_obstacle_id_ = 0;
+  std::optional<GoalRequest> current_goal_;
+  std::optional<planning::Plan> last_plan_;
+};
+
+}  // namespace kinograph::daemon

@@ -1,0 +1,301 @@
+// LCM verbs of the CLI: talk to a running kinographd.
+//   kinograph send-goal     --prefix IIWA (--q ... | --frame F --position ... --quaternion ...)
+//   kinograph send-obstacle --prefix IIWA --id box --shape box --size ... --position ...
+//   kinograph send-state    --prefix IIWA --scene S --q ... [--qd ...]
+//   kinograph log-plans     LOG.lcmlog --channel IIWA_PLAN --scene S --out-dir DIR
+// send-goal and send-obstacle can wait for the answering plan (--wait) and write it (--out).
+#include <chrono>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "daemon/message_convert.h"
+#include "kinograph/goal_t.hpp"
+#include "kinograph/obstacle_list_t.hpp"
+#include "kinograph/planning/plan_json.h"
+#include "kinograph/planning/scene.h"
+#include "kinograph/robot_state_t.hpp"
+#include "lcmtypes/safe_decode.h"
+#include "tools/command_registry.h"
+#include "tools/lcm_client.h"
+
+namespace kinograph::tools {
+
+PlanWaiter::PlanWaiter(lcm::LCM& lcm, const std::string& plan_channel) : lcm_(lcm) {
+  lcm_.subscribe(plan_channel, &PlanWaiter::on_plan, this);
+}
+
+void PlanWaiter::on_plan(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+  plan_t msg;
+  if (!lcmtypes::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), msg).ok) return;
+  if (msg.goal_id == goal_id_ && !received_) received_ = std::move(msg);
+}
+
+std::optional<plan_t> PlanWaiter::wait(int64_t goal_id, double timeout_s) {
+  goal_id_ = goal_id;
+  received_.reset();
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  while (!received_ && std::chrono::steady_clock::now() < deadline) {
+    if (lcm_.handleTimeout(20) < 0) break;
+  }
+  return std::move(received_);
+}
+
+lcm::LCM& open_lcm(const std::string& url) {
+  static std::unique_ptr<lcm::LCM> lcm;
+  lcm = std::make_unique<lcm::LCM>(url);
+  if (!lcm->good()) {
+    throw CommandFailure("LCM could not start on \"" + (url.empty() ? "default URL" : url) +
+                         "\" (udpm needs a multicast route)");
+  }
+  return *lcm;
+}
+
+std::string summarize(const plan_t& p) {
+  static const char* kStatus[] = {"SUCCESS",       "FAILED",    "INVALID_GOAL",
+                                  "INVALID_STATE", "CANCELLED", "NOT_CONVERGED"};
+  std::ostringstream s;
+  s << "plan " << p.plan_id << " for goal " << p.goal_id << ": "
+    << (p.status >= 0 && p.status <= 5 ? kStatus[p.status] : "UNKNOWN");
+  if (!p.status_message.empty()) s << " (" << p.status_message << ")";
+  if (p.num_steps > 0) {
+    s << "\n  method " << p.method << ", " << p.num_steps << " states, " << p.iterations
+      << " iterations, " << p.solve_time_s * 1e3 << " ms, cost " << p.cost
+      << "\n  dynamics residual " << p.max_dynamics_residual << " N·m, collocation "
+      << p.max_collocation_residual << ", min clearance " << p.min_clearance << " m, goal error "
+      << p.goal_error << ", valid " << (p.valid ? "yes" : "no");
+  }
+  return s.str();
+}
+
+namespace {
+
+std::vector<double> parse_list(const std::string& text, const std::string& option) {
+  std::vector<double> values;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    try {
+      size_t used = 0;
+      values.push_back(std::stod(item, &used));
+      if (used != item.size()) throw std::invalid_argument(item);
+    } catch (const std::exception&) {
+      throw CommandFailure(option + ": \"" + item + "\" is not a number");
+    }
+  }
+  return values;
+}
+
+std::vector<double> parse_fixed(const std::string& text, const std::string& option, size_t n) {
+  auto v = parse_list(text, option);
+  if (v.size() != n) {
+    throw CommandFailure(option + " needs " + std::to_string(n) + " comma-separated numbers");
+  }
+  return v;
+}
+
+int64_t now_utime() {
+  using namespace std::chrono;
+  return duration_cast<microseconds>(system_clock::now().time_since_epoch()).count();
+}
+
+// Options every sending verb has.
+struct Common {
+  std::string prefix, url, scene, out;
+  double wait_s = 0;
+  void add(CLI::App* sub, bool waits) {
+    sub->add_option("--prefix", prefix, "channel prefix of the daemon, e.g. IIWA")->required();
+    sub->add_option("--lcm-url", url, "LCM URL (default: $LCM_DEFAULT_URL or udpm)");
+    if (!waits) return;
+    sub->add_option("--wait", wait_s, "wait this many seconds for the answering plan");
+    sub->add_option("--out", out, "write the answering plan as JSON (needs --scene)");
+    sub->add_option("--scene", scene, "the daemon's scene (robot for --out)");
+  }
+};
+
+// Waits for the plan answering goal_id, prints it, writes it if asked; returns the exit code.
+int finish(PlanWaiter& waiter, const Common& c, int64_t goal_id) {
+  if (c.wait_s <= 0) return 0;
+  auto plan = waiter.wait(goal_id, c.wait_s);
+  if (!plan) {
+    throw CommandFailure("no plan for goal " + std::to_string(goal_id) + " within " +
+                             std::to_string(c.wait_s) + " s",
+                         3);
+  }
+  std::cout << summarize(*plan) << "\n";
+  if (!c.out.empty()) {
+    if (c.scene.empty()) throw CommandFailure("--out needs --scene");
+    const auto scene = planning::load_scene(c.scene);
+    if (plan->num_steps == 0) throw CommandFailure("plan has no trajectory to write", 2);
+    planning::write_plan(daemon::plan_from_message(*plan), scene, c.out);
+    std::cout << "wrote " << c.out << "\n";
+  }
+  return plan->status == plan_t::SUCCESS ? 0 : 2;
+}
+
+const bool kSendGoal = register_command([](CLI::App& root) {
+  auto* sub = root.add_subcommand("send-goal", "publish a goal_t to a kinographd");
+  auto c = std::make_shared<Common>();
+  auto q = std::make_shared<std::string>();
+  auto frame = std::make_shared<std::string>();
+  auto position = std::make_shared<std::string>();
+  auto quaternion = std::make_shared<std::string>("1,0,0,0");
+  auto goal_id = std::make_shared<int64_t>(-1);
+  auto duration = std::make_shared<double>(0);
+  auto robot = std::make_shared<std::string>();
+  c->add(sub, true);
+  sub->add_option("--id", *goal_id, "goal id (default: current time in µs)");
+  sub->add_option("--q", *q, "joint goal, comma-separated");
+  sub->add_option("--frame", *frame, "end-effector frame for a pose goal");
+  sub->add_option("--position", *position, "pose goal position x,y,z (m)");
+  sub->add_option("--quaternion", *quaternion, "pose goal orientation w,x,y,z");
+  sub->add_option("--duration", *duration, "plan duration (s), 0 = the daemon's default");
+  sub->add_option("--robot", *robot, "robot name in the message (default: empty = any)");
+  sub->callback([=] {
+    goal_t msg;
+    msg.utime = now_utime();
+    msg.goal_id = *goal_id >= 0 ? *goal_id : msg.utime;
+    msg.robot = *robot;
+    msg.duration_s = *duration;
+    std::fill(std::begin(msg.ee_position), std::end(msg.ee_position), 0.0);
+    std::fill(std::begin(msg.ee_quaternion), std::end(msg.ee_quaternion), 0.0);
+    msg.ee_quaternion[0] = 1;
+    if (!q->empty()) {
+      msg.kind = goal_t::KIND_JOINT_CONFIGURATION;
+      msg.joint_position = parse_list(*q, "--q");
+      msg.num_joints = static_cast<int32_t>(msg.joint_position.size());
+    } else if (!frame->empty() && !position->empty()) {
+      msg.kind = goal_t::KIND_END_EFFECTOR_POSE;
+      msg.num_joints = 0;
+      msg.ee_frame = *frame;
+      auto p = parse_fixed(*position, "--position", 3);
+      auto r = parse_fixed(*quaternion, "--quaternion", 4);
+      std::copy(p.begin(), p.end(), msg.ee_position);
+      std::copy(r.begin(), r.end(), msg.ee_quaternion);
+    } else {
+      throw CommandFailure("send-goal needs --q, or --frame with --position");
+    }
+    lcm::LCM& lcm = open_lcm(c->url);
+    PlanWaiter waiter(lcm, c->prefix + "_PLAN");
+    lcm.publish(c->prefix + "_GOAL", &msg);
+    std::cout << "sent goal " << msg.goal_id << " on " << c->prefix << "_GOAL\n";
+    if (int code = finish(waiter, *c, msg.goal_id); code != 0) throw CommandFailure("", code);
+  });
+});
+
+const bool kSendObstacle = register_command([](CLI::App& root) {
+  auto* sub = root.add_subcommand("send-obstacle", "add, move or remove one obstacle");
+  auto c = std::make_shared<Common>();
+  auto id = std::make_shared<std::string>();
+  auto shape = std::make_shared<std::string>("box");
+  auto size = std::make_shared<std::string>();
+  auto position = std::make_shared<std::string>("0,0,0");
+  auto quaternion = std::make_shared<std::string>("1,0,0,0");
+  auto remove = std::make_shared<bool>(false);
+  auto goal_id = std::make_shared<int64_t>(-1);
+  c->add(sub, true);
+  sub->add_option("--id", *id, "obstacle name")->required();
+  sub->add_option("--shape", *shape, "box, sphere, cylinder or capsule")
+      ->check(CLI::IsMember({"box", "sphere", "cylinder", "capsule"}));
+  sub->add_option("--size", *size, "box: x,y,z; sphere: r; cylinder/capsule: r,length");
+  sub->add_option("--position", *position, "centre x,y,z (m)");
+  sub->add_option("--quaternion", *quaternion, "orientation w,x,y,z");
+  sub->add_flag("--remove", *remove, "remove the obstacle instead");
+  sub->add_option("--goal-id", *goal_id, "with --wait: the goal whose replan to wait for");
+  sub->callback([=] {
+    obstacle_t o;
+    o.id = *id;
+    o.action = *remove ? obstacle_t::REMOVE : obstacle_t::ADD_OR_MOVE;
+    o.shape = *shape == "box"        ? obstacle_t::BOX
+              : *shape == "sphere"   ? obstacle_t::SPHERE
+              : *shape == "cylinder" ? obstacle_t::CYLINDER
+                                     : obstacle_t::CAPSULE;
+    std::fill(std::begin(o.size), std::end(o.size), 0.0);
+    if (!*remove) {
+      auto s = parse_list(*size, "--size");
+      if (s.empty() || s.size() > 3) throw CommandFailure("--size needs 1 to 3 numbers");
+      std::copy(s.begin(), s.end(), o.size);
+    }
+    auto p = parse_fixed(*position, "--position", 3);
+    auto r = parse_fixed(*quaternion, "--quaternion", 4);
+    std::copy(p.begin(), p.end(), o.position);
+    std::copy(r.begin(), r.end(), o.quaternion);
+    obstacle_list_t msg;
+    msg.utime = now_utime();
+    msg.num_obstacles = 1;
+    msg.obstacles.push_back(o);
+    msg.replace_all = false;
+    if (c->wait_s > 0 && *goal_id < 0) throw CommandFailure("--wait needs --goal-id");
+    lcm::LCM& lcm = open_lcm(c->url);
+    PlanWaiter waiter(lcm, c->prefix + "_PLAN");
+    lcm.publish(c->prefix + "_OBSTACLES", &msg);
+    std::cout << "sent obstacle \"" << o.id << "\" on " << c->prefix << "_OBSTACLES\n";
+    if (int code = finish(waiter, *c, *goal_id); code != 0) throw CommandFailure("", code);
+  });
+});
+
+const bool kSendState = register_command([](CLI::App& root) {
+  auto* sub = root.add_subcommand("send-state", "publish a measured robot_state_t");
+  auto c = std::make_shared<Common>();
+  auto scene = std::make_shared<std::string>();
+  auto q = std::make_shared<std::string>();
+  auto qd = std::make_shared<std::string>();
+  c->add(sub, false);
+  sub->add_option("--scene", *scene, "scene with the robot (for the joint names)")->required();
+  sub->add_option("--q", *q, "joint positions, comma-separated")->required();
+  sub->add_option("--qd", *qd, "joint velocities (default zeros)");
+  sub->callback([=] {
+    const auto s = planning::load_scene(*scene);
+    const auto& model = *s.problem.model;
+    robot_state_t msg;
+    msg.utime = now_utime();
+    msg.robot = model.name;
+    msg.num_joints = model.nq();
+    for (const auto& b : model.bodies) msg.joint_name.push_back(b.joint_name);
+    msg.position = parse_fixed(*q, "--q", model.nq());
+    msg.velocity =
+        qd->empty() ? std::vector<double>(model.nq(), 0.0) : parse_fixed(*qd, "--qd", model.nq());
+    open_lcm(c->url).publish(c->prefix + "_STATE", &msg);
+    std::cout << "sent state on " << c->prefix << "_STATE\n";
+  });
+});
+
+const bool kLogPlans = register_command([](CLI::App& root) {
+  auto* sub = root.add_subcommand("log-plans", "write the plans in an LCM log as plan JSON files");
+  auto log = std::make_shared<std::string>();
+  auto channel = std::make_shared<std::string>();
+  auto scene = std::make_shared<std::string>();
+  auto out_dir = std::make_shared<std::string>(".");
+  sub->add_option("log", *log, "LCM log file (lcm-logger)")->required();
+  sub->add_option("--channel", *channel, "plan channel, e.g. IIWA_PLAN")->required();
+  sub->add_option("--scene", *scene, "the daemon's scene (robot for the JSON)")->required();
+  sub->add_option("--out-dir", *out_dir, "folder for plan_<goal>_<plan>.json");
+  sub->callback([=] {
+    const auto s = planning::load_scene(*scene);
+    lcm::LogFile file(*log, "r");
+    if (!file.good()) throw CommandFailure("cannot read LCM log " + *log);
+    std::filesystem::create_directories(*out_dir);
+    int written = 0, rejected = 0;
+    while (const lcm::LogEvent* event = file.readNextEvent()) {
+      if (event->channel != *channel) continue;
+      plan_t msg;
+      if (!lcmtypes::safe_decode(event->data, event->datalen, msg).ok) {
+        ++rejected;
+        continue;
+      }
+      std::cout << summarize(msg) << "\n";
+      if (msg.num_steps == 0) continue;
+      const std::string path = *out_dir + "/plan_" + std::to_string(msg.goal_id) + "_" +
+                               std::to_string(msg.plan_id) + ".json";
+      planning::write_plan(daemon::plan_from_message(msg), s, path);
+      ++written;
+    }
+    std::cout << written << " plans written to " << *out_dir;
+    if (rejected) std::cout << ", " << rejected << " malformed messages skipped";
+    std::cout << "\n";
+  });
+});
+
+}  // namespace
+}  // namespace kinograph::tools
