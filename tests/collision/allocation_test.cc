@@ -29,7 +29,7 @@ void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 namespace kinograph::collision {
 namespace {
 
-TEST(Allocation, QueriesGradientsAndSegmentsAllocateNothingAfterWarmUp) {
+TEST(CollisionAllocation, QueriesGradientsAndSegmentsAllocateNothingAfterWarmUp) {
   const dynamics::Model model = dynamics::Model::from_urdf_file(std::string(KINOGRAPH_SOURCE_DIR) +
                                                                 "/robots/iiwa14/iiwa14.urdf");
   dynamics::Data data(model);
