@@ -5,5 +5,42 @@ cd "$(dirname "$0")/.."
 ./scripts/install-deps.sh
 ./scripts/build.sh
 mkdir -p out
-./build/tools/kinograph info robots/iiwa14/iiwa14.urdf
-./build/tools/kinograph info robots/acrobot/acrobot.urdf
+KG=./build/tools/kinograph
+$KG info robots/iiwa14/iiwa14.urdf
+$KG info robots/acrobot/acrobot.urdf
+
+# Plan every shipped scene into out/<scene>.json. `kinograph plan` exits 2 for a plan that does
+# not validate; the demo reports it and goes on (the plan file is written either way).
+plan() {
+  local name=$1
+  echo "== plan robots/scenes/$name.yaml"
+  local rc=0
+  $KG plan "robots/scenes/$name.yaml" --out "out/$name.json" || rc=$?
+  if [ "$rc" -eq 2 ]; then
+    echo "   ($name: the plan does not validate; see the figures above)"
+  elif [ "$rc" -ne 0 ]; then
+    exit "$rc"
+  fi
+  $KG validate "robots/scenes/$name.yaml" "out/$name.json" >/dev/null 2>&1 || true
+}
+for scene in acrobot_swingup rr_reach iiwa_desk iiwa_min_torque; do
+  plan "$scene"
+done
+
+# Pictures, when the renderer's verbs are built: an Acrobot 20-frame strip, 5-frame strips of
+# the other plans, and task 2's joint torques with and without the minimum-torque objective
+# (iiwa_desk.yaml is the same move without it).
+if $KG render --help >/dev/null 2>&1; then
+  $KG render out/acrobot_swingup.json --frames 20 \
+    --width 3000 --height 240 --out out/acrobot_swingup_strip.png
+  for scene in rr_reach iiwa_desk iiwa_min_torque; do
+    $KG render "out/$scene.json" --scene "robots/scenes/$scene.yaml" --frames 5 \
+      --out "out/${scene}_strip.png"
+  done
+fi
+if $KG plot --help >/dev/null 2>&1; then
+  $KG plot out/iiwa_min_torque.json out/iiwa_desk.json --label "with min torque" \
+    --label "without min torque" --title "iiwa task 2: joint torques" \
+    --out out/iiwa_task2_torque.png
+fi
+ls -l out/
