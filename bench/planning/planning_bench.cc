@@ -97,8 +97,8 @@ json failures_of(const std::vector<Run>& runs) {
     const Plan& p = runs[i].plan;
     out.push_back({{"goal", i},
                    {"status", p.stats.status},
-                   {"first_failure", p.validation.failures.empty() ? std::string()
-                                                                   : p.validation.failures[0]}});
+                   {"first_failure",
+                    p.validation.failures.empty() ? std::string() : p.validation.failures[0]}});
   }
   return out;
 }
