@@ -211,7 +211,7 @@ Eigen::Isometry3d make_pose(const Eigen::Vector3d& position, const Eigen::Matrix
 
 class SceneParser {
  public:
-  SceneParser(std::string source) : r_(source), source_(std::move(source)) {
+  explicit SceneParser(std::string source) : r_(source), source_(std::move(source)) {
     anchor_ = anchor_of(source_);
   }
 

@@ -288,6 +288,15 @@ TEST(SceneErrors, UnknownTopLevelKeyNamesKeyAndLine) {
   EXPECT_NE(std::string(e.what()).find("unknown key"), std::string::npos);
 }
 
+TEST(SceneErrors, DuplicateKeys) {
+  SceneError e = parse_error(std::string(kBase) + "horizon: 2.0\n");
+  EXPECT_EQ(e.key(), "horizon");
+  EXPECT_EQ(e.line(), 6);
+  EXPECT_NE(std::string(e.what()).find("duplicate"), std::string::npos);
+  e = parse_error(std::string(kBase) + "limits:\n  joint1: {effort: 1}\n  joint1: {effort: 2}\n");
+  EXPECT_EQ(e.key(), "limits.joint1");
+}
+
 TEST(SceneErrors, UnknownNestedKey) {
   const SceneError e = parse_error(std::string(kBase) +
                                    "obstacles:\n  - {id: a, shape: sphere, size: [0.1]}\n"
