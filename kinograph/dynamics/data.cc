@@ -22,7 +22,9 @@ Data::Data(const Model& model) {
   for (auto* m : {&s.Iw, &s.Ic, &s.Ec}) m->assign(n, Matrix6::Zero());
   s.joint_pose.assign(n, Eigen::Isometry3d::Identity());
   s.bias = Eigen::VectorXd::Zero(n);
-  s.llt = Eigen::LLT<Eigen::MatrixXd>(n);
+  // Factor once to size the LLT's storage (copying a sized but unfactored LLT reads its
+  // uninitialised status, which UBSan flags).
+  s.llt.compute(Eigen::MatrixXd::Identity(n, n));
 
   // G = [[Ī − m[c]², m[c]], [−m[c], m·1]] about the body origin; keep (m, c, Ī) to move the
   // inertia into the world frame with 3×3 products only.

@@ -57,6 +57,12 @@ KDL::Wrench to_kdl_wrench(const Vector6& w) {  // ours [m; f], KDL (force, torqu
   return KDL::Wrench(KDL::Vector(w[3], w[4], w[5]), KDL::Vector(w[0], w[1], w[2]));
 }
 
+// Copies into a JntArray without handing Eigen storage across the library boundary (a moved
+// vector would be freed by code built with a different Eigen allocation setting than KDL's).
+void fill(KDL::JntArray& a, const Eigen::VectorXd& v) {
+  for (int i = 0; i < v.size(); ++i) a(i) = v[i];
+}
+
 Eigen::VectorXd damping_of(const Model& m) {
   Eigen::VectorXd b(m.nq());
   for (int i = 0; i < m.nq(); ++i) b[i] = m.bodies[i].damping;
@@ -78,9 +84,9 @@ void compare_chain(const Model& model, bool with_wrench, std::mt19937& rng) {
   const Eigen::VectorXd b = damping_of(model);
   for (int k = 0; k < 100; ++k) {
     KDL::JntArray q(n), qd(n), qdd(n), tau(n);
-    q.data = testing::random_vector(rng, n, 3.0);
-    qd.data = testing::random_vector(rng, n, 2.0);
-    qdd.data = testing::random_vector(rng, n, 5.0);
+    fill(q, testing::random_vector(rng, n, 3.0));
+    fill(qd, testing::random_vector(rng, n, 2.0));
+    fill(qdd, testing::random_vector(rng, n, 5.0));
     KDL::Wrenches f_ext(chain.getNrOfSegments(), KDL::Wrench::Zero());
     std::vector<ExternalWrench> ext;
     if (with_wrench) {
@@ -145,9 +151,9 @@ TEST(Kdl, IiwaPayloadEqualsAddingItsInertiaInKdl) {
   const Eigen::VectorXd b = damping_of(loaded);
   for (int k = 0; k < 100; ++k) {
     KDL::JntArray q(7), qd(7), qdd(7), tau(7);
-    q.data = testing::random_vector(rng, 7, 3.0);
-    qd.data = testing::random_vector(rng, 7, 2.0);
-    qdd.data = testing::random_vector(rng, 7, 5.0);
+    fill(q, testing::random_vector(rng, 7, 3.0));
+    fill(qd, testing::random_vector(rng, 7, 2.0));
+    fill(qdd, testing::random_vector(rng, 7, 5.0));
     KDL::Wrenches f_ext(chain.getNrOfSegments(), KDL::Wrench::Zero());
     ASSERT_EQ(solver.CartToJnt(q, qd, qdd, f_ext, tau), 0);
     const Eigen::VectorXd kdl = tau.data + b.cwiseProduct(qd.data);
