@@ -116,6 +116,7 @@ Problem iiwa_desk() {
 }
 
 TEST(BatchPlanner, IiwaCarriesTheBlockPastTheBox) {
+  if (std::getenv("KINOGRAPH_DEBUG")) spdlog::set_level(spdlog::level::debug);
   const Problem p = iiwa_desk();
   const Plan plan = BatchPlanner().plan(p);
   for (const auto& f : plan.validation.failures) ADD_FAILURE() << f;
