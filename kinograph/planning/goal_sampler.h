@@ -47,7 +47,8 @@ struct GoalSamplerOptions {
 /// Draws collision-free joint goals within limits for one problem's robot and obstacles.
 class GoalSampler {
  public:
-  /// Throws std::invalid_argument for a problem without a model or an unknown region frame.
+  /// Keeps a reference to `problem`, which must outlive the sampler. Throws
+  /// std::invalid_argument for a problem without a model or an unknown region frame.
   GoalSampler(const Problem& problem, GoalSamplerOptions options = {});
   ~GoalSampler();
   GoalSampler(const GoalSampler&) = delete;
