@@ -49,6 +49,8 @@ Plan failed_plan(const Problem& problem, const std::string& status, const std::s
 
 }  // namespace
 
+std::string to_string(Formulation f) { return f == Formulation::kCondensed ? "condensed" : "dfg"; }
+
 std::string check_problem(const Problem& p) {
   if (!p.model) return "problem has no robot model";
   const dynamics::Model& model = *p.model;
@@ -130,8 +132,12 @@ Plan BatchPlanner::plan(const Problem& problem, const Plan* warm) const {
   }
 
   PlanningGraph pg;
+  std::vector<DfgConstraintStep> dfg_steps;
   try {
     pg = build_graph(problem, init, options_.graph);
+    if (options_.formulation == Formulation::kDynamicFactorGraph) {
+      dfg_steps = use_dfg_dynamics(pg, problem, options_.graph, options_.dfg);
+    }
   } catch (const std::exception& e) {
     Plan p = failed_plan(problem, "invalid_problem", e.what());
     p.stats.method = method;
@@ -206,8 +212,9 @@ Plan BatchPlanner::plan(const Problem& problem, const Plan* warm) const {
     reason = os.str();
   }
 
-  // The plan: trajectory from the values, τ from inverse dynamics (the condensed formulation
-  // eliminates it, so it equals RNEA exactly).
+  // The plan: trajectory from the values; τ from inverse dynamics in the condensed formulation
+  // (which eliminates it, so it equals RNEA exactly), the DFG's own τ variables otherwise (so
+  // the validator's dynamics residual checks the DFG's equations of motion).
   Plan plan;
   const Trajectory tr = read_trajectory(pg.values, N, n);
   plan.q = tr.q;
@@ -221,6 +228,10 @@ Plan BatchPlanner::plan(const Problem& problem, const Plan* warm) const {
     plan.tau.row(k) = dynamics::rnea(*problem.model, data, tr.q.row(k).transpose(),
                                      tr.qd.row(k).transpose(), tr.qdd.row(k).transpose())
                           .transpose();
+  }
+  for (const DfgConstraintStep& s : dfg_steps) {
+    plan.tau.row(s.step) =
+        dfg_torques(pg.values, *problem.model, s.step, options_.dfg.keys).transpose();
   }
   // Soft cost without the constraint terms: zero the penalty contributions by evaluating the
   // soft factors only.

@@ -2,6 +2,7 @@
 // DFGP batch planning: the problem's factor graph solved by Levenberg–Marquardt inside an
 // augmented-Lagrangian outer loop, then validated independently.
 #include "kinograph/planning/augmented_lagrangian.h"
+#include "kinograph/planning/dfg_builder.h"
 #include "kinograph/planning/graph_builder.h"
 #include "kinograph/planning/plan.h"
 #include "kinograph/planning/problem.h"
@@ -9,8 +10,21 @@
 
 namespace kinograph::planning {
 
+/// How the equations of motion enter the graph. Both pose the same problem (same torque rows)
+/// and give the same plans; the condensed form has far fewer variables and is the faster.
+enum class Formulation {
+  kCondensed,           ///< τ = RNEA(q, q̇, q̈) eliminated into one factor per step
+  kDynamicFactorGraph,  ///< the paper's DFG: V, V̇, F, τ variables, 4 equations per joint and step
+};
+
+/// "condensed" or "dfg" (the scene file's planner.formulation names).
+std::string to_string(Formulation f);
+
 /// Options of BatchPlanner, defaults tuned on the shipped scenes.
 struct BatchPlannerOptions {
+  Formulation formulation = Formulation::kCondensed;
+  /// Keys, scale and external wrenches of the DFG formulation (unused when condensed).
+  DfgOptions dfg;
   GraphOptions graph;
   AugmentedLagrangianOptions augmented_lagrangian;
   /// Stop when every constraint row's scaled violation |z/s| is below this.

@@ -1,0 +1,63 @@
+// The batch planner's two formulations of the equations of motion — condensed (τ = RNEA per
+// step) and the full dynamic factor graph — pose the same problem and must give the same plan.
+#include <gtest/gtest.h>
+
+#include "kinograph/planning/batch_planner.h"
+#include "tests/planning/test_problems.h"
+
+namespace kinograph::planning {
+namespace {
+
+// Plans `problem` in both formulations and checks that both validate and agree. They agree to
+// the planner's convergence tolerances, not to rounding: the inner LM solves stop at a relative
+// decrease, and the DFG's extra variables change the path LM takes to the same optimum.
+void expect_same_plans(const Problem& problem, double q_tol, double tau_tol) {
+  BatchPlannerOptions condensed;
+  BatchPlannerOptions dfg;
+  dfg.formulation = Formulation::kDynamicFactorGraph;
+  const Plan a = BatchPlanner(condensed).plan(problem);
+  const Plan b = BatchPlanner(dfg).plan(problem);
+  for (const auto& f : a.validation.failures) ADD_FAILURE() << "condensed: " << f;
+  for (const auto& f : b.validation.failures) ADD_FAILURE() << "dfg: " << f;
+  ASSERT_TRUE(a.success());
+  ASSERT_TRUE(b.success());
+  // The DFG's τ are its own variables: the validator's dynamics residual checks them.
+  EXPECT_LT(b.validation.max_dynamics_residual, 1e-3);
+  EXPECT_LT((a.q - b.q).cwiseAbs().maxCoeff(), q_tol);
+  EXPECT_LT((a.qd - b.qd).cwiseAbs().maxCoeff(), 3 * q_tol);
+  EXPECT_LT((a.tau - b.tau).cwiseAbs().maxCoeff(), tau_tol);
+  EXPECT_NEAR(a.stats.cost, b.stats.cost, 1e-2 * (1 + a.stats.cost));
+}
+
+TEST(Formulation, Names) {
+  EXPECT_EQ(to_string(Formulation::kCondensed), "condensed");
+  EXPECT_EQ(to_string(Formulation::kDynamicFactorGraph), "dfg");
+}
+
+TEST(Formulation, RrReachIsTheSamePlan) {
+  Problem p = testing::rr_reach();
+  p.obstacles.clear();  // with the ball, the two solvers' paths may pass it on different sides
+  expect_same_plans(p, 1e-2, 5e-2);
+}
+
+TEST(Formulation, BothAvoidTheBall) {
+  BatchPlannerOptions dfg;
+  dfg.formulation = Formulation::kDynamicFactorGraph;
+  const Plan plan = BatchPlanner(dfg).plan(testing::rr_reach());
+  for (const auto& f : plan.validation.failures) ADD_FAILURE() << f;
+  EXPECT_TRUE(plan.success());
+  EXPECT_GE(plan.validation.min_clearance, 0.0);
+}
+
+TEST(Formulation, IiwaWithBlockIsTheSamePlan) {
+  expect_same_plans(testing::iiwa_swing(12), 1e-2, 5e-2);
+}
+
+TEST(Formulation, MinimumTorqueRowsAreTheSame) {
+  Problem p = testing::iiwa_swing(12);
+  p.objectives.min_torque = 1e-3;
+  expect_same_plans(p, 1e-2, 5e-2);
+}
+
+}  // namespace
+}  // namespace kinograph::planning

@@ -1,0 +1,74 @@
+#pragma once
+// Small planning problems shared by the planner's end-to-end tests: the Acrobot swing-up, the RR
+// arm reaching past a ball, and the iiwa carrying a 2 kg block past a box.
+#include <Eigen/Core>
+#include <cmath>
+#include <memory>
+#include <string>
+
+#include "kinograph/dynamics/kinematics.h"
+#include "kinograph/dynamics/payload.h"
+#include "kinograph/planning/problem.h"
+
+namespace kinograph::planning::testing {
+
+inline std::shared_ptr<const dynamics::Model> load_robot(const std::string& rel) {
+  return std::make_shared<const dynamics::Model>(
+      dynamics::Model::from_urdf_file(std::string(KINOGRAPH_SOURCE_DIR) + "/" + rel));
+}
+
+/// Rest to upright in 10 s over 100 steps, elbow limited by the URDF's ±8 N·m.
+inline Problem acrobot_swingup() {
+  Problem p;
+  p.name = "acrobot_swingup";
+  p.model = load_robot("robots/acrobot/acrobot.urdf");
+  p.horizon = 10;
+  p.steps = 100;
+  p.start_q = Eigen::Vector2d(0, 0);
+  p.start_qd = Eigen::Vector2d(0, 0);
+  p.goal.q = Eigen::Vector2d(M_PI, 0);
+  return p;
+}
+
+/// The RR arm swings from one side to the other past a ball its straight line would hit.
+inline Problem rr_reach() {
+  Problem p;
+  p.name = "rr_reach";
+  p.model = load_robot("robots/rr/rr.urdf");
+  p.horizon = 3;
+  p.steps = 30;
+  p.start_q = Eigen::Vector2d(-1.2, 0);
+  p.start_qd = Eigen::Vector2d(0, 0);
+  p.goal.q = Eigen::Vector2d(1.2, 0);
+  collision::Obstacle ball;
+  ball.id = 1;
+  ball.shape = collision::Shape::sphere(0.12);
+  ball.pose.translation() = Eigen::Vector3d(0.1, 0, 1.9);
+  p.obstacles.push_back(ball);
+  return p;
+}
+
+/// The iiwa14 with the default 2 kg block (robots/README.md) at its flange.
+inline std::shared_ptr<const dynamics::Model> iiwa_with_block() {
+  return std::make_shared<const dynamics::Model>(dynamics::attach_box_payload(
+      *load_robot("robots/iiwa14/iiwa14.urdf"), "iiwa_link_ee_kuka", 2.0, {0.1, 0.1, 0.1},
+      Eigen::Isometry3d(Eigen::Translation3d(0, 0, 0.05))));
+}
+
+/// The iiwa swings the block about its base axis, 2 s over `steps` intervals, without obstacles.
+inline Problem iiwa_swing(int steps = 20) {
+  Problem p;
+  p.name = "iiwa_swing";
+  p.model = iiwa_with_block();
+  p.horizon = 2;
+  p.steps = steps;
+  Eigen::VectorXd qs(7), qg(7);
+  qs << -0.9, 0.7, 0, -1.2, 0, 0.9, 0;
+  qg << 0.9, 0.7, 0, -1.2, 0, 0.9, 0;
+  p.start_q = qs;
+  p.start_qd = Eigen::VectorXd::Zero(7);
+  p.goal.q = qg;
+  return p;
+}
+
+}  // namespace kinograph::planning::testing
