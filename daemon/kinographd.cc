@@ -13,7 +13,11 @@
 
 namespace {
 std::atomic<bool> g_stop{false};
-void on_signal(int) { g_stop = true; }
+std::atomic<int> g_signal{0};
+void on_signal(int signal) {
+  g_signal = signal;
+  g_stop = true;
+}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -36,6 +40,7 @@ int main(int argc, char** argv) {
     kinograph::daemon::PlannerNode node(kinograph::planning::load_scene(scene_path), options);
     node.run(g_stop);
     const auto c = node.counters();
+    if (g_signal != 0) spdlog::info("kinographd: signal {} received", g_signal.load());
     spdlog::info("kinographd: stopped after {} goals, {} plans ({} failed), {} rejected messages",
                  c.goals_received, c.plans_published, c.failures, c.messages_rejected);
   } catch (const std::exception& e) {

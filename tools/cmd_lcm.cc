@@ -2,6 +2,7 @@
 //   kinograph send-goal     --prefix IIWA (--q ... | --frame F --position ... --quaternion ...)
 //   kinograph send-obstacle --prefix IIWA --id box --shape box --size ... --position ...
 //   kinograph send-state    --prefix IIWA --scene S --q ... [--qd ...]
+//   kinograph send-raw      CHANNEL --text BYTES
 //   kinograph log-plans     LOG.lcmlog --channel IIWA_PLAN --scene S --out-dir DIR
 // send-goal and send-obstacle can wait for the answering plan (--wait) and write it (--out).
 #include <chrono>
@@ -258,6 +259,21 @@ const bool kSendState = register_command([](CLI::App& root) {
         qd->empty() ? std::vector<double>(model.nq(), 0.0) : parse_fixed(*qd, "--qd", model.nq());
     open_lcm(c->url).publish(c->prefix + "_STATE", &msg);
     std::cout << "sent state on " << c->prefix << "_STATE\n";
+  });
+});
+
+// Robustness testing: publish arbitrary bytes on a channel, to see a daemon reject them.
+const bool kSendRaw = register_command([](CLI::App& root) {
+  auto* sub = root.add_subcommand("send-raw", "publish raw bytes on a channel (for testing)");
+  auto channel = std::make_shared<std::string>();
+  auto text = std::make_shared<std::string>();
+  auto url = std::make_shared<std::string>();
+  sub->add_option("channel", *channel, "channel, e.g. IIWA_GOAL")->required();
+  sub->add_option("--text", *text, "the bytes to send, as text")->required();
+  sub->add_option("--lcm-url", *url, "LCM URL (default: $LCM_DEFAULT_URL or udpm)");
+  sub->callback([=] {
+    open_lcm(*url).publish(*channel, text->data(), static_cast<unsigned>(text->size()));
+    std::cout << "sent " << text->size() << " bytes on " << *channel << "\n";
   });
 });
 
