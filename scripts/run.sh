@@ -43,4 +43,8 @@ if $KG plot --help >/dev/null 2>&1; then
     --label "without min torque" --title "iiwa task 2: joint torques" \
     --out out/iiwa_task2_torque.png
 fi
-ls -l out/
+
+# The daemon end to end over LCM: a goal, then an obstacle that forces a replan (out/daemon/).
+echo "== daemon demo (kinographd over LCM)"
+./scripts/daemon_demo.sh || echo "   (daemon demo: a plan did not validate; see out/daemon/kinographd.log)"
+ls -l out/ out/daemon/

@@ -116,7 +116,9 @@ struct Common {
 };
 
 // Waits for the plan answering goal_id, prints it, writes it if asked; returns the exit code.
-int finish(PlanWaiter& waiter, const Common& c, int64_t goal_id) {
+// `extra` is an obstacle this command sent, written into the plan file with the scene's own.
+int finish(PlanWaiter& waiter, const Common& c, int64_t goal_id,
+           const std::optional<std::pair<std::string, collision::Obstacle>>& extra = {}) {
   if (c.wait_s <= 0) return 0;
   auto plan = waiter.wait(goal_id, c.wait_s);
   if (!plan) {
@@ -127,7 +129,12 @@ int finish(PlanWaiter& waiter, const Common& c, int64_t goal_id) {
   std::cout << summarize(*plan) << "\n";
   if (!c.out.empty()) {
     if (c.scene.empty()) throw CommandFailure("--out needs --scene");
-    const auto scene = planning::load_scene(c.scene);
+    auto scene = planning::load_scene(c.scene);
+    if (extra) {
+      scene.obstacle_names.push_back(extra->first);
+      scene.problem.obstacles.push_back(extra->second);
+      scene.problem.obstacles.back().id = static_cast<int>(scene.problem.obstacles.size()) - 1;
+    }
     if (plan->num_steps == 0) throw CommandFailure("plan has no trajectory to write", 2);
     planning::write_plan(daemon::plan_from_message(*plan), scene, c.out);
     std::cout << "wrote " << c.out << "\n";
@@ -232,7 +239,17 @@ const bool kSendObstacle = register_command([](CLI::App& root) {
     PlanWaiter waiter(lcm, c->prefix + "_PLAN");
     lcm.publish(c->prefix + "_OBSTACLES", &msg);
     std::cout << "sent obstacle \"" << o.id << "\" on " << c->prefix << "_OBSTACLES\n";
-    if (int code = finish(waiter, *c, *goal_id); code != 0) throw CommandFailure("", code);
+    std::optional<std::pair<std::string, collision::Obstacle>> extra;
+    if (!*remove) {
+      std::vector<daemon::ObstacleUpdate> updates;
+      if (daemon::obstacles_from_message(msg, updates).ok) {
+        collision::Obstacle obstacle;
+        obstacle.shape = updates[0].shape;
+        obstacle.pose = updates[0].pose;
+        extra.emplace(o.id, obstacle);
+      }
+    }
+    if (int code = finish(waiter, *c, *goal_id, extra); code != 0) throw CommandFailure("", code);
   });
 });
 

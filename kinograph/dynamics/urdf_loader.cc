@@ -5,6 +5,7 @@
 #include <urdf_parser/urdf_parser.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <mutex>
@@ -237,6 +238,19 @@ class Loader {
       for (fs::path d = fs::absolute(base_dir_);; d = d.parent_path()) {
         if (d.filename() == pkg) candidates.push_back(d / rel);
         candidates.push_back(d / pkg / rel);
+        if (d == d.parent_path() || d.empty()) break;
+      }
+      // ROS's own search path, when set.
+      if (const char* ros_path = std::getenv("ROS_PACKAGE_PATH")) {
+        std::stringstream dirs(ros_path);
+        for (std::string dir; std::getline(dirs, dir, ':');) {
+          if (!dir.empty()) candidates.push_back(fs::path(dir) / pkg / rel);
+        }
+      }
+      // Last resort: a URDF shipped at the root of its package under another folder name
+      // (e.g. Debian dart-doc's wam/wam.urdf naming package://herb_description/meshes/...).
+      for (fs::path d = fs::absolute(base_dir_);; d = d.parent_path()) {
+        candidates.push_back(d / rel);
         if (d == d.parent_path() || d.empty()) break;
       }
     } else {

@@ -6,10 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
 #include <memory>
-#include <regex>
-#include <sstream>
 
 #include "kinograph/dynamics/data.h"
 #include "kinograph/dynamics/kinematics.h"
@@ -251,17 +248,12 @@ TEST(PlanarRobot, SpatialArmIsNotPlanar) {
 }
 
 // Barrett WAM from Debian's dart-doc: STL/DAE meshes written as package://herb_description/...
-// The package folder is the URDF's own folder, which a package:// resolver cannot guess from
-// the file system, so the test maps the package the way DART's own examples do.
+// with the URDF at the root of that package under another folder name; the Model's package://
+// resolver falls back to the URDF's own folder for exactly this layout.
 TEST(ThirdPartyMeshes, BarrettWamRenders) {
   const std::string dir = "/usr/share/doc/dart/data/urdf/wam";
   if (!std::filesystem::exists(dir + "/wam.urdf")) GTEST_SKIP() << "dart-doc is not installed";
-  std::ifstream in(dir + "/wam.urdf");
-  std::stringstream text;
-  text << in.rdbuf();
-  const std::string xml =
-      std::regex_replace(text.str(), std::regex("package://herb_description/"), "");
-  const dynamics::Model model = dynamics::Model::from_urdf_string(xml, dir);
+  const dynamics::Model model = dynamics::Model::from_urdf_file(dir + "/wam.urdf");
   int meshes = 0;
   for (const dynamics::Geometry& g : model.visual) {
     if (g.shape == dynamics::Geometry::Shape::kMesh) ++meshes;
