@@ -110,6 +110,7 @@ json to_json(const SolveStats& s) {
           {"iterations", s.iterations},
           {"outer_iterations", s.outer_iterations},
           {"linear_solves", s.linear_solves},
+          {"attempts", s.attempts},
           {"solve_time_s", number(s.solve_time_s)},
           {"cost", number(s.cost)},
           {"max_constraint_violation", number(s.max_constraint_violation)}};
@@ -156,6 +157,7 @@ SolveStats stats_from_json(const json& j, const std::string& source) {
   integer("iterations", s.iterations);
   integer("outer_iterations", s.outer_iterations);
   integer("linear_solves", s.linear_solves);
+  integer("attempts", s.attempts);
   real("solve_time_s", s.solve_time_s);
   real("cost", s.cost);
   real("max_constraint_violation", s.max_constraint_violation);
@@ -227,7 +229,7 @@ std::string summarize(const Plan& plan) {
   os << "solver: " << s.method << ", status " << s.status;
   if (!s.reason.empty()) os << " (" << s.reason << ")";
   os << "\n  iterations: " << s.iterations << " LM, " << s.outer_iterations << " outer, "
-     << s.linear_solves << " linear solves\n";
+     << s.linear_solves << " linear solves, " << s.attempts << " attempt(s)\n";
   os.precision(4);
   os << "  solve time: " << s.solve_time_s * 1e3 << " ms\n";
   os << "  cost: " << s.cost << "\n";

@@ -31,7 +31,16 @@ Plan random_plan(const Problem& problem, unsigned seed) {
   plan.qd = random();
   plan.qdd = random();
   plan.tau = random();
-  plan.stats = {"batch-W", "converged", "why not", 42, 5, 84, 0.125, 3.5, 1.5e-5};
+  plan.stats.method = "batch-W";
+  plan.stats.status = "converged";
+  plan.stats.reason = "why not";
+  plan.stats.iterations = 42;
+  plan.stats.outer_iterations = 5;
+  plan.stats.linear_solves = 84;
+  plan.stats.attempts = 3;
+  plan.stats.solve_time_s = 0.125;
+  plan.stats.cost = 3.5;
+  plan.stats.max_constraint_violation = 1.5e-5;
   Validation& v = plan.validation;
   v.valid = false;
   v.failures = {"dynamics residual 0.1 exceeds 0.001", "goal error 0.2 exceeds 0.01"};
@@ -63,6 +72,7 @@ void expect_same_plan(const Plan& a, const Plan& b) {
   EXPECT_EQ(a.stats.iterations, b.stats.iterations);
   EXPECT_EQ(a.stats.outer_iterations, b.stats.outer_iterations);
   EXPECT_EQ(a.stats.linear_solves, b.stats.linear_solves);
+  EXPECT_EQ(a.stats.attempts, b.stats.attempts);
   EXPECT_EQ(a.stats.solve_time_s, b.stats.solve_time_s);
   EXPECT_EQ(a.stats.cost, b.stats.cost);
   EXPECT_EQ(a.stats.max_constraint_violation, b.stats.max_constraint_violation);
