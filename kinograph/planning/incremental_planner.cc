@@ -1,0 +1,762 @@
+#include "kinograph/planning/incremental_planner.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include "kinograph/dynamics/inverse_dynamics.h"
+#include "kinograph/graph/levenberg_marquardt.h"
+#include "kinograph/planning/augmented_lagrangian.h"
+#include "kinograph/planning/collision_factors.h"
+#include "kinograph/planning/graph_builder.h"
+#include "kinograph/planning/initialization.h"
+#include "kinograph/planning/pose_factors.h"
+#include "kinograph/planning/replan_factors.h"
+#include "kinograph/planning/trajectory_factors.h"
+#include "kinograph/planning/validate.h"
+
+namespace kinograph::planning {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+/// What a factor of the incremental graph is for (which changes replace it).
+enum class Role {
+  kStart,      // StateTargetFactor on q_0, q̇_0
+  kGoal,       // StateTargetFactor on q_N or PoseFactor on q_N
+  kTiming,     // depends on Δt: GP prior, collocation
+  kCollision,  // one obstacle's hinge at one state or sub-step (depends on Δt too)
+  kOther,      // limits, dynamics, task constraints
+};
+
+struct Entry {
+  graph::FactorPtr factor;
+  std::shared_ptr<ConstrainedFactor> constrained;  // null for purely soft factors
+  size_t index = 0;                                // slot in the ISAM2 graph (when added)
+  Role role = Role::kOther;
+  int obstacle = -1;  // kCollision: obstacle id
+};
+
+Entry make_entry(graph::FactorPtr f, Role role, int obstacle = -1) {
+  Entry e;
+  e.constrained = std::dynamic_pointer_cast<ConstrainedFactor>(f);
+  if (e.constrained && !e.constrained->has_constraints()) e.constrained = nullptr;
+  e.factor = std::move(f);
+  e.role = role;
+  e.obstacle = obstacle;
+  return e;
+}
+
+Plan failed(const std::string& method, const std::string& status, const std::string& reason) {
+  Plan p;
+  p.stats.method = method;
+  p.stats.status = status;
+  p.stats.reason = reason;
+  p.validation.valid = false;
+  p.validation.failures.push_back(status + ": " + reason);
+  return p;
+}
+
+// Copies the multipliers of `from` into `to` when their rows agree (a replaced factor of the
+// same shape: moved obstacle, new joint goal, new Δt), so the constraint forces carry over.
+void carry_multipliers(const ConstrainedFactor* from, ConstrainedFactor* to) {
+  if (from == nullptr || to == nullptr || from->residual_dim() != to->residual_dim()) return;
+  to->set_multipliers(from->multipliers(), from->multipliers_upper());
+}
+
+}  // namespace
+
+double soft_cost(const graph::FactorGraph& graph, const graph::Values& values) {
+  double soft = 0;
+  Eigen::VectorXd z;
+  for (const auto& f : graph.factors()) {
+    if (!f) continue;
+    if (auto* c = dynamic_cast<const ConstrainedFactor*>(f.get())) {
+      c->values_at(values, z);
+      for (int i = 0; i < c->residual_dim(); ++i) {
+        const RowSpec& row = c->rows()[i];
+        if (row.kind == RowKind::kSoft) soft += 0.5 * std::pow(row.weight * (z[i] - row.lower), 2);
+      }
+      continue;
+    }
+    soft += f->error(values);
+  }
+  return soft;
+}
+
+// The incremental graph and its solver state.
+struct IncrementalPlanner::State {
+  std::shared_ptr<dynamics::Data> workspace;
+  std::unique_ptr<graph::ISAM2> isam;
+  std::vector<Entry> entries;  // live factors
+  double mu = 100;
+  double last_violation = -1;
+
+  // Factors of the next ISAM2 update: entries (by position) to add and slots to remove.
+  std::vector<size_t> pending_add;
+  std::vector<size_t> pending_remove;
+  graph::Values pending_values;  // only when the tree is (re)built
+};
+
+IncrementalPlanner::IncrementalPlanner(IncrementalPlannerOptions options)
+    : options_(std::move(options)) {}
+IncrementalPlanner::~IncrementalPlanner() = default;
+
+namespace {
+
+// Factors of the goal on state N.
+Entry goal_entry(const Problem& p, const std::shared_ptr<dynamics::Data>& ws,
+                 const IncrementalPlannerOptions& o) {
+  const int N = p.steps;
+  if (p.goal.kind == Goal::Kind::kJoint) {
+    return make_entry(std::make_shared<StateTargetFactor>(std::vector<graph::Key>{q_key(N)},
+                                                          p.model->nq(), p.goal.q, o.goal_scale),
+                      Role::kGoal);
+  }
+  const PoseParts parts = p.goal.position_only ? PoseParts::kPosition : PoseParts::kFull;
+  return make_entry(std::make_shared<PoseFactor>(N, p.model, ws, p.goal.frame, p.goal.pose, parts,
+                                                 o.batch.graph.pose_scale),
+                    Role::kGoal);
+}
+
+Entry start_entry(const Problem& p, const IncrementalPlannerOptions& o) {
+  const int n = p.model->nq();
+  Eigen::VectorXd target(2 * n);
+  target << p.start_q, (p.start_qd.size() == n ? p.start_qd : Eigen::VectorXd::Zero(n));
+  return make_entry(StateTargetFactor::soft({q_key(0), v_key(0)}, n, target, o.start_weight),
+                    Role::kStart);
+}
+
+// One obstacle's collision hinges at every free state and sub-step (as build_graph places them).
+std::vector<Entry> obstacle_entries(const Problem& p, const collision::Obstacle& obstacle,
+                                    const IncrementalPlannerOptions& o) {
+  std::vector<Entry> out;
+  if (p.model->collision.empty()) return out;
+  const Objectives& obj = p.objectives;
+  auto ctx = std::make_shared<CollisionContext>(
+      p.model, std::vector<collision::Obstacle>{obstacle},
+      obj.collision_epsilon + o.batch.graph.collision_query_margin);
+  if (ctx->num_pairs == 0) return out;
+  const int N = p.steps, sub = std::max(0, obj.collision_substeps);
+  const double dt = p.dt();
+  for (int k = 0; k <= N; ++k) {
+    if (k > 0) {
+      out.push_back(
+          make_entry(std::make_shared<CollisionFactor>(k, 0.0, dt, obj.collision_epsilon,
+                                                       o.batch.graph.collision_scale, ctx),
+                     Role::kCollision, obstacle.id));
+    }
+    if (k == N) break;
+    for (int i = 1; i <= sub; ++i) {
+      out.push_back(make_entry(std::make_shared<CollisionFactor>(
+                                   k, static_cast<double>(i) / (sub + 1), dt, obj.collision_epsilon,
+                                   o.batch.graph.collision_scale, ctx),
+                               Role::kCollision, obstacle.id));
+    }
+  }
+  return out;
+}
+
+// GP priors and collocation for the problem's Δt, in build_graph's order.
+std::vector<Entry> timing_entries(const Problem& p, const IncrementalPlannerOptions& o) {
+  std::vector<Entry> out;
+  const int n = p.model->nq();
+  for (int k = 0; k < p.steps; ++k) {
+    out.push_back(
+        make_entry(std::make_shared<GpPriorFactor>(k, n, p.dt(), p.objectives.qc), Role::kTiming));
+    out.push_back(make_entry(
+        std::make_shared<CollocationFactor>(k, n, p.dt(), o.batch.graph.collocation_scale),
+        Role::kTiming));
+  }
+  return out;
+}
+
+}  // namespace
+
+Plan IncrementalPlanner::make_plan(const std::string& method) {
+  const graph::Values& values = state_->isam->estimate();
+  const int n = problem_.model->nq(), N = problem_.steps;
+  const Trajectory tr = read_trajectory(values, N, n);
+  Plan plan;
+  plan.q = tr.q;
+  plan.qd = tr.qd;
+  plan.qdd = tr.qdd;
+  plan.tau.resize(N + 1, n);
+  plan.t.resize(N + 1);
+  dynamics::Data data(*problem_.model);
+  for (int k = 0; k <= N; ++k) {
+    plan.t[k] = problem_.dt() * k;
+    plan.tau.row(k) = dynamics::rnea(*problem_.model, data, tr.q.row(k).transpose(),
+                                     tr.qd.row(k).transpose(), tr.qdd.row(k).transpose())
+                          .transpose();
+  }
+  plan.stats.method = method;
+  plan.stats.cost = soft_cost(state_->isam->graph(), values);
+  double worst = 0;
+  for (const Entry& e : state_->entries) {
+    if (e.constrained) worst = std::max(worst, e.constrained->violation(values));
+  }
+  plan.stats.max_constraint_violation = worst;
+  plan.validation = validate(problem_, plan, options_.batch.validation);
+  return plan;
+}
+
+Plan IncrementalPlanner::batch_solve(const Problem& problem, const Eigen::MatrixXd* q,
+                                     const Eigen::MatrixXd* qd, const Eigen::MatrixXd* qdd,
+                                     const std::string& method, bool /*keep_multipliers*/) {
+  const auto t0 = Clock::now();
+  const std::string problem_error = check_problem(problem);
+  if (!problem_error.empty()) return failed(method, "invalid_problem", problem_error);
+  const int n = problem.model->nq(), N = problem.steps;
+
+  Trajectory init;
+  if (q != nullptr) {
+    init.q = *q;
+    init.qd = *qd;
+    init.qdd = *qdd;
+    init.q.row(0) = problem.start_q.transpose();
+    if (problem.start_qd.size() == n) {
+      init.qd.row(0) = problem.start_qd.transpose();
+    } else {
+      init.qd.row(0).setZero();
+    }
+    init.qd.row(N).setZero();
+    init.qdd.row(N).setZero();
+  } else {
+    const auto q_goal = goal_configuration(problem);
+    if (!q_goal) return failed(method, "invalid_problem", "no goal configuration");
+    init = straight_line(problem, *q_goal);
+  }
+
+  auto state = std::make_unique<State>();
+  graph::Values values;
+  try {
+    // The batch graph without obstacles and with a joint goal at the initial final state (so
+    // build_graph adds no goal factor); the goal, start and obstacles are added below.
+    Problem p0 = problem;
+    p0.obstacles.clear();
+    p0.goal = Goal();
+    p0.goal.q = init.q.row(N).transpose();
+    PlanningGraph pg = build_graph(p0, init, options_.batch.graph);
+    state->workspace = pg.dynamics_workspace;
+    values = pg.values;
+    // During the batch solve the start and a joint goal are fixed variables, exactly as in
+    // BatchPlanner; they become factors before the Bayes tree is built.
+    if (problem.goal.kind == Goal::Kind::kJoint) {
+      values.update(q_key(N), problem.goal.q);
+    } else {
+      values.set_fixed(q_key(N), false);
+    }
+    for (const auto& f : pg.graph.factors()) {
+      if (!f) continue;
+      const bool timing = dynamic_cast<const GpPriorFactor*>(f.get()) != nullptr ||
+                          dynamic_cast<const CollocationFactor*>(f.get()) != nullptr;
+      state->entries.push_back(make_entry(f, timing ? Role::kTiming : Role::kOther));
+    }
+    state->entries.push_back(start_entry(problem, options_));
+    state->entries.push_back(goal_entry(problem, state->workspace, options_));
+    std::set<int> ids;
+    for (const collision::Obstacle& o : problem.obstacles) {
+      if (!ids.insert(o.id).second) {
+        return failed(method, "invalid_problem",
+                      "obstacle id " + std::to_string(o.id) + " is repeated");
+      }
+      for (Entry& e : obstacle_entries(problem, o, options_)) state->entries.push_back(e);
+    }
+  } catch (const std::exception& e) {
+    return failed(method, "invalid_problem", e.what());
+  }
+
+  // Augmented-Lagrangian LM loop, as BatchPlanner's.
+  graph::FactorGraph graph;
+  std::vector<std::shared_ptr<ConstrainedFactor>> constraints;
+  const bool joint_goal = problem.goal.kind == Goal::Kind::kJoint;
+  for (const Entry& e : state->entries) {
+    if (e.role == Role::kStart || (e.role == Role::kGoal && joint_goal)) continue;
+    graph.add(e.factor);
+    if (e.constrained) constraints.push_back(e.constrained);
+  }
+  const BatchPlannerOptions& bo = options_.batch;
+  AugmentedLagrangian al(constraints, bo.augmented_lagrangian);
+  graph::LevenbergMarquardtOptions lm_options;
+  lm_options.record_history = false;
+  lm_options.relative_error_tol = bo.inner_tolerance_initial;
+  graph::LevenbergMarquardt lm(lm_options);
+  SolveStats stats;
+  stats.method = method;
+  std::string status = "infeasible";
+  for (int outer = 0; outer < bo.max_outer_iterations; ++outer) {
+    lm_options.max_iterations =
+        std::min(bo.max_inner_iterations, bo.max_total_iterations - stats.iterations);
+    if (lm_options.max_iterations <= 0) break;
+    lm.set_options(lm_options);
+    const graph::OptimizationResult r = lm.optimize(graph, values);
+    stats.iterations += r.iterations;
+    stats.linear_solves += r.trials;
+    stats.outer_iterations = outer + 1;
+    if (r.status == graph::SolverStatus::kNonFinite) {
+      status = "non_finite";
+      stats.reason = r.reason;
+      break;
+    }
+    const double violation = al.report(values).scaled_violation;
+    if (violation <= bo.constraint_tolerance &&
+        lm_options.relative_error_tol <= bo.inner_tolerance_final * 1.0001) {
+      status = "converged";
+      break;
+    }
+    al.update(values);
+    lm_options.relative_error_tol =
+        violation <= bo.constraint_tolerance
+            ? bo.inner_tolerance_final
+            : std::max(bo.inner_tolerance_final, lm_options.relative_error_tol * 0.1);
+  }
+  const ConstraintReport worst = al.report(values);
+  if (status == "infeasible" && worst.scaled_violation <= bo.constraint_tolerance) {
+    status = "converged";
+  }
+  if (status == "infeasible") {
+    std::ostringstream os;
+    os << "constraints still violated after " << stats.outer_iterations << " outer and "
+       << stats.iterations << " LM iterations: worst " << worst.violation << " at " << worst.where;
+    stats.reason = os.str();
+  }
+  stats.status = status;
+
+  // The Bayes tree at the solution, with a moderate penalty (the multipliers hold the forces).
+  state->mu = std::min(al.penalty(), options_.penalty);
+  for (Entry& e : state->entries) {
+    if (e.constrained) e.constrained->set_penalty(state->mu);
+  }
+  values.set_fixed(q_key(0), false);
+  values.set_fixed(v_key(0), false);
+  values.set_fixed(q_key(N), false);
+  if (joint_goal) {
+    // The joint goal's multipliers are the force that held q_N: stationarity of the augmented
+    // Lagrangian at c = 0 gives λ/s = −∂(rest of the cost)/∂q_N.
+    Eigen::VectorXd g = Eigen::VectorXd::Zero(n);
+    Eigen::VectorXd r;
+    Eigen::MatrixXd J;
+    ConstrainedFactor* goal = nullptr;
+    for (const Entry& e : state->entries) {
+      if (e.role == Role::kGoal) {
+        goal = e.constrained.get();
+        continue;
+      }
+      const auto& keys = e.factor->keys();
+      const auto it = std::find(keys.begin(), keys.end(), q_key(N));
+      if (it == keys.end()) continue;
+      e.factor->linearize(values, r, J);
+      const int col = e.factor->block_offsets()[it - keys.begin()];
+      g += J.middleCols(col, n).transpose() * r;
+    }
+    if (goal != nullptr) {
+      goal->set_multipliers(-options_.goal_scale * g, Eigen::VectorXd::Zero(n));
+    }
+  }
+  state->isam = std::make_unique<graph::ISAM2>(options_.isam2);
+  std::vector<graph::FactorPtr> all;
+  for (const Entry& e : state->entries) all.push_back(e.factor);
+  graph::Values start_values = values;
+  const graph::ISAM2Result r = state->isam->update(all, {}, start_values);
+  for (size_t i = 0; i < state->entries.size(); ++i) {
+    state->entries[i].index = r.new_factor_indices[i];
+  }
+
+  // The plan is the batch result (validated); the tree continues from its own estimate.
+  problem_ = problem;
+  state_ = std::move(state);
+  Plan plan;
+  {
+    const Trajectory tr = read_trajectory(values, N, n);
+    plan.q = tr.q;
+    plan.qd = tr.qd;
+    plan.qdd = tr.qdd;
+    plan.tau.resize(N + 1, n);
+    plan.t.resize(N + 1);
+    dynamics::Data data(*problem.model);
+    for (int k = 0; k <= N; ++k) {
+      plan.t[k] = problem.dt() * k;
+      plan.tau.row(k) = dynamics::rnea(*problem.model, data, tr.q.row(k).transpose(),
+                                       tr.qd.row(k).transpose(), tr.qdd.row(k).transpose())
+                            .transpose();
+    }
+  }
+  stats.cost = soft_cost(graph, values);
+  stats.max_constraint_violation = worst.violation;
+  plan.stats = stats;
+  plan.validation = validate(problem, plan, bo.validation);
+  plan.stats.solve_time_s = seconds_since(t0);
+  stats_ = IncrementalStats();
+  stats_.method = method;
+  stats_.penalty = state_->mu;
+  if (!r.ok()) spdlog::warn("incremental planner: building the Bayes tree: {}", r.reason);
+  plan_ = plan;
+  return plan;
+}
+
+Plan IncrementalPlanner::plan(const Problem& problem, const Plan* warm) {
+  if (warm != nullptr) {
+    Trajectory init;
+    try {
+      init = warm_start(problem, *warm);
+    } catch (const std::exception& e) {
+      return failed("batch-W", "invalid_problem", e.what());
+    }
+    return batch_solve(problem, &init.q, &init.qd, &init.qdd, "batch-W", false);
+  }
+  // The batch planner's own initializations (straight line, detours) find the way; the solve on
+  // the incremental graph, warm-started there, then recovers the multipliers.
+  const auto t0 = Clock::now();
+  const Plan batch = BatchPlanner(options_.batch).plan(problem);
+  if (batch.stats.status == "invalid_problem" || batch.q.rows() != problem.steps + 1 ||
+      !batch.q.allFinite()) {
+    return batch;
+  }
+  Plan p = batch_solve(problem, &batch.q, &batch.qd, &batch.qdd, "batch-L", false);
+  if (!p.success() && batch.success()) {
+    spdlog::debug("incremental planner: the re-solve on the incremental graph did not validate");
+  }
+  p.stats.iterations += batch.stats.iterations;
+  p.stats.outer_iterations += batch.stats.outer_iterations;
+  p.stats.linear_solves += batch.stats.linear_solves;
+  p.stats.solve_time_s = seconds_since(t0);
+  plan_.stats = p.stats;
+  return p;
+}
+
+Plan IncrementalPlanner::replan(const ProblemChange& change) {
+  const auto t0 = Clock::now();
+  if (!state_) return failed("incremental", "no_plan", "replan needs a plan first");
+  State& st = *state_;
+  const int n = problem_.model->nq(), N = problem_.steps;
+
+  // The changed problem; checked before any state changes.
+  Problem next = problem_;
+  if (change.goal) next.goal = *change.goal;
+  if (change.start_q) next.start_q = *change.start_q;
+  if (change.start_qd) next.start_qd = *change.start_qd;
+  if (change.horizon) next.horizon = *change.horizon;
+  for (int id : change.remove) {
+    const auto it = std::find_if(next.obstacles.begin(), next.obstacles.end(),
+                                 [id](const collision::Obstacle& o) { return o.id == id; });
+    if (it == next.obstacles.end()) {
+      return failed("incremental", "invalid_problem",
+                    "no obstacle with id " + std::to_string(id) + " to remove");
+    }
+    next.obstacles.erase(it);
+  }
+  std::set<int> changed_obstacles(change.remove.begin(), change.remove.end());
+  for (const collision::Obstacle& o : change.add_or_move) {
+    const auto it = std::find_if(next.obstacles.begin(), next.obstacles.end(),
+                                 [&o](const collision::Obstacle& x) { return x.id == o.id; });
+    if (it != next.obstacles.end()) {
+      *it = o;
+    } else {
+      next.obstacles.push_back(o);
+    }
+    changed_obstacles.insert(o.id);
+  }
+  const std::string problem_error = check_problem(next);
+  if (!problem_error.empty()) return failed("incremental", "invalid_problem", problem_error);
+
+  // New factors for the change, replacing the old ones by index.
+  std::vector<Entry> added;
+  std::vector<Entry> removed;
+  try {
+    const bool timing = change.horizon.has_value() && *change.horizon != problem_.horizon;
+    std::vector<Entry> keep;
+    std::map<int, std::vector<const ConstrainedFactor*>> old_collision;
+    std::vector<const ConstrainedFactor*> old_timing;
+    const ConstrainedFactor* old_goal = nullptr;
+    const ConstrainedFactor* old_start = nullptr;
+    for (Entry& e : st.entries) {
+      bool replace = false;
+      switch (e.role) {
+        case Role::kStart:
+          replace = change.start_q.has_value() || change.start_qd.has_value();
+          if (replace) old_start = e.constrained.get();
+          break;
+        case Role::kGoal:
+          replace = change.goal.has_value();
+          if (replace) old_goal = e.constrained.get();
+          break;
+        case Role::kTiming:
+          replace = timing;
+          if (replace && e.constrained) old_timing.push_back(e.constrained.get());
+          break;
+        case Role::kCollision:
+          replace = timing || changed_obstacles.count(e.obstacle) > 0;
+          if (replace) old_collision[e.obstacle].push_back(e.constrained.get());
+          break;
+        case Role::kOther:
+          break;
+      }
+      (replace ? removed : keep).push_back(e);
+    }
+    if (change.start_q || change.start_qd) {
+      added.push_back(start_entry(next, options_));
+      carry_multipliers(old_start, added.back().constrained.get());
+    }
+    if (change.goal) {
+      added.push_back(goal_entry(next, st.workspace, options_));
+      carry_multipliers(old_goal, added.back().constrained.get());
+    }
+    if (timing) {
+      std::vector<Entry> t = timing_entries(next, options_);
+      size_t c = 0;
+      for (Entry& e : t) {
+        if (e.constrained && c < old_timing.size()) {
+          carry_multipliers(old_timing[c++], e.constrained.get());
+        }
+        added.push_back(e);
+      }
+    }
+    for (const collision::Obstacle& o : next.obstacles) {
+      if (!timing && changed_obstacles.count(o.id) == 0) continue;
+      std::vector<Entry> es = obstacle_entries(next, o, options_);
+      const auto& old = old_collision[o.id];
+      for (size_t i = 0; i < es.size(); ++i) {
+        if (i < old.size()) carry_multipliers(old[i], es[i].constrained.get());
+        added.push_back(es[i]);
+      }
+    }
+    for (Entry& e : added) {
+      if (e.constrained) e.constrained->set_penalty(st.mu);
+    }
+    st.entries = std::move(keep);
+  } catch (const std::exception& e) {
+    return failed("incremental", "invalid_problem", e.what());
+  }
+  problem_ = next;
+  (void)n;
+  (void)N;
+
+  stats_ = IncrementalStats();
+  stats_.method = "incremental";
+  stats_.factors_replaced = static_cast<int>(removed.size());
+  stats_.factors_added = static_cast<int>(added.size());
+
+  st.pending_remove.clear();
+  st.pending_add.clear();
+  for (const Entry& e : removed) st.pending_remove.push_back(e.index);
+  for (Entry& e : added) {
+    st.pending_add.push_back(st.entries.size());
+    st.entries.push_back(e);
+  }
+  // Compaction: a fresh tree from the current estimate when re-adds left too many empty slots.
+  const graph::ISAM2& isam = *st.isam;
+  if (static_cast<double>(isam.graph().size()) >
+      options_.compaction_ratio * static_cast<double>(st.entries.size())) {
+    graph::Values values = isam.estimate();
+    st.isam = std::make_unique<graph::ISAM2>(options_.isam2);
+    st.pending_values = values;
+    st.pending_remove.clear();
+    st.pending_add.clear();
+    for (size_t i = 0; i < st.entries.size(); ++i) st.pending_add.push_back(i);
+  }
+
+  if (spdlog::should_log(spdlog::level::trace)) {
+    spdlog::trace("iDFGP before change: full error {:.6g}", st.isam->error());
+  }
+  // ISAM2 sweeps with multiplier rounds (the stopping rule of the file comment).
+  const double tol = options_.batch.constraint_tolerance;
+  const AugmentedLagrangianOptions& alo = options_.batch.augmented_lagrangian;
+  std::string status = "max_updates";
+  std::string reason;
+  double round_tol = options_.relative_error_tol;
+  bool polish = false;
+  st.last_violation = -1;
+  while (stats_.updates < options_.max_updates) {
+    std::vector<graph::FactorPtr> new_factors;
+    for (size_t i : st.pending_add) new_factors.push_back(st.entries[i].factor);
+    graph::ISAM2UpdateOptions uo;
+    uo.force_relinearize = polish || options_.relinearize_all;
+    const graph::ISAM2Result r =
+        st.isam->update(new_factors, st.pending_remove, st.pending_values, uo);
+    for (size_t i = 0; i < st.pending_add.size(); ++i) {
+      st.entries[st.pending_add[i]].index = r.new_factor_indices[i];
+    }
+    st.pending_add.clear();
+    st.pending_remove.clear();
+    st.pending_values = graph::Values();
+    ++stats_.updates;
+    stats_.cliques_reeliminated += r.cliques_reeliminated;
+    stats_.variables_relinearized += r.variables_relinearized;
+    stats_.full_reeliminations += r.full_reelimination ? 1 : 0;
+    if (!r.ok()) {
+      status = graph::to_string(r.status);
+      reason = r.reason;
+      break;
+    }
+    const double e = r.error_evaluated ? r.error_after : st.isam->error();
+    spdlog::debug(
+        "iDFGP update {}{}: error {:.6g} -> {:.6g}, relinearized {}, cliques {}, trials {}, "
+        "lambda {:.3g}{}, {:.2f} ms",
+        stats_.updates, polish ? " (polish)" : "", r.error_before, e, r.variables_relinearized,
+        r.cliques_reeliminated, r.trials, r.lambda, r.error_increased ? " ROSE" : "",
+        r.total_s * 1e3);
+    if (spdlog::should_log(spdlog::level::trace)) {
+      spdlog::trace("iDFGP full error {:.6g}", st.isam->error());
+    }
+    if (polish) {
+      status = "converged";
+      break;
+    }
+    // Settled at this multiplier estimate when the update's relative decrease is small (the
+    // tolerance tightens with every multiplier round, as the batch planner's inner solves).
+    if (r.error_before - e > round_tol * std::max(r.error_before, 1e-12)) continue;
+    // Converged at this multiplier estimate: check the constraints.
+    const graph::Values& values = st.isam->estimate();
+    double worst = 0;
+    const Entry* worst_entry = nullptr;
+    for (const Entry& en : st.entries) {
+      if (!en.constrained) continue;
+      const double v = en.constrained->scaled_violation(values);
+      if (v > worst) {
+        worst = v;
+        worst_entry = &en;
+      }
+    }
+    if (worst_entry != nullptr) {
+      spdlog::debug("iDFGP round {}: mu {:.3g}, worst scaled violation {:.3g} at {} {}",
+                    stats_.rounds, st.mu, worst, worst_entry->factor->name(),
+                    worst_entry->factor->keys().front().to_string());
+    }
+    if (worst <= tol && round_tol > options_.final_relative_error_tol) {
+      // Feasible: settle the objective at the final tolerance before stopping (as the batch
+      // planner's last inner solve).
+      round_tol = options_.final_relative_error_tol;
+      continue;
+    }
+    if (worst <= tol) {
+      if (!options_.polish || stats_.updates >= options_.max_updates) {
+        status = "converged";
+        break;
+      }
+      polish = true;  // one update relinearizing every moved variable (ISAM2's threshold)
+      continue;
+    }
+    if (stats_.rounds >= options_.max_rounds) {
+      status = "max_rounds";
+      break;
+    }
+    ++stats_.rounds;
+    round_tol = std::max(options_.final_relative_error_tol, 0.1 * round_tol);
+    // Penalty growth (every factor re-added) or a selective multiplier update.
+    const bool grow = st.last_violation >= 0 && worst > alo.required_decrease * st.last_violation &&
+                      st.mu < options_.max_penalty;
+    st.last_violation = worst;
+    for (size_t i = 0; i < st.entries.size(); ++i) {
+      Entry& en = st.entries[i];
+      if (!en.constrained) continue;
+      const Eigen::VectorXd lo = en.constrained->multipliers();
+      const Eigen::VectorXd up = en.constrained->multipliers_upper();
+      en.constrained->update_multipliers(values);
+      const double change_scaled =
+          std::max((en.constrained->multipliers() - lo).cwiseAbs().maxCoeff(),
+                   (en.constrained->multipliers_upper() - up).cwiseAbs().maxCoeff()) /
+          st.mu;
+      if (change_scaled <= 0.5 * tol && !grow) {
+        en.constrained->set_multipliers(lo, up);
+        continue;
+      }
+      if (grow) {
+        en.constrained->set_penalty(std::min(options_.max_penalty, st.mu * alo.penalty_growth));
+      }
+      st.pending_remove.push_back(en.index);
+      st.pending_add.push_back(i);
+    }
+    if (grow) st.mu = std::min(options_.max_penalty, st.mu * alo.penalty_growth);
+    stats_.factors_readded += static_cast<int>(st.pending_add.size());
+  }
+  stats_.penalty = st.mu;
+  stats_.incremental_time_s = seconds_since(t0);
+
+  Plan plan = make_plan("incremental");
+  plan.stats.status = status;
+  plan.stats.reason = reason;
+  plan.stats.iterations = stats_.updates;
+  plan.stats.outer_iterations = stats_.rounds;
+  plan.stats.linear_solves = stats_.updates;
+  if (!plan.success() && options_.fallback) {
+    stats_.fell_back = true;
+    stats_.fallback_reason =
+        plan.validation.failures.empty() ? status : plan.validation.failures.front();
+    spdlog::info("incremental replan did not validate ({}); falling back to a batch solve",
+                 stats_.fallback_reason);
+    const auto tf = Clock::now();
+    const IncrementalStats inc = stats_;
+    Plan batch = batch_solve(problem_, &plan.q, &plan.qd, &plan.qdd, "batch-W", false);
+    stats_ = inc;
+    stats_.method = "batch-W";
+    stats_.fallback_time_s = seconds_since(tf);
+    batch.stats.reason = "incremental replan did not validate (" + stats_.fallback_reason +
+                         "); warm-started batch solve" +
+                         (batch.stats.reason.empty() ? "" : ": " + batch.stats.reason);
+    plan = batch;
+  } else {
+    std::ostringstream os;
+    os << stats_.updates << " ISAM2 updates, " << stats_.rounds << " multiplier rounds, "
+       << stats_.cliques_reeliminated << " cliques re-eliminated";
+    if (reason.empty()) plan.stats.reason = os.str();
+  }
+  plan.stats.solve_time_s = seconds_since(t0);
+  plan_ = plan;
+  return plan;
+}
+
+Plan IncrementalPlanner::set_goal(const Goal& goal) {
+  ProblemChange c;
+  c.goal = goal;
+  return replan(c);
+}
+
+Plan IncrementalPlanner::add_or_move_obstacle(const collision::Obstacle& obstacle) {
+  ProblemChange c;
+  c.add_or_move.push_back(obstacle);
+  return replan(c);
+}
+
+Plan IncrementalPlanner::move_obstacle(int id, const Eigen::Isometry3d& pose) {
+  const auto it = std::find_if(problem_.obstacles.begin(), problem_.obstacles.end(),
+                               [id](const collision::Obstacle& o) { return o.id == id; });
+  if (it == problem_.obstacles.end()) {
+    return failed("incremental", "invalid_problem",
+                  "no obstacle with id " + std::to_string(id) + " to move");
+  }
+  collision::Obstacle o = *it;
+  o.pose = pose;
+  o.trajectory = collision::PoseTrajectory();
+  return add_or_move_obstacle(o);
+}
+
+Plan IncrementalPlanner::remove_obstacle(int id) {
+  ProblemChange c;
+  c.remove.push_back(id);
+  return replan(c);
+}
+
+Plan IncrementalPlanner::update_start(const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
+  ProblemChange c;
+  c.start_q = q;
+  c.start_qd = qd;
+  return replan(c);
+}
+
+Plan IncrementalPlanner::set_horizon(double horizon) {
+  ProblemChange c;
+  c.horizon = horizon;
+  return replan(c);
+}
+
+}  // namespace kinograph::planning
