@@ -115,21 +115,79 @@ Plan BatchPlanner::plan(const Problem& problem, const Plan* warm) const {
     p.stats.solve_time_s = elapsed();
     return p;
   }
-  const int n = problem.model->nq(), N = problem.steps;
-
   Trajectory init;
+  Eigen::VectorXd q_goal;
   try {
     if (warm != nullptr) {
       init = warm_start(problem, *warm);
     } else {
-      const auto q_goal = goal_configuration(problem);
-      init = straight_line(problem, *q_goal);
+      q_goal = *goal_configuration(problem);
+      init = straight_line(problem, q_goal);
     }
   } catch (const std::exception& e) {
     Plan p = failed_plan(problem, "invalid_problem", e.what());
     p.stats.method = method;
+    p.stats.solve_time_s = elapsed();
     return p;
   }
+  // Initializations in the order tried: the straight line (or the warm start), then detours
+  // around the obstacles (best clearance first). A straight line that runs through an obstacle
+  // usually leads into a poor local minimum (e.g. straddling a thin tabletop), so when it collides
+  // and the best detour does not, the detour goes first.
+  std::vector<Trajectory> inits{init};
+  if (warm == nullptr && options_.max_restarts > 0 && !problem.obstacles.empty()) {
+    const std::vector<Eigen::VectorXd> vias = detour_candidates(problem, q_goal, options_.detour);
+    for (int r = 0; r < options_.max_restarts && r < static_cast<int>(vias.size()); ++r) {
+      inits.push_back(via_point(problem, vias[r], q_goal));
+    }
+    if (options_.detour_first && inits.size() > 1 &&
+        segment_clearance(problem, problem.start_q, q_goal, 2 * options_.detour.samples) < 0 &&
+        segment_clearance(problem, problem.start_q, vias[0], options_.detour.samples) >= 0 &&
+        segment_clearance(problem, vias[0], q_goal, options_.detour.samples) >= 0) {
+      std::swap(inits[0], inits[1]);
+    }
+  }
+  Plan best;
+  SolveStats total;
+  for (size_t a = 0; a < inits.size(); ++a) {
+    Plan p = solve(problem, inits[a], method);
+    if (a == 0) {
+      total = p.stats;
+    } else {
+      total.iterations += p.stats.iterations;
+      total.outer_iterations += p.stats.outer_iterations;
+      total.linear_solves += p.stats.linear_solves;
+      ++total.attempts;
+    }
+    spdlog::debug("plan {}: attempt {}: {}", problem.name, a + 1,
+                  p.success() ? "valid" : p.stats.status);
+    const bool first = a == 0;
+    if (first || p.success() ||
+        p.stats.max_constraint_violation < best.stats.max_constraint_violation) {
+      best = std::move(p);
+    }
+    if (best.success() || best.stats.status == "invalid_problem" ||
+        best.stats.status == "non_finite") {
+      break;
+    }
+  }
+  const SolveStats own = best.stats;
+  best.stats = total;
+  best.stats.status = own.status;
+  best.stats.reason = own.reason;
+  best.stats.cost = own.cost;
+  best.stats.max_constraint_violation = own.max_constraint_violation;
+  best.stats.solve_time_s = elapsed();
+  return best;
+}
+
+Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init,
+                         const std::string& method) const {
+  const auto t0 = std::chrono::steady_clock::now();
+  auto elapsed = [&t0] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  };
+  const int n = problem.model->nq(), N = problem.steps;
 
   PlanningGraph pg;
   std::vector<DfgConstraintStep> dfg_steps;
@@ -144,6 +202,12 @@ Plan BatchPlanner::plan(const Problem& problem, const Plan* warm) const {
     return p;
   }
   AugmentedLagrangian al(pg.constraints, options_.augmented_lagrangian);
+  const double tolerance = dfg_steps.empty() ? options_.constraint_tolerance
+                                             : std::min(options_.constraint_tolerance,
+                                                        options_.dfg_constraint_tolerance);
+  const double tolerance_final = dfg_steps.empty() ? options_.inner_tolerance_final
+                                                   : std::min(options_.inner_tolerance_final,
+                                                              options_.dfg_inner_tolerance_final);
 
   graph::LevenbergMarquardtOptions lm_options;
   lm_options.record_history = false;
@@ -185,24 +249,22 @@ Plan BatchPlanner::plan(const Problem& problem, const Plan* warm) const {
     spdlog::debug("AL outer {}: mu={:.3g} LM {} its ({}), cost {:.6g}, worst {:.3g} at {}", outer,
                   al.penalty(), r.iterations, graph::to_string(r.status), r.final_error,
                   worst.scaled_violation, worst.where);
-    if (violation <= options_.constraint_tolerance &&
-        lm_options.relative_error_tol <= options_.inner_tolerance_final * 1.0001) {
+    if (violation <= tolerance && lm_options.relative_error_tol <= tolerance_final * 1.0001) {
       status = "converged";
       break;
     }
-    if (violation <= options_.constraint_tolerance) {
+    if (violation <= tolerance) {
       // Feasible: one more solve at the final tolerance to settle the objective.
-      lm_options.relative_error_tol = options_.inner_tolerance_final;
+      lm_options.relative_error_tol = tolerance_final;
       al.update(pg.values);
       continue;
     }
     al.update(pg.values);
-    lm_options.relative_error_tol =
-        std::max(options_.inner_tolerance_final, lm_options.relative_error_tol * 0.1);
+    lm_options.relative_error_tol = std::max(tolerance_final, lm_options.relative_error_tol * 0.1);
   }
   const ConstraintReport worst = al.report(pg.values);
   stats.max_constraint_violation = worst.violation;
-  if (status == "infeasible" && worst.scaled_violation <= options_.constraint_tolerance) {
+  if (status == "infeasible" && worst.scaled_violation <= tolerance) {
     status = "converged";
   }
   if (status == "infeasible") {

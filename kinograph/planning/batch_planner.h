@@ -4,6 +4,7 @@
 #include "kinograph/planning/augmented_lagrangian.h"
 #include "kinograph/planning/dfg_builder.h"
 #include "kinograph/planning/graph_builder.h"
+#include "kinograph/planning/initialization.h"
 #include "kinograph/planning/plan.h"
 #include "kinograph/planning/problem.h"
 #include "kinograph/planning/validate.h"
@@ -23,18 +24,38 @@ std::string to_string(Formulation f);
 /// Options of BatchPlanner, defaults tuned on the shipped scenes.
 struct BatchPlannerOptions {
   Formulation formulation = Formulation::kCondensed;
-  /// Keys, scale and external wrenches of the DFG formulation (unused when condensed).
+  /// Keys, scale and external wrenches of the DFG formulation (unused when condensed). The
+  /// equation rows keep scale 1: smaller scales weight them so heavily that LM stalls on the
+  /// objective (plans then differ from the condensed ones).
   DfgOptions dfg;
+  /// constraint_tolerance of the DFG formulation: its equation rows' errors accumulate along the
+  /// chain into τ (about 20× on the iiwa), which must stay within the validator's 1e-3 N·m.
+  double dfg_constraint_tolerance = 2e-5;
+  /// inner_tolerance_final of the DFG formulation: at the condensed default the inner solves
+  /// stop after one LM step and the multipliers stall above dfg_constraint_tolerance.
+  double dfg_inner_tolerance_final = 1e-7;
   GraphOptions graph;
   AugmentedLagrangianOptions augmented_lagrangian;
-  /// Stop when every constraint row's scaled violation |z/s| is below this.
-  double constraint_tolerance = 1e-4;
+  /// Stop when every constraint row's scaled violation |z/s| is below this. With the default
+  /// scales that is 1e-4 rad (rad/s, rad/s²) on limits, 1e-3 N·m on torques, 3e-5 m on
+  /// collision: within the validator's thresholds, which a converged plan therefore meets.
+  double constraint_tolerance = 1e-3;
   int max_outer_iterations = 15;          ///< augmented-Lagrangian updates
   int max_inner_iterations = 15;          ///< LM linearizations per outer iteration
   int max_total_iterations = 400;         ///< LM linearizations over the whole plan
   double inner_tolerance_initial = 1e-2;  ///< LM relative decrease in the first outer iteration
-  double inner_tolerance_final = 1e-7;    ///< ... tightened by 10× per outer iteration to this
+  /// ... tightened by 10× per outer iteration to this. Loose: once feasible, further objective
+  /// decrease is small (the soft cost changes by well under 1 %) and costs many LM iterations.
+  double inner_tolerance_final = 1e-3;
   ValidationThresholds validation;
+  /// When the straight-line (L) plan of a problem with obstacles does not validate, up to this
+  /// many more attempts start from detours (via_point() through detour_candidates()); the plan
+  /// returned is the first that validates, and its stats count every attempt. 0 = never.
+  int max_restarts = 2;
+  /// Start from the best detour instead when the straight line collides and the detour's path
+  /// does not (the straight line is then the first restart).
+  bool detour_first = true;
+  DetourOptions detour;
 };
 
 /// Plans a trajectory for a Problem from a straight-line (L) or warm-start (W) initialization.
@@ -51,6 +72,9 @@ class BatchPlanner {
   const BatchPlannerOptions& options() const { return options_; }
 
  private:
+  /// One augmented-Lagrangian solve from `init`, validated.
+  Plan solve(const Problem& problem, const Trajectory& init, const std::string& method) const;
+
   BatchPlannerOptions options_;
 };
 

@@ -18,8 +18,8 @@ namespace kinograph::planning {
 struct GraphOptions {
   double collocation_scale = 1.0;  ///< × Δt² (position rows) and × Δt (velocity rows)
   double torque_scale = 1.0;       ///< N·m, effort limits and unactuated joints
-  double limit_scale = 1.0;        ///< rad, rad/s, rad/s²
-  double collision_scale = 0.01;   ///< m
+  double limit_scale = 0.1;        ///< rad, rad/s, rad/s²
+  double collision_scale = 0.03;   ///< m
   double pose_scale = 0.01;        ///< m and rad (goal pose and task constraints)
   /// Pairs farther than this (m, beyond ε) are not queried from Bullet.
   double collision_query_margin = 0.1;

@@ -4,8 +4,11 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <random>
 #include <stdexcept>
 
+#include "kinograph/collision/collision_world.h"
 #include "kinograph/dynamics/kinematics.h"
 
 namespace kinograph::planning {
@@ -113,6 +116,97 @@ Trajectory warm_start(const Problem& problem, const Plan& previous) {
   tr.q.row(0) = problem.start_q.transpose();
   if (problem.start_qd.size() == n) tr.qd.row(0) = problem.start_qd.transpose();
   return tr;
+}
+
+Trajectory via_point(const Problem& problem, const Eigen::VectorXd& q_via,
+                     const Eigen::VectorXd& q_goal) {
+  const int N = problem.steps;
+  const int n = problem.model->nq();
+  if (N < 2) return straight_line(problem, q_goal);
+  const int half = N / 2;
+  Problem first = problem;
+  first.steps = half;
+  first.horizon = problem.dt() * half;
+  const Trajectory a = straight_line(first, q_via);
+  Problem second = problem;
+  second.steps = N - half;
+  second.horizon = problem.dt() * (N - half);
+  second.start_q = q_via;
+  second.start_qd = Eigen::VectorXd::Zero(n);
+  const Trajectory b = straight_line(second, q_goal);
+  Trajectory tr;
+  tr.q.resize(N + 1, n);
+  tr.qd.resize(N + 1, n);
+  tr.qdd.resize(N + 1, n);
+  tr.q << a.q, b.q.bottomRows(N - half);
+  tr.qd << a.qd, b.qd.bottomRows(N - half);
+  tr.qdd << a.qdd, b.qdd.bottomRows(N - half);
+  return tr;
+}
+
+namespace {
+// Smallest clearance along a → b with a prepared world and workspace.
+double clearance_along(const dynamics::Model& model, collision::CollisionWorld& world,
+                       dynamics::Data& data, const Eigen::VectorXd& a, const Eigen::VectorXd& b,
+                       int samples, double stop_below) {
+  double worst = std::numeric_limits<double>::infinity();
+  for (int i = 0; i <= samples; ++i) {
+    const double s = static_cast<double>(i) / samples;
+    dynamics::forward_kinematics(model, data, (1 - s) * a + s * b);
+    worst = std::min(worst, world.closest(data, 0).distance);
+    if (worst < stop_below) break;
+  }
+  return worst;
+}
+}  // namespace
+
+double segment_clearance(const Problem& problem, const Eigen::VectorXd& a, const Eigen::VectorXd& b,
+                         int samples) {
+  if (problem.obstacles.empty()) return std::numeric_limits<double>::infinity();
+  collision::CollisionWorld world(*problem.model);
+  for (const auto& o : problem.obstacles) world.add_obstacle(o);
+  dynamics::Data data(*problem.model);
+  return clearance_along(*problem.model, world, data, a, b, std::max(1, samples),
+                         -std::numeric_limits<double>::infinity());
+}
+
+std::vector<Eigen::VectorXd> detour_candidates(const Problem& problem,
+                                               const Eigen::VectorXd& q_goal,
+                                               const DetourOptions& options) {
+  if (problem.obstacles.empty() || options.candidates <= 0) return {};
+  const dynamics::Model& model = *problem.model;
+  const int n = model.nq();
+  collision::CollisionWorld world(model);
+  for (const auto& o : problem.obstacles) world.add_obstacle(o);
+  dynamics::Data data(model);
+  std::mt19937_64 rng(options.seed);
+  std::uniform_real_distribution<double> u(-options.spread, options.spread);
+  const Eigen::VectorXd mid = 0.5 * (problem.start_q + q_goal);
+  const double eps = problem.objectives.collision_epsilon;
+  const int samples = std::max(1, options.samples);
+  struct Candidate {
+    double score;
+    Eigen::VectorXd q;
+  };
+  std::vector<Candidate> ranked;
+  for (int c = 0; c < options.candidates; ++c) {
+    Eigen::VectorXd q = mid;
+    for (int j = 0; j < n; ++j) {
+      const auto& l = model.bodies[j].limits;
+      q[j] = std::clamp(q[j] + u(rng), l.lower, l.upper);
+    }
+    // Clearance capped at ε (anything clearer is as good), then a small preference for short
+    // detours, so the ranking is: collision-free first, then by joint-space length.
+    const double c1 = clearance_along(model, world, data, problem.start_q, q, samples, -1e9);
+    const double c2 = clearance_along(model, world, data, q, q_goal, samples, -1e9);
+    const double length = (q - problem.start_q).norm() + (q_goal - q).norm();
+    ranked.push_back({std::min({c1, c2, eps}) - 1e-3 * length, q});
+  }
+  std::stable_sort(ranked.begin(), ranked.end(),
+                   [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
+  std::vector<Eigen::VectorXd> out;
+  for (auto& c : ranked) out.push_back(std::move(c.q));
+  return out;
 }
 
 }  // namespace kinograph::planning

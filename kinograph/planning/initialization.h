@@ -2,8 +2,10 @@
 // Initial trajectories for the batch planner: a smooth straight line (L) and a warm start from
 // a previous plan (W).
 #include <Eigen/Core>
+#include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "kinograph/planning/plan.h"
 #include "kinograph/planning/problem.h"
@@ -23,6 +25,31 @@ std::optional<Eigen::VectorXd> goal_configuration(const Problem& problem);
 /// Straight line in joint space from start to `q_goal` along a quintic time law (zero velocity
 /// and acceleration at the goal, the start velocity at the start), so q, q̇, q̈ are consistent.
 Trajectory straight_line(const Problem& problem, const Eigen::VectorXd& q_goal);
+
+/// Two smooth straight lines, start → q_via over the first half of the steps (ending at rest) and
+/// q_via → q_goal over the rest: a detour for when the straight line passes through an obstacle.
+Trajectory via_point(const Problem& problem, const Eigen::VectorXd& q_via,
+                     const Eigen::VectorXd& q_goal);
+
+/// Options of detour_candidates.
+struct DetourOptions {
+  int candidates = 24;  ///< random via points drawn (seeded, so plans are repeatable)
+  double spread = 1.2;  ///< rad: via = midpoint + uniform(±spread) per joint, within limits
+  int samples = 16;     ///< configurations checked per path segment
+  std::uint64_t seed = 1;
+};
+
+/// Via points for via_point(), best first: drawn around the midpoint of start and goal, ranked by
+/// the clearance of their two-segment joint-space path to the problem's obstacles (capped at the
+/// planner's ε, so among clear paths the shorter wins). Empty without obstacles.
+std::vector<Eigen::VectorXd> detour_candidates(const Problem& problem,
+                                               const Eigen::VectorXd& q_goal,
+                                               const DetourOptions& options = {});
+
+/// Smallest clearance (m) to the problem's obstacles along the joint-space segment a → b,
+/// sampled at `samples` + 1 configurations (+inf without obstacles).
+double segment_clearance(const Problem& problem, const Eigen::VectorXd& a, const Eigen::VectorXd& b,
+                         int samples);
 
 /// A previous plan resampled (piecewise linearly in time) to the problem's steps; the start
 /// state is replaced by the problem's. Throws std::invalid_argument if the plan's joint count

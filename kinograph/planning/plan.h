@@ -16,6 +16,7 @@ struct SolveStats {
   int iterations = 0;        ///< LM linearizations over all inner solves
   int outer_iterations = 0;  ///< augmented-Lagrangian outer iterations
   int linear_solves = 0;     ///< sparse factorizations + solves
+  int attempts = 1;          ///< solves from different initializations (restarts + 1)
   double solve_time_s = 0;   ///< wall time of the whole plan() call
   double cost = 0;           ///< final soft cost ½Σ‖r‖² (without constraint terms)
   double max_constraint_violation = 0;  ///< largest must-hold residual at the end

@@ -8,12 +8,23 @@
 namespace kinograph::planning {
 namespace {
 
+// Options that solve each plan to a tight optimum: the defaults stop at the first feasible plan
+// with a loose objective tolerance, where two solvers' plans may differ along the flat objective.
+BatchPlannerOptions tight() {
+  BatchPlannerOptions o;
+  o.constraint_tolerance = 1e-5;
+  o.inner_tolerance_final = 1e-8;
+  o.max_outer_iterations = 30;
+  o.max_total_iterations = 1500;
+  return o;
+}
+
 // Plans `problem` in both formulations and checks that both validate and agree. They agree to
-// the planner's convergence tolerances, not to rounding: the inner LM solves stop at a relative
-// decrease, and the DFG's extra variables change the path LM takes to the same optimum.
+// the convergence tolerances, not to rounding: the inner LM solves stop at a relative decrease,
+// and the DFG's extra variables change the path LM takes to the same optimum.
 void expect_same_plans(const Problem& problem, double q_tol, double tau_tol) {
-  BatchPlannerOptions condensed;
-  BatchPlannerOptions dfg;
+  BatchPlannerOptions condensed = tight();
+  BatchPlannerOptions dfg = tight();
   dfg.formulation = Formulation::kDynamicFactorGraph;
   const Plan a = BatchPlanner(condensed).plan(problem);
   const Plan b = BatchPlanner(dfg).plan(problem);
@@ -26,7 +37,7 @@ void expect_same_plans(const Problem& problem, double q_tol, double tau_tol) {
   EXPECT_LT((a.q - b.q).cwiseAbs().maxCoeff(), q_tol);
   EXPECT_LT((a.qd - b.qd).cwiseAbs().maxCoeff(), 3 * q_tol);
   EXPECT_LT((a.tau - b.tau).cwiseAbs().maxCoeff(), tau_tol);
-  EXPECT_NEAR(a.stats.cost, b.stats.cost, 1e-2 * (1 + a.stats.cost));
+  EXPECT_NEAR(a.stats.cost, b.stats.cost, 1e-3 * (1 + a.stats.cost));
 }
 
 TEST(Formulation, Names) {
@@ -37,10 +48,18 @@ TEST(Formulation, Names) {
 TEST(Formulation, RrReachIsTheSamePlan) {
   Problem p = testing::rr_reach();
   p.obstacles.clear();  // with the ball, the two solvers' paths may pass it on different sides
-  expect_same_plans(p, 1e-2, 5e-2);
+  expect_same_plans(p, 3e-3, 2e-2);
 }
 
-TEST(Formulation, BothAvoidTheBall) {
+TEST(Formulation, DfgWithDefaultOptionsValidates) {
+  BatchPlannerOptions dfg;
+  dfg.formulation = Formulation::kDynamicFactorGraph;
+  const Plan plan = BatchPlanner(dfg).plan(testing::iiwa_swing(12));
+  for (const auto& f : plan.validation.failures) ADD_FAILURE() << f;
+  EXPECT_TRUE(plan.success());
+}
+
+TEST(Formulation, DfgAvoidsTheBall) {
   BatchPlannerOptions dfg;
   dfg.formulation = Formulation::kDynamicFactorGraph;
   const Plan plan = BatchPlanner(dfg).plan(testing::rr_reach());
@@ -50,13 +69,13 @@ TEST(Formulation, BothAvoidTheBall) {
 }
 
 TEST(Formulation, IiwaWithBlockIsTheSamePlan) {
-  expect_same_plans(testing::iiwa_swing(12), 1e-2, 5e-2);
+  expect_same_plans(testing::iiwa_swing(12), 3e-3, 2e-2);
 }
 
 TEST(Formulation, MinimumTorqueRowsAreTheSame) {
   Problem p = testing::iiwa_swing(12);
   p.objectives.min_torque = 1e-3;
-  expect_same_plans(p, 1e-2, 5e-2);
+  expect_same_plans(p, 3e-3, 2e-2);
 }
 
 }  // namespace
