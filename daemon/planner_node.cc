@@ -85,6 +85,19 @@ void PlannerNode::reject(const std::string& reason) {
   publish_status();
 }
 
+void PlannerNode::answer_with_failure(int8_t status, const std::string& reason, int64_t goal_id) {
+  int64_t plan_id;
+  {
+    std::lock_guard lock(mutex_);
+    plan_id = next_plan_id_++;
+    ++counters_.plans_published;
+    ++counters_.failures;
+  }
+  plan_t answer =
+      failure_message(status, reason, identity_.model_name, plan_id, goal_id, now_utime());
+  lcm_->publish(channel("PLAN"), &answer);
+}
+
 void PlannerNode::on_goal(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
   goal_t msg;
   if (auto s = lcmtypes::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), msg); !s.ok) {
@@ -95,18 +108,7 @@ void PlannerNode::on_goal(const lcm::ReceiveBuffer* rbuf, const std::string& cha
   if (Check c = goal_from_message(msg, *scene_.problem.model, identity_, request); !c.ok) {
     reject(channel + ": " + c.reason);
     // The sender named a goal: answer it, so no goal ever goes unanswered.
-    if (msg.goal_id >= 0) {
-      int64_t plan_id;
-      {
-        std::lock_guard lock(mutex_);
-        plan_id = next_plan_id_++;
-        ++counters_.plans_published;
-        ++counters_.failures;
-      }
-      plan_t answer = failure_message(plan_t::INVALID_GOAL, c.reason, identity_.model_name, plan_id,
-                                      msg.goal_id, now_utime());
-      lcm_->publish(this->channel("PLAN"), &answer);
-    }
+    if (msg.goal_id >= 0) answer_with_failure(plan_t::INVALID_GOAL, c.reason, msg.goal_id);
     return;
   }
   std::optional<GoalRequest> superseded;
@@ -122,17 +124,8 @@ void PlannerNode::on_goal(const lcm::ReceiveBuffer* rbuf, const std::string& cha
   }
   wake_.notify_one();
   if (superseded) {
-    int64_t plan_id;
-    {
-      std::lock_guard lock(mutex_);
-      plan_id = next_plan_id_++;
-      ++counters_.plans_published;
-      ++counters_.failures;
-    }
-    plan_t answer =
-        failure_message(plan_t::CANCELLED, "superseded by a newer goal before planning began",
-                        identity_.model_name, plan_id, superseded->goal_id, now_utime());
-    lcm_->publish(this->channel("PLAN"), &answer);
+    answer_with_failure(plan_t::CANCELLED, "superseded by a newer goal before planning began",
+                        superseded->goal_id);
   }
 }
 

@@ -73,6 +73,8 @@ class PlannerNode {
   void on_obstacles(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   void on_state(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   void reject(const std::string& reason);
+  /// Publishes a plan_t without trajectory that answers `goal_id` with a failure status.
+  void answer_with_failure(int8_t status, const std::string& reason, int64_t goal_id);
   void worker_loop(const std::atomic<bool>& stop);
   bool apply_obstacles(const std::vector<ObstacleUpdate>& updates, bool replace_all);
   void plan_and_publish(const GoalRequest& goal, bool replan);
