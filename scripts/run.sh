@@ -32,7 +32,7 @@ done
 # (iiwa_desk.yaml is the same move without it).
 if $KG render --help >/dev/null 2>&1; then
   $KG render out/acrobot_swingup.json --frames 20 \
-    --width 3000 --height 240 --out out/acrobot_swingup_strip.png
+    --width 4000 --height 420 --out out/acrobot_swingup_strip.png
   for scene in rr_reach iiwa_desk iiwa_min_torque; do
     $KG render "out/$scene.json" --scene "robots/scenes/$scene.yaml" --frames 5 \
       --out "out/${scene}_strip.png"
