@@ -37,9 +37,9 @@ rc=0
 "$KG" send-goal --prefix IIWA --lcm-url "$URL" --id 1 \
   --q 0.771,0.335,-0.570,-1.046,-0.686,0.356,-0.122 --wait 120 \
   --scene "$SCENE" --out "$OUT/goal1.json" || rc=$?
-echo "== a box appears on the desk, in the way: the daemon replans goal 1"
-"$KG" send-obstacle --prefix IIWA --lcm-url "$URL" --id box --shape box --size 0.2,0.2,0.2 \
-  --position 0.55,0.15,0.85 --goal-id 1 --wait 120 --scene "$SCENE" \
+echo "== a ball appears above the desk edge: the daemon replans goal 1"
+"$KG" send-obstacle --prefix IIWA --lcm-url "$URL" --id ball --shape sphere --size 0.05 \
+  --position 0.35,0.25,0.62 --goal-id 1 --wait 120 --scene "$SCENE" \
   --out "$OUT/goal1_replan.json" || rc=$?
 
 kill -TERM "$DAEMON"
