@@ -135,17 +135,24 @@ Plan BatchPlanner::plan(const Problem& problem, const Plan* warm) const {
   // usually leads into a poor local minimum (e.g. straddling a thin tabletop), so when it collides
   // and the best detour does not, the detour goes first.
   std::vector<Trajectory> inits{init};
-  if (warm == nullptr && options_.max_restarts > 0 && !problem.obstacles.empty()) {
-    const std::vector<Eigen::VectorXd> vias = detour_candidates(problem, q_goal, options_.detour);
+  const bool may_detour =
+      warm == nullptr && options_.max_restarts > 0 && !problem.obstacles.empty();
+  bool detours_added = false;
+  auto add_detours = [&](bool detour_goes_first) {  // ranking costs queries: only when needed
+    if (detours_added || !may_detour) return;
+    detours_added = true;
+    const std::vector<Detour> vias = detour_candidates(problem, q_goal, options_.detour);
+    const size_t first = inits.size();
     for (int r = 0; r < options_.max_restarts && r < static_cast<int>(vias.size()); ++r) {
-      inits.push_back(via_point(problem, vias[r], q_goal));
+      inits.push_back(via_point(problem, vias[r].via, q_goal));
     }
-    if (options_.detour_first && inits.size() > 1 &&
-        segment_clearance(problem, problem.start_q, q_goal, 2 * options_.detour.samples) < 0 &&
-        segment_clearance(problem, problem.start_q, vias[0], options_.detour.samples) >= 0 &&
-        segment_clearance(problem, vias[0], q_goal, options_.detour.samples) >= 0) {
-      std::swap(inits[0], inits[1]);
+    if (detour_goes_first && inits.size() > first && vias[0].clearance >= 0) {
+      std::swap(inits[0], inits[first]);
     }
+  };
+  if (may_detour && options_.detour_first &&
+      segment_clearance(problem, problem.start_q, q_goal, 2 * options_.detour.samples) < 0) {
+    add_detours(true);
   }
   Plan best;
   SolveStats total;
@@ -170,6 +177,7 @@ Plan BatchPlanner::plan(const Problem& problem, const Plan* warm) const {
         best.stats.status == "non_finite") {
       break;
     }
+    add_detours(false);
   }
   const SolveStats own = best.stats;
   best.stats = total;

@@ -145,15 +145,16 @@ Trajectory via_point(const Problem& problem, const Eigen::VectorXd& q_via,
 }
 
 namespace {
-// Smallest clearance along a → b with a prepared world and workspace.
+// Smallest clearance along a → b, travelled from time t0 to t1 (for moving obstacles), with a
+// prepared world and workspace.
 double clearance_along(const dynamics::Model& model, collision::CollisionWorld& world,
                        dynamics::Data& data, const Eigen::VectorXd& a, const Eigen::VectorXd& b,
-                       int samples, double stop_below) {
+                       double t0, double t1, int samples, double stop_below) {
   double worst = std::numeric_limits<double>::infinity();
   for (int i = 0; i <= samples; ++i) {
     const double s = static_cast<double>(i) / samples;
     dynamics::forward_kinematics(model, data, (1 - s) * a + s * b);
-    worst = std::min(worst, world.closest(data, 0).distance);
+    worst = std::min(worst, world.closest(data, (1 - s) * t0 + s * t1).distance);
     if (worst < stop_below) break;
   }
   return worst;
@@ -166,13 +167,12 @@ double segment_clearance(const Problem& problem, const Eigen::VectorXd& a, const
   collision::CollisionWorld world(*problem.model);
   for (const auto& o : problem.obstacles) world.add_obstacle(o);
   dynamics::Data data(*problem.model);
-  return clearance_along(*problem.model, world, data, a, b, std::max(1, samples),
-                         -std::numeric_limits<double>::infinity());
+  return clearance_along(*problem.model, world, data, a, b, 0, problem.horizon,
+                         std::max(1, samples), -std::numeric_limits<double>::infinity());
 }
 
-std::vector<Eigen::VectorXd> detour_candidates(const Problem& problem,
-                                               const Eigen::VectorXd& q_goal,
-                                               const DetourOptions& options) {
+std::vector<Detour> detour_candidates(const Problem& problem, const Eigen::VectorXd& q_goal,
+                                      const DetourOptions& options) {
   if (problem.obstacles.empty() || options.candidates <= 0) return {};
   const dynamics::Model& model = *problem.model;
   const int n = model.nq();
@@ -186,7 +186,7 @@ std::vector<Eigen::VectorXd> detour_candidates(const Problem& problem,
   const int samples = std::max(1, options.samples);
   struct Candidate {
     double score;
-    Eigen::VectorXd q;
+    Detour detour;
   };
   std::vector<Candidate> ranked;
   for (int c = 0; c < options.candidates; ++c) {
@@ -197,15 +197,17 @@ std::vector<Eigen::VectorXd> detour_candidates(const Problem& problem,
     }
     // Clearance capped at ε (anything clearer is as good), then a small preference for short
     // detours, so the ranking is: collision-free first, then by joint-space length.
-    const double c1 = clearance_along(model, world, data, problem.start_q, q, samples, -1e9);
-    const double c2 = clearance_along(model, world, data, q, q_goal, samples, -1e9);
+    const double T = problem.horizon, half = problem.dt() * (problem.steps / 2);
+    const double c1 =
+        clearance_along(model, world, data, problem.start_q, q, 0, half, samples, -1e9);
+    const double c2 = clearance_along(model, world, data, q, q_goal, half, T, samples, -1e9);
     const double length = (q - problem.start_q).norm() + (q_goal - q).norm();
-    ranked.push_back({std::min({c1, c2, eps}) - 1e-3 * length, q});
+    ranked.push_back({std::min({c1, c2, eps}) - 1e-3 * length, Detour{q, std::min(c1, c2)}});
   }
   std::stable_sort(ranked.begin(), ranked.end(),
                    [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
-  std::vector<Eigen::VectorXd> out;
-  for (auto& c : ranked) out.push_back(std::move(c.q));
+  std::vector<Detour> out;
+  for (auto& c : ranked) out.push_back(std::move(c.detour));
   return out;
 }
 

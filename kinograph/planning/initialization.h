@@ -39,15 +39,21 @@ struct DetourOptions {
   std::uint64_t seed = 1;
 };
 
-/// Via points for via_point(), best first: drawn around the midpoint of start and goal, ranked by
-/// the clearance of their two-segment joint-space path to the problem's obstacles (capped at the
-/// planner's ε, so among clear paths the shorter wins). Empty without obstacles.
-std::vector<Eigen::VectorXd> detour_candidates(const Problem& problem,
-                                               const Eigen::VectorXd& q_goal,
-                                               const DetourOptions& options = {});
+/// A via point for via_point() and the clearance (m) of its two-segment path.
+struct Detour {
+  Eigen::VectorXd via;
+  double clearance = 0;
+};
+
+/// Detours drawn around the midpoint of start and goal, best first: ranked by the clearance of
+/// their two-segment joint-space path to the problem's obstacles (capped at the planner's ε, so
+/// among clear paths the shorter wins). Empty without obstacles.
+std::vector<Detour> detour_candidates(const Problem& problem, const Eigen::VectorXd& q_goal,
+                                      const DetourOptions& options = {});
 
 /// Smallest clearance (m) to the problem's obstacles along the joint-space segment a → b,
-/// sampled at `samples` + 1 configurations (+inf without obstacles).
+/// travelled over the whole horizon and sampled at `samples` + 1 configurations (+inf without
+/// obstacles).
 double segment_clearance(const Problem& problem, const Eigen::VectorXd& a, const Eigen::VectorXd& b,
                          int samples);
 
