@@ -45,29 +45,36 @@ void ConstrainedFactor::evaluate(const graph::FactorValues& x, Eigen::Ref<Eigen:
                                  const graph::Jacobians* J) const {
   compute(x, e, J);
   const double sq = std::sqrt(mu_);
+  // dr/dz of every row, applied to the Jacobian blocks column by column afterwards (blocks are
+  // column-major: scaling row by row would stride through memory). Per-thread scratch that only
+  // grows, so linearizing allocates nothing after the first factor of the largest size.
+  thread_local Eigen::VectorXd scratch;
+  if (scratch.size() < residual_dim()) scratch.resize(residual_dim());
+  auto f = scratch.head(residual_dim());
   for (int i = 0; i < residual_dim(); ++i) {
     const RowSpec& row = rows_[i];
     const double z = e[i];
-    double f = 0;  // dr/dz
     switch (row.kind) {
       case RowKind::kSoft:
-        f = row.weight;
+        f[i] = row.weight;
         e[i] = row.weight * (z - row.lower);
         break;
       case RowKind::kEquality:
-        f = sq / row.scale;
-        e[i] = f * (z - row.lower) + lambda_[i] / sq;
+        f[i] = sq / row.scale;
+        e[i] = f[i] * (z - row.lower) + lambda_[i] / sq;
         break;
       case RowKind::kBounds: {
         const double a = sq * (row.lower - z) / row.scale + lambda_[i] / sq;
         const double b = sq * (z - row.upper) / row.scale + lambda_upper_[i] / sq;
         e[i] = std::max(0.0, a) - std::max(0.0, b);
-        f = -(sq / row.scale) * ((a > 0 ? 1.0 : 0.0) + (b > 0 ? 1.0 : 0.0));
+        f[i] = -(sq / row.scale) * ((a > 0 ? 1.0 : 0.0) + (b > 0 ? 1.0 : 0.0));
         break;
       }
     }
-    if (J != nullptr) {
-      for (size_t k = 0; k < keys().size(); ++k) J->block(static_cast<int>(k)).row(i) *= f;
+  }
+  if (J != nullptr) {
+    for (size_t k = 0; k < keys().size(); ++k) {
+      J->block(static_cast<int>(k)).array().colwise() *= f.array();
     }
   }
 }

@@ -21,8 +21,9 @@ struct GraphOptions {
   double limit_scale = 0.1;        ///< rad, rad/s, rad/s²
   double collision_scale = 0.03;   ///< m
   double pose_scale = 0.01;        ///< m and rad (goal pose and task constraints)
-  /// Pairs farther than this (m, beyond ε) are not queried from Bullet.
-  double collision_query_margin = 0.1;
+  /// Pairs farther than this (m, beyond ε) are not queried from Bullet (their hinge rows are
+  /// inactive unless a multiplier reaches that far, which needs λ·s/μ above the margin).
+  double collision_query_margin = 0.03;
 };
 
 /// A built planning graph with its variables and the handles the planner needs.
