@@ -538,6 +538,7 @@ Plan IncrementalPlanner::replan(const ProblemChange& change) {
     return failed("incremental", "invalid_problem", e.what());
   }
   problem_ = next;
+  const Plan previous = plan_;
   (void)n;
   (void)N;
 
@@ -696,7 +697,14 @@ Plan IncrementalPlanner::replan(const ProblemChange& change) {
                  stats_.fallback_reason);
     const auto tf = Clock::now();
     const IncrementalStats inc = stats_;
-    Plan batch = batch_solve(problem_, &plan.q, &plan.qd, &plan.qdd, "batch-W", false);
+    // Warm-started from the previous plan (DFGP-W), resampled to the changed problem.
+    Plan batch;
+    try {
+      const Trajectory warm = warm_start(problem_, previous);
+      batch = batch_solve(problem_, &warm.q, &warm.qd, &warm.qdd, "batch-W", false);
+    } catch (const std::exception& e) {
+      batch = failed("batch-W", "invalid_problem", e.what());
+    }
     stats_ = inc;
     stats_.method = "batch-W";
     stats_.fallback_time_s = seconds_since(tf);
