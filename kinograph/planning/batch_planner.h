@@ -51,7 +51,7 @@ struct BatchPlannerOptions {
   /// When the straight-line (L) plan of a problem with obstacles does not validate, up to this
   /// many more attempts start from detours (via_point() through detour_candidates()); the plan
   /// returned is the first that validates, and its stats count every attempt. 0 = never.
-  int max_restarts = 2;
+  int max_restarts = 4;
   /// Start from the best detour instead when the straight line collides and the detour's path
   /// does not (the straight line is then the first restart).
   bool detour_first = true;
