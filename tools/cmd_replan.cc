@@ -29,9 +29,10 @@ std::string describe(const planning::IncrementalStats& s, const planning::Plan& 
                 "replan: method %s%s, %d ISAM2 updates, %d multiplier rounds, %ld cliques "
                 "re-eliminated, %ld variables relinearized, %d factors replaced, %d added, "
                 "%d re-added; incremental %.1f ms, fallback %.1f ms, total %.1f ms\n",
-                s.method.c_str(), s.fell_back ? " (fell back: the incremental plan did not validate)" : "",
-                s.updates, s.rounds, s.cliques_reeliminated, s.variables_relinearized,
-                s.factors_replaced, s.factors_added, s.factors_readded, s.incremental_time_s * 1e3,
+                s.method.c_str(),
+                s.fell_back ? " (fell back: the incremental plan did not validate)" : "", s.updates,
+                s.rounds, s.cliques_reeliminated, s.variables_relinearized, s.factors_replaced,
+                s.factors_added, s.factors_readded, s.incremental_time_s * 1e3,
                 s.fallback_time_s * 1e3, plan.stats.solve_time_s * 1e3);
   return buf;
 }
@@ -74,17 +75,17 @@ void run_replan(const ReplanArgs& args) {
     throw CommandFailure(e.what());
   }
   if (!after.success()) {
-    throw CommandFailure("the replan after '" + args.change + "' does not validate (" +
-                             after.stats.status + ")",
-                         2);
+    throw CommandFailure(
+        "the replan after '" + args.change + "' does not validate (" + after.stats.status + ")", 2);
   }
 }
 
 const bool kRegistered = register_command([](CLI::App& root) {
   auto args = std::make_shared<ReplanArgs>();
   CLI::App* cmd = root.add_subcommand(
-      "replan", "Plan a scene, apply a change file (goal, start, horizon, obstacles) and replan "
-                "incrementally (iDFGP)");
+      "replan",
+      "Plan a scene, apply a change file (goal, start, horizon, obstacles) and replan "
+      "incrementally (iDFGP)");
   cmd->add_option("scene", args->scene, "Scene file (YAML), e.g. robots/scenes/rr_reach.yaml")
       ->required();
   cmd->add_option("change", args->change,

@@ -117,17 +117,15 @@ struct Row {
 };
 
 json row_json(const Row& r) {
-  return {{"problems", r.problems},
-          {"first_plan_failed", r.first_failed},
-          {"no_nearby_change", r.no_change},
-          {"DFGP-L", r.L.to_json()},
-          {"DFGP-W", r.W.to_json()},
-          {"iDFGP", r.inc.to_json()}};
+  return {{"problems", r.problems},          {"first_plan_failed", r.first_failed},
+          {"no_nearby_change", r.no_change}, {"DFGP-L", r.L.to_json()},
+          {"DFGP-W", r.W.to_json()},         {"iDFGP", r.inc.to_json()}};
 }
 
 // Plans `first`, applies `change` to a copy for the batch methods, and replans with all three.
 void replan_all(Row& row, const Problem& first_problem, const Problem& changed,
-                const planning::ProblemChange& change, const planning::IncrementalPlannerOptions& io) {
+                const planning::ProblemChange& change,
+                const planning::IncrementalPlannerOptions& io) {
   ++row.problems;
   planning::IncrementalPlanner planner(io);
   const Plan first = planner.plan(first_problem);
@@ -240,8 +238,8 @@ int run(int argc, char** argv) {
       planning::ProblemChange change;
       change.add_or_move.push_back(o);
       replan_all(moved, first, changed, change, io);
-      std::cerr << "obstacle move " << i << ": L " << moved.L.ok << " W " << moved.W.ok
-                << " iDFGP " << moved.inc.ok << " / " << moved.L.runs << "\n";
+      std::cerr << "obstacle move " << i << ": L " << moved.L.ok << " W " << moved.W.ok << " iDFGP "
+                << moved.inc.ok << " / " << moved.L.runs << "\n";
     }
     result["obstacle_move"] = row_json(moved);
   }
@@ -279,9 +277,10 @@ int run(int argc, char** argv) {
   }
   for (int r = 0; r < 3; ++r) {
     const Method& x = all[r]->inc;
-    std::cout << "\n" << names[r] << ": " << all[r]->problems << " problems, "
-              << all[r]->first_failed << " first plans did not validate (not replanned); iDFGP "
-              << x.incremental_ok << " validated incrementally, " << x.fell_back
+    std::cout << "\n"
+              << names[r] << ": " << all[r]->problems << " problems, " << all[r]->first_failed
+              << " first plans did not validate (not replanned); iDFGP " << x.incremental_ok
+              << " validated incrementally, " << x.fell_back
               << " fell back to a warm batch solve; median " << cell(median(x.updates))
               << " ISAM2 updates; speed-up of iDFGP over DFGP-W (mean times) "
               << cell(mean(all[r]->W.ok_times) / mean(x.ok_times), 1, 1) << "×, median "

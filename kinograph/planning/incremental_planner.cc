@@ -46,6 +46,22 @@ struct Entry {
   int obstacle = -1;  // kCollision: obstacle id
 };
 
+// Whether a bound row holds a positive multiplier (which shrinks once the row is inactive).
+bool has_bound_multipliers(const ConstrainedFactor& f) {
+  for (int i = 0; i < f.residual_dim(); ++i) {
+    if (f.rows()[i].kind == RowKind::kBounds &&
+        (f.multipliers()[i] > 0 || f.multipliers_upper()[i] > 0)) {
+      return true;
+    }
+  }
+  return false;
+}
+
+bool same_shape(const collision::Shape& a, const collision::Shape& b) {
+  return a.kind == b.kind && a.size == b.size && a.mesh_path == b.mesh_path &&
+         a.mesh_scale == b.mesh_scale;
+}
+
 Entry make_entry(graph::FactorPtr f, Role role, int obstacle = -1) {
   Entry e;
   e.constrained = std::dynamic_pointer_cast<ConstrainedFactor>(f);
@@ -97,7 +113,8 @@ double soft_cost(const graph::FactorGraph& graph, const graph::Values& values) {
 struct IncrementalPlanner::State {
   std::shared_ptr<dynamics::Data> workspace;
   std::unique_ptr<graph::ISAM2> isam;
-  std::vector<Entry> entries;  // live factors
+  std::vector<Entry> entries;                                 // live factors
+  std::map<int, std::shared_ptr<CollisionContext>> contexts;  // per obstacle id
   double mu = 100;
   double last_violation = -1;
 
@@ -137,14 +154,19 @@ Entry start_entry(const Problem& p, const IncrementalPlannerOptions& o) {
 }
 
 // One obstacle's collision hinges at every free state and sub-step (as build_graph places them).
+// `ctx` is the obstacle's collision world when it can be reused (else null: a new one is built
+// and returned through it).
 std::vector<Entry> obstacle_entries(const Problem& p, const collision::Obstacle& obstacle,
-                                    const IncrementalPlannerOptions& o) {
+                                    const IncrementalPlannerOptions& o,
+                                    std::shared_ptr<CollisionContext>& ctx) {
   std::vector<Entry> out;
   if (p.model->collision.empty()) return out;
   const Objectives& obj = p.objectives;
-  auto ctx = std::make_shared<CollisionContext>(
-      p.model, std::vector<collision::Obstacle>{obstacle},
-      obj.collision_epsilon + o.batch.graph.collision_query_margin);
+  if (!ctx) {
+    ctx = std::make_shared<CollisionContext>(
+        p.model, std::vector<collision::Obstacle>{obstacle},
+        obj.collision_epsilon + o.batch.graph.collision_query_margin);
+  }
   if (ctx->num_pairs == 0) return out;
   const int N = p.steps, sub = std::max(0, obj.collision_substeps);
   const double dt = p.dt();
@@ -270,7 +292,9 @@ Plan IncrementalPlanner::batch_solve(const Problem& problem, const Eigen::Matrix
         return failed(method, "invalid_problem",
                       "obstacle id " + std::to_string(o.id) + " is repeated");
       }
-      for (Entry& e : obstacle_entries(problem, o, options_)) state->entries.push_back(e);
+      std::shared_ptr<CollisionContext> ctx;
+      for (Entry& e : obstacle_entries(problem, o, options_, ctx)) state->entries.push_back(e);
+      state->contexts[o.id] = ctx;
     }
   } catch (const std::exception& e) {
     return failed(method, "invalid_problem", e.what());
@@ -333,7 +357,7 @@ Plan IncrementalPlanner::batch_solve(const Problem& problem, const Eigen::Matrix
   stats.status = status;
 
   // The Bayes tree at the solution, with a moderate penalty (the multipliers hold the forces).
-  state->mu = std::min(al.penalty(), options_.penalty);
+  state->mu = std::clamp(al.penalty(), options_.penalty, options_.max_penalty);
   for (Entry& e : state->entries) {
     if (e.constrained) e.constrained->set_penalty(state->mu);
   }
@@ -426,11 +450,28 @@ Plan IncrementalPlanner::plan(const Problem& problem, const Plan* warm) {
   if (!p.success() && batch.success()) {
     spdlog::debug("incremental planner: the re-solve on the incremental graph did not validate");
   }
+  if (state_) {
+    // Settle the Bayes tree at its own optimum (moderate μ), so that the next replan starts
+    // there; the settled plan is reported when it validates.
+    const bool fallback = options_.fallback;
+    options_.fallback = false;
+    const Plan settled = replan(ProblemChange());
+    options_.fallback = fallback;
+    if (settled.success() || !p.success()) {
+      const SolveStats stats = p.stats;
+      p = settled;
+      p.stats.method = stats.method;
+      p.stats.iterations = stats.iterations + settled.stats.iterations;
+      p.stats.outer_iterations = stats.outer_iterations + settled.stats.outer_iterations;
+      p.stats.linear_solves = stats.linear_solves + settled.stats.linear_solves;
+    }
+    stats_.method = p.stats.method;
+  }
   p.stats.iterations += batch.stats.iterations;
   p.stats.outer_iterations += batch.stats.outer_iterations;
   p.stats.linear_solves += batch.stats.linear_solves;
   p.stats.solve_time_s = seconds_since(t0);
-  plan_.stats = p.stats;
+  plan_ = p;
   return p;
 }
 
@@ -523,13 +564,25 @@ Plan IncrementalPlanner::replan(const ProblemChange& change) {
     }
     for (const collision::Obstacle& o : next.obstacles) {
       if (!timing && changed_obstacles.count(o.id) == 0) continue;
-      std::vector<Entry> es = obstacle_entries(next, o, options_);
+      // A static obstacle that keeps its shape is moved in its own collision world (building
+      // one costs more than the replan); otherwise the world is rebuilt.
+      std::shared_ptr<CollisionContext> ctx;
+      const auto old_it = std::find_if(problem_.obstacles.begin(), problem_.obstacles.end(),
+                                       [&o](const collision::Obstacle& x) { return x.id == o.id; });
+      if (old_it != problem_.obstacles.end() && st.contexts.count(o.id) > 0 &&
+          same_shape(old_it->shape, o.shape) && !o.is_moving() && !old_it->is_moving()) {
+        ctx = st.contexts[o.id];
+        if (!ctx->world.move_obstacle(o.id, o.pose).ok) ctx = nullptr;
+      }
+      std::vector<Entry> es = obstacle_entries(next, o, options_, ctx);
+      st.contexts[o.id] = ctx;
       const auto& old = old_collision[o.id];
       for (size_t i = 0; i < es.size(); ++i) {
         if (i < old.size()) carry_multipliers(old[i], es[i].constrained.get());
         added.push_back(es[i]);
       }
     }
+    for (int id : change.remove) st.contexts.erase(id);
     for (Entry& e : added) {
       if (e.constrained) e.constrained->set_penalty(st.mu);
     }
@@ -574,7 +627,9 @@ Plan IncrementalPlanner::replan(const ProblemChange& change) {
   const AugmentedLagrangianOptions& alo = options_.batch.augmented_lagrangian;
   std::string status = "max_updates";
   std::string reason;
+  const double change_s = seconds_since(t0);
   double round_tol = options_.relative_error_tol;
+  std::vector<double> violations;
   bool polish = false;
   st.last_violation = -1;
   while (stats_.updates < options_.max_updates) {
@@ -620,9 +675,12 @@ Plan IncrementalPlanner::replan(const ProblemChange& change) {
     const graph::Values& values = st.isam->estimate();
     double worst = 0;
     const Entry* worst_entry = nullptr;
-    for (const Entry& en : st.entries) {
+    violations.resize(st.entries.size());
+    for (size_t i = 0; i < st.entries.size(); ++i) {
+      const Entry& en = st.entries[i];
       if (!en.constrained) continue;
       const double v = en.constrained->scaled_violation(values);
+      violations[i] = v;
       if (v > worst) {
         worst = v;
         worst_entry = &en;
@@ -660,6 +718,10 @@ Plan IncrementalPlanner::replan(const ProblemChange& change) {
     for (size_t i = 0; i < st.entries.size(); ++i) {
       Entry& en = st.entries[i];
       if (!en.constrained) continue;
+      // Nothing to update where the rows hold and no bound multiplier is left to shrink.
+      if (!grow && violations[i] <= 0.5 * tol && !has_bound_multipliers(*en.constrained)) {
+        continue;
+      }
       const Eigen::VectorXd lo = en.constrained->multipliers();
       const Eigen::VectorXd up = en.constrained->multipliers_upper();
       en.constrained->update_multipliers(values);
@@ -682,6 +744,8 @@ Plan IncrementalPlanner::replan(const ProblemChange& change) {
   }
   stats_.penalty = st.mu;
   stats_.incremental_time_s = seconds_since(t0);
+  spdlog::debug("iDFGP: change applied in {:.2f} ms, updates and rounds done at {:.2f} ms",
+                change_s * 1e3, stats_.incremental_time_s * 1e3);
 
   Plan plan = make_plan("incremental");
   plan.stats.status = status;

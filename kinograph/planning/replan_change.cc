@@ -49,7 +49,8 @@ SceneChange parse_change(const std::string& yaml, const Scene& scene, const std:
     if (!list.IsSequence()) {
       throw SceneError(source, "obstacles", line_of(list), "must be a list of obstacles");
     }
-    YAML::Node obstacles = merged["obstacles"] ? merged["obstacles"] : YAML::Node(YAML::NodeType::Sequence);
+    YAML::Node obstacles =
+        merged["obstacles"] ? merged["obstacles"] : YAML::Node(YAML::NodeType::Sequence);
     for (size_t i = 0; i < list.size(); ++i) {
       const std::string key = "obstacles[" + std::to_string(i) + "]";
       if (!list[i].IsMap() || !list[i]["id"]) {
