@@ -10,6 +10,7 @@
 #include "kinograph/collision/collision_world.h"
 #include "kinograph/dynamics/kinematics.h"
 #include "kinograph/planning/batch_planner.h"
+#include "kinograph/planning/replan_change.h"
 #include "kinograph/planning/replan_factors.h"
 #include "kinograph/planning/scene.h"
 #include "kinograph/planning/trajectory_factors.h"
@@ -227,6 +228,73 @@ TEST(IncrementalPlanner, InvalidChangesAreRejected) {
   Goal ok;
   ok.q = Eigen::Vector2d(1.1, 0.7);
   EXPECT_TRUE(planner.set_goal(ok).success());
+}
+
+// Change files: the scene schema for goals, starts and obstacles; ids by scene name.
+TEST(ReplanChange, ParsesGoalStartHorizonAndObstacles) {
+  const Scene scene = load_scene(kScenes + "rr_reach.yaml");
+  const SceneChange c = parse_change(
+      "goal: {q: [1.0, 0.9]}\n"
+      "start: {q: [-1.1, -0.5], qd: [0.1, 0]}\n"
+      "horizon: 3.0\n"
+      "obstacles:\n"
+      "  - {id: ball, shape: sphere, size: [0.15], position: [0.3, 0, 1.5]}\n"
+      "  - {id: pebble, shape: box, size: [0.1, 0.1, 0.1], position: [1, 0, 0.5]}\n",
+      scene);
+  ASSERT_TRUE(c.change.goal.has_value());
+  EXPECT_TRUE(c.change.goal->q.isApprox(Eigen::Vector2d(1.0, 0.9)));
+  EXPECT_TRUE(c.change.start_q->isApprox(Eigen::Vector2d(-1.1, -0.5)));
+  EXPECT_TRUE(c.change.start_qd->isApprox(Eigen::Vector2d(0.1, 0)));
+  EXPECT_EQ(*c.change.horizon, 3.0);
+  ASSERT_EQ(c.change.add_or_move.size(), 2u);
+  EXPECT_EQ(c.change.add_or_move[0].id, 0);  // the scene's ball, moved
+  EXPECT_TRUE(c.change.add_or_move[0].pose.translation().isApprox(Eigen::Vector3d(0.3, 0, 1.5)));
+  EXPECT_EQ(c.change.add_or_move[1].id, 1);  // new
+  EXPECT_EQ(c.added_names, std::vector<std::string>{"pebble"});
+  const Scene next = apply_change(scene, c);
+  EXPECT_EQ(next.obstacle_names, (std::vector<std::string>{"ball", "pebble"}));
+  EXPECT_EQ(next.problem.horizon, 3.0);
+
+  const SceneChange r = parse_change("remove: [ball]", scene);
+  EXPECT_EQ(r.change.remove, std::vector<int>{0});
+  EXPECT_TRUE(apply_change(scene, r).problem.obstacles.empty());
+}
+
+TEST(ReplanChange, BadInputNamesTheKey) {
+  const Scene scene = load_scene(kScenes + "rr_reach.yaml");
+  auto key_of = [&scene](const std::string& yaml) {
+    try {
+      parse_change(yaml, scene, "change.yaml");
+    } catch (const SceneError& e) {
+      EXPECT_NE(std::string(e.what()).find("change.yaml"), std::string::npos) << e.what();
+      return e.key();
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(key_of("gaol: {q: [1, 1]}"), "gaol");
+  EXPECT_EQ(key_of("remove: [nothing]"), "remove[0]");
+  EXPECT_EQ(key_of("obstacles: [{shape: sphere, size: [0.1]}]"), "obstacles[0]");
+  EXPECT_EQ(key_of("obstacles: [{id: ball, shape: sphere, size: [0.1]}]\nremove: [ball]"),
+            "remove[0]");
+  EXPECT_NE(key_of("goal: {q: [1, 2, 3]}"), "no error");
+  EXPECT_NE(key_of("[1, 2"), "no error");
+  EXPECT_THROW(load_change("/nonexistent/change.yaml", scene), SceneError);
+}
+
+// Every shipped change file parses for its scene and replans to a valid plan (RR ones).
+TEST(ReplanChange, ShippedChangeFiles) {
+  const Scene rr = load_scene(kScenes + "rr_reach.yaml");
+  for (const char* name : {"rr_reach_goal", "rr_reach_move_ball", "rr_reach_start"}) {
+    const SceneChange c = load_change(kScenes + "changes/" + name + ".yaml", rr);
+    IncrementalPlanner planner;
+    ASSERT_TRUE(planner.plan(rr.problem).success());
+    const Plan re = planner.replan(c.change);
+    EXPECT_TRUE(re.success()) << name << ": " << failures(re);
+  }
+  const Scene desk = load_scene(kScenes + "iiwa_desk.yaml");
+  for (const char* name : {"iiwa_desk_goal", "iiwa_desk_add_box"}) {
+    EXPECT_NO_THROW(load_change(kScenes + "changes/" + name + ".yaml", desk)) << name;
+  }
 }
 
 }  // namespace
