@@ -7,22 +7,28 @@
 // does not validate.
 //
 // Differences from the batch graph (build_graph), all of the same cost function:
-//  - the start (q_0, q̇_0) and a joint goal q_N are equality constraints (StateTargetFactor), not
-//    fixed variables, so that changing them is a factor replacement (ISAM2 cannot change a
-//    variable's value or fixed flag); q̇_N = q̈_N = 0 stay fixed (every goal is at rest);
+//  - the start (q_0, q̇_0) is a strong linear prior and a joint goal q_N an equality constraint
+//    (StateTargetFactor), not fixed variables, so that changing them is a factor replacement
+//    (ISAM2 cannot change a variable's value or fixed flag); q̇_N = q̈_N = 0 stay fixed (every
+//    goal is at rest). The first plan is solved with them fixed, exactly as BatchPlanner, and
+//    converted (the goal's multipliers from the stationarity of the Lagrangian at q_N);
 //  - each obstacle has its own collision factors (one per state and sub-step), so adding,
 //    moving or removing one obstacle touches only its own factors;
-//  - during incremental updates the penalty μ is moderate (`penalty`), the multipliers carry the
-//    constraint forces: with the large μ a batch solve may end with, ISAM2's Gauss–Newton steps
-//    are badly conditioned (issue 6).
+//  - during incremental updates the penalty μ stays moderate (the batch's final μ clamped to
+//    [penalty, max_penalty]) and the multipliers carry the constraint forces: with the large μ a
+//    batch solve may end with, Gauss–Newton steps are badly conditioned (issue 6).
 //
-// Stopping rule of a replan: ISAM2 updates (relinearizing what moved past the threshold) until
-// the relative change of the error is below `relative_error_tol` and nothing was relinearized,
-// then one update relinearizing every moved variable (the "polish"); if every constraint row's
-// scaled violation is then below the batch planner's constraint_tolerance the replan is done,
-// otherwise the multipliers of the rows whose update is significant (|Δλ|/μ above the tolerance)
-// are updated, their factors re-added, and the sweeps continue; at most `max_updates` ISAM2
-// updates in all.
+// Stopping rule of a replan. Every ISAM2 update is a safeguarded Gauss–Newton step (LM-damped
+// when the error would rise) that relinearizes every moved variable. At one multiplier estimate
+// the updates settle when one lowers the error by less than a relative tolerance (first
+// `relative_error_tol`, 10× smaller after each multiplier round, at least
+// `final_relative_error_tol`). Then: if some constraint row's scaled violation exceeds the batch
+// planner's constraint_tolerance, a multiplier round λ ← λ + μc runs on the rows that are
+// violated or hold a bound multiplier, the factors whose multipliers changed by more than half
+// the tolerance (scaled) are re-added, and μ grows (×penalty_growth, up to max_penalty) when the
+// violation did not shrink enough since the last round; if the constraints hold but the
+// tolerance is not yet the final one, sweeping continues at the final tolerance; otherwise one
+// polish update ends the replan. At most `max_updates` updates and `max_rounds` rounds.
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <map>
@@ -50,7 +56,7 @@ struct IncrementalPlannerOptions {
     o.relinearize_threshold = 0.01;
     return o;
   }();
-  /// Penalty μ of every constraint row during incremental updates (moderate, see file comment).
+  /// Smallest penalty μ of the constraint rows during incremental updates (see file comment).
   double penalty = 100;
   /// μ may grow (×batch.augmented_lagrangian.penalty_growth) up to this when the violation does
   /// not shrink between multiplier rounds.
