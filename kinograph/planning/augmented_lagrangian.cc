@@ -17,23 +17,22 @@ void AugmentedLagrangian::set_penalty(double mu) {
 
 ConstraintReport AugmentedLagrangian::report(const graph::Values& values) const {
   ConstraintReport r;
+  const ConstrainedFactor* worst = nullptr;
   for (const auto& f : factors_) {
-    const double s = f->scaled_violation(values);
-    if (s > r.scaled_violation) {
-      r.scaled_violation = s;
-      r.violation = f->violation(values);
-      r.where = f->name() + " " + f->keys().front().to_string();
+    const ConstrainedFactor::Violation v = f->check(values);
+    if (v.scaled > r.scaled_violation) {
+      r.scaled_violation = v.scaled;
+      r.violation = v.own_units;
+      worst = f.get();
     }
   }
+  if (worst != nullptr) r.where = worst->name() + " " + worst->keys().front().to_string();
   return r;
 }
 
 double AugmentedLagrangian::update(const graph::Values& values) {
   double worst = 0;
-  for (auto& f : factors_) {
-    worst = std::max(worst, f->scaled_violation(values));
-    f->update_multipliers(values);
-  }
+  for (auto& f : factors_) worst = std::max(worst, f->update_multipliers(values).scaled);
   if (last_violation_ >= 0 && worst > options_.required_decrease * last_violation_) {
     set_penalty(std::min(options_.max_penalty, mu_ * options_.penalty_growth));
   }

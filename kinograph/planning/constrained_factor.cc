@@ -80,9 +80,17 @@ void ConstrainedFactor::evaluate(const graph::FactorValues& x, Eigen::Ref<Eigen:
 }
 
 void ConstrainedFactor::values_at(const graph::Values& values, Eigen::VectorXd& z) const {
-  std::vector<const double*> ptrs(keys().size());
-  for (size_t k = 0; k < keys().size(); ++k) ptrs[k] = values.at(keys()[k]).data();
   z.setZero(residual_dim());
+  compute_at(values, z);
+}
+
+void ConstrainedFactor::compute_at(const graph::Values& values,
+                                   Eigen::Ref<Eigen::VectorXd> z) const {
+  // Per-thread key pointers that only grow: the outer loop calls this for every factor.
+  thread_local std::vector<const double*> ptrs;
+  if (ptrs.size() < keys().size()) ptrs.resize(keys().size());
+  for (size_t k = 0; k < keys().size(); ++k) ptrs[k] = values.at(keys()[k]).data();
+  z.setZero();
   compute(graph::FactorValues(ptrs.data(), dims().data()), z, nullptr);
 }
 
@@ -99,12 +107,55 @@ double row_violation(const RowSpec& row, double z) {
   }
   return 0;
 }
+
+// Raw values of `f` at `values` in a per-thread buffer (valid until the next call).
+Eigen::Ref<Eigen::VectorXd> raw_values(const ConstrainedFactor& f, const graph::Values& values) {
+  thread_local Eigen::VectorXd z;
+  if (z.size() < f.residual_dim()) z.resize(f.residual_dim());
+  auto head = z.head(f.residual_dim());
+  f.compute_at(values, head);
+  return head;
+}
 }  // namespace
+
+ConstrainedFactor::Violation ConstrainedFactor::check(const graph::Values& values) const {
+  return scan(values, nullptr, nullptr);
+}
+
+ConstrainedFactor::Violation ConstrainedFactor::update_multipliers(const graph::Values& values) {
+  return scan(values, &lambda_, &lambda_upper_);
+}
+
+ConstrainedFactor::Violation ConstrainedFactor::scan(const graph::Values& values,
+                                                     Eigen::VectorXd* lambda,
+                                                     Eigen::VectorXd* lambda_upper) const {
+  const bool update = lambda != nullptr;
+  Violation v;
+  if (num_constraints_ == 0) return v;
+  const Eigen::Ref<Eigen::VectorXd> z = raw_values(*this, values);
+  for (int i = 0; i < residual_dim(); ++i) {
+    const RowSpec& row = rows_[i];
+    if (row.kind == RowKind::kSoft) continue;
+    const double viol = row_violation(row, z[i]);
+    if (viol / row.scale > v.scaled) {
+      v.scaled = viol / row.scale;
+      v.own_units = viol;
+    }
+    if (!update) continue;
+    if (row.kind == RowKind::kEquality) {
+      (*lambda)[i] += mu_ * (z[i] - row.lower) / row.scale;
+    } else {
+      // Infinite bounds give -inf here and clip to 0.
+      (*lambda)[i] = std::max(0.0, (*lambda)[i] + mu_ * (row.lower - z[i]) / row.scale);
+      (*lambda_upper)[i] = std::max(0.0, (*lambda_upper)[i] + mu_ * (z[i] - row.upper) / row.scale);
+    }
+  }
+  return v;
+}
 
 double ConstrainedFactor::violation(const graph::Values& values) const {
   if (num_constraints_ == 0) return 0;
-  Eigen::VectorXd z;
-  values_at(values, z);
+  const Eigen::Ref<Eigen::VectorXd> z = raw_values(*this, values);
   double worst = 0;
   for (int i = 0; i < residual_dim(); ++i) worst = std::max(worst, row_violation(rows_[i], z[i]));
   return worst;
@@ -112,30 +163,13 @@ double ConstrainedFactor::violation(const graph::Values& values) const {
 
 double ConstrainedFactor::scaled_violation(const graph::Values& values) const {
   if (num_constraints_ == 0) return 0;
-  Eigen::VectorXd z;
-  values_at(values, z);
+  const Eigen::Ref<Eigen::VectorXd> z = raw_values(*this, values);
   double worst = 0;
   for (int i = 0; i < residual_dim(); ++i) {
     if (rows_[i].kind == RowKind::kSoft) continue;
     worst = std::max(worst, row_violation(rows_[i], z[i]) / rows_[i].scale);
   }
   return worst;
-}
-
-void ConstrainedFactor::update_multipliers(const graph::Values& values) {
-  if (num_constraints_ == 0) return;
-  Eigen::VectorXd z;
-  values_at(values, z);
-  for (int i = 0; i < residual_dim(); ++i) {
-    const RowSpec& row = rows_[i];
-    if (row.kind == RowKind::kEquality) {
-      lambda_[i] += mu_ * (z[i] - row.lower) / row.scale;
-    } else if (row.kind == RowKind::kBounds) {
-      // Infinite bounds give -inf here and clip to 0.
-      lambda_[i] = std::max(0.0, lambda_[i] + mu_ * (row.lower - z[i]) / row.scale);
-      lambda_upper_[i] = std::max(0.0, lambda_upper_[i] + mu_ * (z[i] - row.upper) / row.scale);
-    }
-  }
 }
 
 }  // namespace kinograph::planning

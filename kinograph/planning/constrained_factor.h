@@ -62,14 +62,30 @@ class ConstrainedFactor : public graph::Factor {
 
   /// Raw values z at `values` (for reports and multiplier updates).
   void values_at(const graph::Values& values, Eigen::VectorXd& z) const;
+  /// The same into a preallocated z (residual_dim rows); allocates nothing.
+  void compute_at(const graph::Values& values, Eigen::Ref<Eigen::VectorXd> z) const;
+
+  /// The worst constraint row at some values: its violation scaled (|c| = violation / s) and in
+  /// its own units.
+  struct Violation {
+    double scaled = 0;
+    double own_units = 0;
+  };
+  /// The worst constraint row at `values` (one evaluation, no allocation).
+  Violation check(const graph::Values& values) const;
   /// Largest constraint violation in the rows' own units (|z − t| or the bound excess).
   double violation(const graph::Values& values) const;
   /// Largest violation measured in scaled units (|c| = violation / s).
   double scaled_violation(const graph::Values& values) const;
-  /// First-order multiplier update λ ← λ + μc (bounds clipped ≥ 0) at `values`.
-  void update_multipliers(const graph::Values& values);
+  /// First-order multiplier update λ ← λ + μc (bounds clipped ≥ 0) at `values`; returns the
+  /// worst row before the update, from the same evaluation.
+  Violation update_multipliers(const graph::Values& values);
 
  private:
+  // check() and, with non-null multipliers, their update from the same evaluation.
+  Violation scan(const graph::Values& values, Eigen::VectorXd* lambda,
+                 Eigen::VectorXd* lambda_upper) const;
+
   std::vector<RowSpec> rows_;
   int num_constraints_ = 0;
   double mu_ = 1.0;
