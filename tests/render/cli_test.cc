@@ -36,7 +36,9 @@ CliRun run(const std::string& args) {
 class Cli : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / "kinograph_render_cli_test";
+    dir_ = fs::temp_directory_path() /
+           (std::string("kinograph_render_cli_test") + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::create_directories(dir_);
     plan_ = (dir_ / "iiwa.json").string();
     write_plan_json(test::iiwa_test_plan(10), plan_);

@@ -81,7 +81,9 @@ TEST(Primitives, TubeFollowsThePolyline) {
 class MeshFiles : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() / "kinograph_mesh_test";
+    dir_ = std::filesystem::temp_directory_path() /
+           (std::string("kinograph_mesh_test") + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
     std::filesystem::create_directories(dir_);
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }

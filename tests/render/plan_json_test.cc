@@ -16,7 +16,9 @@ namespace fs = std::filesystem;
 class PlanJson : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / "kinograph_plan_json_test";
+    dir_ = fs::temp_directory_path() /
+           (std::string("kinograph_plan_json_test") + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::create_directories(dir_);
   }
   void TearDown() override { fs::remove_all(dir_); }
