@@ -173,10 +173,7 @@ Plan BatchPlanner::plan(const Problem& problem, const Plan* warm) const {
         p.stats.max_constraint_violation < best.stats.max_constraint_violation) {
       best = std::move(p);
     }
-    if (best.success() || best.stats.status == "invalid_problem" ||
-        best.stats.status == "non_finite") {
-      break;
-    }
+    if (best.success() || best.stats.status == "invalid_problem") break;
     add_detours(false);
   }
   const SolveStats own = best.stats;

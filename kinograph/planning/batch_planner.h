@@ -44,13 +44,15 @@ struct BatchPlannerOptions {
   int max_inner_iterations = 15;          ///< LM linearizations per outer iteration
   int max_total_iterations = 400;         ///< LM linearizations over the whole plan
   double inner_tolerance_initial = 1e-2;  ///< LM relative decrease in the first outer iteration
-  /// ... tightened by 10× per outer iteration to this. Loose: once feasible, further objective
-  /// decrease is small (the soft cost changes by well under 1 %) and costs many LM iterations.
+  /// ... tightened by 10× per outer iteration to this. Loose: plans are feasible long before
+  /// their objective is polished (1e-7 took 142 instead of 91 LM iterations on the Acrobot
+  /// swing-up for a soft cost 3 % lower: 6181 instead of 6350).
   double inner_tolerance_final = 1e-3;
   ValidationThresholds validation;
   /// When the straight-line (L) plan of a problem with obstacles does not validate, up to this
   /// many more attempts start from detours (via_point() through detour_candidates()); the plan
-  /// returned is the first that validates, and its stats count every attempt. 0 = never.
+  /// returned is the first that validates (else the one with the smallest constraint violation),
+  /// and its stats count every attempt; each attempt has its own iteration limits. 0 = never.
   int max_restarts = 4;
   /// Start from the best detour instead when the straight line collides and the detour's path
   /// does not (the straight line is then the first restart).
