@@ -1,10 +1,13 @@
 #include "kinograph/planning/plan_json.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <sstream>
+
+#include "kinograph/dynamics/payload.h"
 
 namespace kinograph::planning {
 namespace {
@@ -60,20 +63,155 @@ std::string portable_path(const std::string& path) {
   return p.string();
 }
 
-std::string shape_name(collision::ShapeKind kind) {
-  switch (kind) {
-    case collision::ShapeKind::kSphere:
-      return "sphere";
-    case collision::ShapeKind::kBox:
-      return "box";
-    case collision::ShapeKind::kCylinder:
-      return "cylinder";
-    case collision::ShapeKind::kCapsule:
-      return "capsule";
-    case collision::ShapeKind::kMesh:
-      return "mesh";
+// A list of `size` finite numbers (any length when size < 0).
+Eigen::VectorXd read_vector(const json& j, const std::string& source, const std::string& key,
+                            int size) {
+  if (!j.is_array()) fail(source, key, "must be an array of numbers");
+  if (size >= 0 && j.size() != static_cast<std::size_t>(size)) {
+    fail(source, key,
+         "must have " + std::to_string(size) + " numbers, has " + std::to_string(j.size()));
   }
-  return "box";
+  Eigen::VectorXd v(j.size());
+  for (std::size_t i = 0; i < j.size(); ++i) {
+    const std::string item = key + "[" + std::to_string(i) + "]";
+    if (!j[i].is_number()) fail(source, item, "must be a number");
+    v[i] = j[i].get<double>();
+    if (!std::isfinite(v[i])) fail(source, item, "must be finite");
+  }
+  return v;
+}
+
+// "position" and "quaternion" [w, x, y, z] of `j` (each optional: origin, identity).
+Eigen::Isometry3d read_pose(const json& j, const std::string& source, const std::string& key) {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  if (j.contains("position")) {
+    pose.translation() = read_vector(j["position"], source, key + ".position", 3);
+  }
+  if (j.contains("quaternion")) {
+    const Eigen::VectorXd q = read_vector(j["quaternion"], source, key + ".quaternion", 4);
+    const Eigen::Quaterniond r(q[0], q[1], q[2], q[3]);
+    if (r.norm() < 1e-9) fail(source, key + ".quaternion", "must not be zero");
+    pose.linear() = r.normalized().toRotationMatrix();
+  }
+  return pose;
+}
+
+std::string anchor_of(const std::string& source) {
+  return source.empty() ? std::string() : fs::absolute(source).parent_path().string();
+}
+
+std::optional<PayloadSpec> read_payload(const json& robot, const std::string& source) {
+  if (!robot.contains("payload") || robot["payload"].is_null()) return std::nullopt;
+  const json& p = robot["payload"];
+  if (!p.is_object()) fail(source, "robot.payload", "must be an object");
+  PayloadSpec payload;
+  if (!p.contains("frame") || !p["frame"].is_string()) {
+    fail(source, "robot.payload.frame", "missing string");
+  }
+  payload.frame = p["frame"].get<std::string>();
+  if (!p.contains("mass") || !p["mass"].is_number()) {
+    fail(source, "robot.payload.mass", "missing number");
+  }
+  payload.mass = p["mass"].get<double>();
+  if (!p.contains("size")) fail(source, "robot.payload.size", "missing array");
+  payload.size = read_vector(p["size"], source, "robot.payload.size", 3);
+  if (p.contains("offset")) {
+    payload.offset = read_vector(p["offset"], source, "robot.payload.offset", 3);
+  }
+  return payload;
+}
+
+collision::Shape read_shape(const json& o, const std::string& source, const std::string& key) {
+  std::string name = "box";  // hand-written files may leave the commonest shape out
+  if (o.contains("shape")) {
+    if (!o["shape"].is_string()) fail(source, key + ".shape", "must be a string");
+    name = o["shape"].get<std::string>();
+  }
+  const std::optional<collision::ShapeKind> kind = shape_kind_from_name(name);
+  if (!kind) {
+    fail(source, key + ".shape",
+         "is '" + name + "'; expected box, sphere, cylinder, capsule or mesh");
+  }
+  const std::string size_key = key + ".size";
+  if (*kind == collision::ShapeKind::kMesh) {
+    if (!o.contains("mesh") || !o["mesh"].is_string())
+      fail(source, key + ".mesh", "missing string");
+    const std::string mesh = o["mesh"].get<std::string>();
+    const std::optional<std::string> path = resolve_plan_path(mesh, source);
+    if (!path) fail(source, key + ".mesh", "file '" + mesh + "' not found");
+    // The writer puts a mesh's scale under "size".
+    Eigen::Vector3d scale = Eigen::Vector3d::Ones();
+    if (o.contains("size")) scale = read_vector(o["size"], source, size_key, 3);
+    return collision::Shape::mesh(*path, scale);
+  }
+  const int count = *kind == collision::ShapeKind::kBox      ? 3
+                    : *kind == collision::ShapeKind::kSphere ? 1
+                                                             : 2;
+  if (!o.contains("size")) fail(source, size_key, "missing array");
+  const Eigen::VectorXd size = read_vector(o["size"], source, size_key, count);
+  if (size.minCoeff() <= 0) fail(source, size_key, "every size must be > 0");
+  switch (*kind) {
+    case collision::ShapeKind::kBox:
+      return collision::Shape::box(size[0], size[1], size[2]);
+    case collision::ShapeKind::kSphere:
+      return collision::Shape::sphere(size[0]);
+    case collision::ShapeKind::kCylinder:
+      return collision::Shape::cylinder(size[0], size[1]);
+    default:
+      return collision::Shape::capsule(size[0], size[1]);
+  }
+}
+
+collision::PoseTrajectory read_motion(const json& list, const std::string& source,
+                                      const std::string& key) {
+  if (!list.is_array() || list.empty()) {
+    fail(source, key, "must be a non-empty array of {t, position, quaternion}");
+  }
+  std::vector<double> times;
+  std::vector<Eigen::Isometry3d> poses;
+  for (std::size_t k = 0; k < list.size(); ++k) {
+    const std::string sample = key + "[" + std::to_string(k) + "]";
+    if (!list[k].is_object()) fail(source, sample, "must be an object");
+    if (!list[k].contains("t") || !list[k]["t"].is_number()) {
+      fail(source, sample + ".t", "missing number");
+    }
+    const double t = list[k]["t"].get<double>();
+    if (!std::isfinite(t) || (!times.empty() && !(t > times.back()))) {
+      fail(source, sample + ".t", "times must be finite and increase strictly");
+    }
+    times.push_back(t);
+    poses.push_back(read_pose(list[k], source, sample));
+  }
+  return collision::PoseTrajectory(std::move(times), std::move(poses));
+}
+
+// "limits.<key>": one number per joint column (null as `null_value`); empty when absent.
+std::vector<double> read_limit(const json& limits, const char* key, const std::string& source,
+                               std::size_t columns, double null_value) {
+  std::vector<double> out;
+  if (!limits.contains(key)) return out;
+  const std::string name = std::string("limits.") + key;
+  const json& list = limits[key];
+  if (!list.is_array()) fail(source, name, "must be an array of numbers");
+  if (columns > 0 && list.size() != columns) {
+    fail(source, name,
+         "has " + std::to_string(list.size()) + " values for " + std::to_string(columns) +
+             " joints");
+  }
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    out.push_back(read_number(list[i], source, name + "[" + std::to_string(i) + "]", null_value));
+  }
+  return out;
+}
+
+json read_json_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw PlanFileError("cannot open plan file '" + path + "'");
+  try {
+    return json::parse(in);
+  } catch (const json::parse_error& e) {
+    throw PlanFileError("plan '" + path + "' is not valid JSON: " + e.what());
+  }
 }
 
 // Plan matrix `key` (rows × width) with columns picked by `column`.
@@ -255,7 +393,7 @@ json plan_to_json(const Plan& plan, const Scene& scene) {
     const collision::Obstacle& o = problem.obstacles[i];
     json oj;
     oj["id"] = i < scene.obstacle_names.size() ? scene.obstacle_names[i] : std::to_string(o.id);
-    oj["shape"] = shape_name(o.shape.kind);
+    oj["shape"] = shape_kind_name(o.shape.kind);
     switch (o.shape.kind) {
       case collision::ShapeKind::kBox:
         oj["size"] = vector(o.shape.size);
@@ -370,15 +508,131 @@ Plan plan_from_json(const json& j, const dynamics::Model& model, const std::stri
 }
 
 Plan read_plan(const std::string& path, const dynamics::Model& model) {
-  std::ifstream in(path);
-  if (!in) throw PlanFileError("cannot open plan file '" + path + "'");
-  json j;
-  try {
-    j = json::parse(in);
-  } catch (const json::parse_error& e) {
-    throw PlanFileError("plan '" + path + "' is not valid JSON: " + e.what());
+  return plan_from_json(read_json_file(path), model, path);
+}
+
+PlanFileInfo plan_info_from_json(const json& j, const std::string& source) {
+  if (!j.is_object()) fail(source, "", "the top level must be a JSON object");
+  PlanFileInfo info;
+  info.source = source;
+  if (j.contains("name") && j["name"].is_string()) info.name = j["name"].get<std::string>();
+  if (!j.contains("robot") || !j["robot"].is_object()) fail(source, "robot", "missing object");
+  const json& robot = j["robot"];
+  if (!robot.contains("urdf") || !robot["urdf"].is_string()) {
+    fail(source, "robot.urdf", "missing string");
   }
-  return plan_from_json(j, model, path);
+  info.urdf = robot["urdf"].get<std::string>();
+  info.payload = read_payload(robot, source);
+  if (j.contains("obstacles")) {
+    const json& list = j["obstacles"];
+    if (!list.is_array()) fail(source, "obstacles", "must be an array");
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const std::string key = "obstacles[" + std::to_string(i) + "]";
+      const json& o = list[i];
+      if (!o.is_object()) fail(source, key, "must be an object");
+      collision::Obstacle obstacle;
+      obstacle.id = static_cast<int>(i);
+      obstacle.shape = read_shape(o, source, key);
+      obstacle.pose = read_pose(o, source, key);
+      if (o.contains("motion"))
+        obstacle.trajectory = read_motion(o["motion"], source, key + ".motion");
+      std::optional<Eigen::Vector4d> rgba;
+      if (o.contains("rgba")) rgba = read_vector(o["rgba"], source, key + ".rgba", 4);
+      info.obstacles.push_back(std::move(obstacle));
+      info.obstacle_names.push_back(
+          o.contains("id") && o["id"].is_string() ? o["id"].get<std::string>() : key);
+      info.obstacle_rgba.push_back(rgba);
+    }
+  }
+  if (j.contains("joint_names")) {
+    const json& names = j["joint_names"];
+    if (!names.is_array()) fail(source, "joint_names", "must be an array of strings");
+    for (const json& name : names) {
+      if (!name.is_string()) fail(source, "joint_names", "must be an array of strings");
+      info.joint_names.push_back(name.get<std::string>());
+    }
+  }
+  if (j.contains("limits")) {
+    const json& limits = j["limits"];
+    if (!limits.is_object()) fail(source, "limits", "must be an object");
+    const std::size_t n = info.joint_names.size();
+    info.limits.lower = read_limit(limits, "lower", source, n, -kInf);
+    info.limits.upper = read_limit(limits, "upper", source, n, kInf);
+    info.limits.velocity = read_limit(limits, "velocity", source, n, kInf);
+    info.limits.acceleration = read_limit(limits, "acceleration", source, n, kInf);
+    info.limits.effort = read_limit(limits, "effort", source, n, kInf);
+  }
+  return info;
+}
+
+std::optional<std::string> resolve_plan_path(const std::string& path,
+                                             const std::string& plan_source) {
+  const fs::path p(path);
+  if (!p.is_absolute() && fs::exists(fs::current_path() / p)) {
+    return fs::weakly_canonical(fs::current_path() / p).string();
+  }
+  return resolve_scene_path(path, anchor_of(plan_source));
+}
+
+dynamics::Model load_plan_model(const PlanFileInfo& info) {
+  const std::optional<std::string> urdf = resolve_plan_path(info.urdf, info.source);
+  if (!urdf) {
+    fail(info.source, "robot.urdf",
+         "file '" + info.urdf +
+             "' not found (looked in the working directory, next to the plan and in " +
+             KINOGRAPH_SOURCE_DIR + ")");
+  }
+  dynamics::Model model;
+  try {
+    model = dynamics::Model::from_urdf_file(*urdf);
+  } catch (const std::exception& e) {
+    fail(info.source, "robot.urdf", std::string("cannot load the robot: ") + e.what());
+  }
+  if (info.payload) {
+    const PayloadSpec& p = *info.payload;
+    Eigen::Isometry3d offset = Eigen::Isometry3d::Identity();
+    offset.translation() = p.offset;
+    try {
+      model = dynamics::attach_box_payload(model, p.frame, p.mass, p.size, offset);
+    } catch (const std::exception& e) {
+      fail(info.source, "robot.payload", std::string("cannot attach: ") + e.what());
+    }
+  }
+  // The file's limits are the problem's (scene overrides included), not only the URDF's.
+  for (int i = 0; i < model.nq(); ++i) {
+    dynamics::Body& body = model.bodies[i];
+    std::size_t column = static_cast<std::size_t>(i);
+    if (!info.joint_names.empty()) {
+      const auto it = std::find(info.joint_names.begin(), info.joint_names.end(), body.joint_name);
+      if (it == info.joint_names.end()) continue;  // plan_from_json names the missing joint
+      column = static_cast<std::size_t>(it - info.joint_names.begin());
+    }
+    const auto apply = [&](const std::vector<double>& list, double& limit) {
+      if (column < list.size()) limit = list[column];
+    };
+    apply(info.limits.lower, body.limits.lower);
+    apply(info.limits.upper, body.limits.upper);
+    apply(info.limits.velocity, body.limits.velocity);
+    apply(info.limits.acceleration, body.limits.acceleration);
+    if (column < info.limits.effort.size()) {
+      body.limits.effort = info.limits.effort[column];
+      body.actuated = body.limits.effort > 0;  // the URDF convention: effort 0 is unactuated
+    }
+  }
+  return model;
+}
+
+PlanFile plan_file_from_json(const json& j, const std::string& source) {
+  PlanFile file;
+  file.info = plan_info_from_json(j, source);
+  auto model = std::make_shared<const dynamics::Model>(load_plan_model(file.info));
+  file.plan = plan_from_json(j, *model, source);
+  file.model = std::move(model);
+  return file;
+}
+
+PlanFile read_plan_file(const std::string& path) {
+  return plan_file_from_json(read_json_file(path), path);
 }
 
 }  // namespace kinograph::planning

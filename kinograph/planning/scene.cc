@@ -186,22 +186,6 @@ std::string anchor_of(const std::string& source) {
   return fs::absolute(fs::path(source)).parent_path().string();
 }
 
-std::string shape_name(collision::ShapeKind kind) {
-  switch (kind) {
-    case collision::ShapeKind::kSphere:
-      return "sphere";
-    case collision::ShapeKind::kBox:
-      return "box";
-    case collision::ShapeKind::kCylinder:
-      return "cylinder";
-    case collision::ShapeKind::kCapsule:
-      return "capsule";
-    case collision::ShapeKind::kMesh:
-      return "mesh";
-  }
-  return "box";
-}
-
 Eigen::Isometry3d make_pose(const Eigen::Vector3d& position, const Eigen::Matrix3d& rotation) {
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   pose.linear() = rotation;
@@ -567,6 +551,31 @@ SceneError::SceneError(std::string file, std::string key, int line, const std::s
       key_(std::move(key)),
       line_(line) {}
 
+std::string shape_kind_name(collision::ShapeKind kind) {
+  switch (kind) {
+    case collision::ShapeKind::kSphere:
+      return "sphere";
+    case collision::ShapeKind::kBox:
+      return "box";
+    case collision::ShapeKind::kCylinder:
+      return "cylinder";
+    case collision::ShapeKind::kCapsule:
+      return "capsule";
+    case collision::ShapeKind::kMesh:
+      return "mesh";
+  }
+  return "box";
+}
+
+std::optional<collision::ShapeKind> shape_kind_from_name(const std::string& name) {
+  for (collision::ShapeKind kind :
+       {collision::ShapeKind::kSphere, collision::ShapeKind::kBox, collision::ShapeKind::kCylinder,
+        collision::ShapeKind::kCapsule, collision::ShapeKind::kMesh}) {
+    if (shape_kind_name(kind) == name) return kind;
+  }
+  return std::nullopt;
+}
+
 std::optional<std::string> resolve_scene_path(const std::string& path,
                                               const std::string& anchor_dir) {
   const fs::path p(path);
@@ -661,7 +670,7 @@ std::string scene_to_yaml(const Scene& scene) {
       out << YAML::BeginMap;
       out << YAML::Key << "id" << YAML::Value
           << (i < scene.obstacle_names.size() ? scene.obstacle_names[i] : std::to_string(o.id));
-      out << YAML::Key << "shape" << YAML::Value << shape_name(o.shape.kind);
+      out << YAML::Key << "shape" << YAML::Value << shape_kind_name(o.shape.kind);
       switch (o.shape.kind) {
         case collision::ShapeKind::kBox:
           out << YAML::Key << "size" << YAML::Value;

@@ -80,6 +80,11 @@ Scene parse_scene(const std::string& yaml, const std::string& source = "");
 /// The YAML text of a scene (paths written resolved), such that parse_scene gives it back.
 std::string scene_to_yaml(const Scene& scene);
 
+/// The name of a shape kind in scene and plan files: box, sphere, cylinder, capsule or mesh.
+std::string shape_kind_name(collision::ShapeKind kind);
+/// The shape kind a scene or plan file names; nullopt for a name that is none of them.
+std::optional<collision::ShapeKind> shape_kind_from_name(const std::string& name);
+
 /// Resolves a path named in a scene: absolute as is; else relative to `anchor_dir` if it
 /// exists there, else relative to the repository root. Empty optional when neither exists.
 std::optional<std::string> resolve_scene_path(const std::string& path,

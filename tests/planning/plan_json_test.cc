@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 #include <random>
 
 namespace kinograph::planning {
@@ -223,6 +224,148 @@ TEST(PlanJson, ErrorsNameTheKey) {
       std::string::npos);
   EXPECT_NE(broken([](json& j) { j["q"][0][0] = "x"; }).find("p.json"), std::string::npos);
   EXPECT_THROW(read_plan("/no/such/plan.json", model), PlanFileError);
+}
+
+TEST(PlanFile, ReadsBackRobotObstaclesLimitsAndPlan) {
+  const Scene scene = parse_scene(R"(robot:
+  urdf: robots/iiwa14/iiwa14.urdf
+  payload: {frame: iiwa_link_ee_kuka, mass: 1.5, size: [0.1, 0.1, 0.2], offset: [0, 0, 0.1]}
+horizon: 2
+steps: 10
+start: {q: [0, 0, 0, 0, 0, 0, 0]}
+goal: {q: [0.1, 0, 0, 0, 0, 0, 0]}
+limits: {iiwa_joint_2: {velocity: 0.5, lower: -1}, iiwa_joint_7: {effort: 0}}
+obstacles:
+  - {id: post, shape: cylinder, size: [0.1, 0.4], position: [0.5, 0, 0.2], rpy: [0.3, 0, 0]}
+  - id: ball
+    shape: sphere
+    size: [0.2]
+    motion: [{t: 0, position: [0, 0.5, 1]}, {t: 2, position: [1, 0.5, 1], rpy: [0, 0, 1]}]
+)");
+  const Plan plan = random_plan(scene.problem, 19);
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "kinograph_plan_file_test" / "plan.json").string();
+  write_plan(plan, scene, path);
+  const PlanFile file = read_plan_file(path);
+  expect_same_plan(plan, file.plan);
+  const PlanFileInfo& info = file.info;
+  EXPECT_EQ(info.source, path);
+  EXPECT_EQ(info.urdf, "robots/iiwa14/iiwa14.urdf");
+  ASSERT_TRUE(info.payload.has_value());
+  EXPECT_EQ(info.payload->frame, "iiwa_link_ee_kuka");
+  EXPECT_EQ(info.payload->mass, 1.5);
+  EXPECT_EQ(info.payload->offset, Eigen::Vector3d(0, 0, 0.1));
+  EXPECT_EQ(info.obstacle_names, (std::vector<std::string>{"post", "ball"}));
+  ASSERT_EQ(info.obstacles.size(), 2u);
+  ASSERT_EQ(info.obstacle_rgba.size(), 2u);
+  EXPECT_FALSE(info.obstacle_rgba[0].has_value());
+  for (std::size_t i = 0; i < 2; ++i) {
+    const collision::Obstacle &a = scene.problem.obstacles[i], &b = info.obstacles[i];
+    EXPECT_EQ(b.id, static_cast<int>(i));
+    EXPECT_EQ(b.shape.kind, a.shape.kind);
+    EXPECT_EQ(b.shape.size, a.shape.size);
+    EXPECT_EQ(b.is_moving(), a.is_moving());
+    for (double t : {-1.0, 0.0, 0.7, 1.5, 3.0}) {
+      EXPECT_TRUE(b.pose_at(t).isApprox(a.pose_at(t), 1e-12)) << i << " at " << t;
+    }
+  }
+  // The robot is the problem's: payload attached, the scene's limit overrides applied.
+  const dynamics::Model& model = *file.model;
+  const dynamics::Model& expected = *scene.problem.model;
+  ASSERT_EQ(model.nq(), 7);
+  EXPECT_EQ(model.visual.size(), expected.visual.size());
+  for (int i = 0; i < 7; ++i) {
+    const dynamics::JointLimits &l = model.bodies[i].limits, &e = expected.bodies[i].limits;
+    EXPECT_EQ(l.lower, e.lower) << i;
+    EXPECT_EQ(l.upper, e.upper) << i;
+    EXPECT_EQ(l.velocity, e.velocity) << i;
+    EXPECT_EQ(l.effort, e.effort) << i;
+    EXPECT_EQ(model.bodies[i].actuated, expected.bodies[i].actuated) << i;
+  }
+  EXPECT_EQ(model.bodies[1].limits.velocity, 0.5);
+  EXPECT_FALSE(model.bodies[6].actuated);
+  EXPECT_EQ(info.limits.effort.size(), 7u);
+}
+
+TEST(PlanFile, InfiniteLimitsAndColoursAndColumnOrder) {
+  const Scene scene = load_scene(kSceneDir + "rr_reach.yaml");
+  json j = plan_to_json(random_plan(scene.problem, 2), scene);
+  j["limits"]["effort"] = {nullptr, 4.0};
+  j["limits"]["lower"] = {nullptr, -1.0};
+  j["joint_names"] = {"joint2", "joint1"};  // limits follow the names, not the model's order
+  j["obstacles"] = json::parse(R"([{"id": "a", "shape": "box", "size": [1, 2, 3],
+                                    "rgba": [1, 0, 0, 0.5]}, {"size": [0.1, 0.2, 0.3]}])");
+  const PlanFile file = plan_file_from_json(j, "p.json");
+  EXPECT_EQ(file.model->bodies[0].limits.effort, 4.0);
+  EXPECT_EQ(file.model->bodies[1].limits.effort, std::numeric_limits<double>::infinity());
+  EXPECT_EQ(file.model->bodies[0].limits.lower, -1.0);
+  EXPECT_EQ(file.model->bodies[1].limits.lower, -std::numeric_limits<double>::infinity());
+  ASSERT_EQ(file.info.obstacles.size(), 2u);
+  ASSERT_TRUE(file.info.obstacle_rgba[0].has_value());
+  EXPECT_EQ(*file.info.obstacle_rgba[0], Eigen::Vector4d(1, 0, 0, 0.5));
+  // Hand-written defaults: a box at the origin, named after its place in the list.
+  EXPECT_EQ(file.info.obstacles[1].shape.kind, collision::ShapeKind::kBox);
+  EXPECT_EQ(file.info.obstacle_names[1], "obstacles[1]");
+  EXPECT_TRUE(file.info.obstacles[1].pose.isApprox(Eigen::Isometry3d::Identity()));
+}
+
+// The message of plan_file_from_json's error, which must name the plan and the key.
+std::string file_error_of(const json& j) {
+  try {
+    plan_file_from_json(j, "p.json");
+  } catch (const PlanFileError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(PlanFile, ErrorsNameTheKey) {
+  const Scene scene = load_scene(kSceneDir + "iiwa_desk.yaml");
+  const json good = plan_to_json(random_plan(scene.problem, 4), scene);
+  ASSERT_EQ(file_error_of(good), "no error");
+  const auto expect = [&](const char* needle, auto edit) {
+    json j = good;
+    edit(j);
+    const std::string what = file_error_of(j);
+    EXPECT_NE(what.find(needle), std::string::npos) << what;
+    EXPECT_NE(what.find("p.json"), std::string::npos) << what;
+  };
+  expect("'robot'", [](json& j) { j.erase("robot"); });
+  expect("robots/no_such.urdf", [](json& j) { j["robot"]["urdf"] = "robots/no_such.urdf"; });
+  expect("robot.payload", [](json& j) { j["robot"]["payload"]["frame"] = "no_frame"; });
+  expect("robot.payload.size", [](json& j) { j["robot"]["payload"]["size"] = {1, 2}; });
+  expect("torus", [](json& j) { j["obstacles"][1]["shape"] = "torus"; });
+  expect("obstacles[2].size", [](json& j) { j["obstacles"][2]["size"] = {1, 2}; });
+  expect("obstacles[0].quaternion", [](json& j) {
+    j["obstacles"][0]["quaternion"] = {0, 0, 0, 0};
+  });
+  expect("obstacles[0].rgba", [](json& j) { j["obstacles"][0]["rgba"] = {1, 0}; });
+  expect("gone.stl", [](json& j) {
+    j["obstacles"][0] = {{"id", "m"}, {"shape", "mesh"}, {"mesh", "meshes/gone.stl"}};
+  });
+  expect("obstacles[3].motion[1].t", [](json& j) {
+    j["obstacles"][3]["motion"] = json::parse(R"([{"t": 1, "position": [0, 0, 0]},
+                                                  {"t": 1, "position": [0, 0, 1]}])");
+  });
+  expect("limits.effort", [](json& j) { j["limits"]["effort"] = {1, 2}; });
+  expect("'q'", [](json& j) { j.erase("q"); });
+  expect("iiwa_joint_3", [](json& j) { j["joint_names"][2] = "elbow"; });
+  EXPECT_THROW(read_plan_file("/no/such/plan.json"), PlanFileError);
+}
+
+TEST(PlanFile, RelativePathsResolveNextToThePlan) {
+  const auto dir = std::filesystem::temp_directory_path() / "kinograph_plan_path_test";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "part.stl") << "solid x\nendsolid x\n";
+  const std::string plan = (dir / "plan.json").string();
+  EXPECT_EQ(resolve_plan_path("part.stl", plan),
+            std::filesystem::canonical(dir / "part.stl").string());
+  EXPECT_EQ(
+      resolve_plan_path("robots/rr/rr.urdf", plan),
+      std::filesystem::canonical(std::filesystem::path(KINOGRAPH_SOURCE_DIR) / "robots/rr/rr.urdf")
+          .string());
+  EXPECT_FALSE(resolve_plan_path("no_such_part.stl", plan).has_value());
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
