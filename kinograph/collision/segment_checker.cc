@@ -85,4 +85,75 @@ SegmentCheckResult SegmentChecker::check(CollisionWorld& world, dynamics::Data& 
   return result;
 }
 
+PathCheckResult SegmentChecker::check_path(CollisionWorld& world, dynamics::Data& data,
+                                           const Eigen::Ref<const Eigen::MatrixXd>& path,
+                                           const std::vector<double>& times, double clearance) {
+  PathCheckResult result;
+  result.min_distance = result.lower_bound = std::numeric_limits<double>::infinity();
+  const int m = static_cast<int>(path.rows());
+  if (m == 0) return result;
+  const bool moving = world.has_moving_obstacles();
+  auto time_at = [&](int i, double u) {
+    if (times.empty()) return 0.0;
+    return i + 1 < m ? times[i] + u * (times[i + 1] - times[i]) : times[i];
+  };
+  auto sweep_of = [&](int i) {
+    return (path.row(i + 1) - path.row(i)).cwiseAbs().dot(lever_.transpose());
+  };
+  auto sample = [&](int i, double u) {
+    if (i + 1 < m) {
+      q_ = path.row(i).transpose() + u * (path.row(i + 1) - path.row(i)).transpose();
+    } else {
+      q_ = path.row(i).transpose();
+    }
+    dynamics::forward_kinematics(model_, data, q_);
+    ++result.samples;
+    const double d = world.closest(data, time_at(i, u)).distance;
+    if (d < result.min_distance) {
+      result.min_distance = d;
+      result.segment = i;
+      result.s = u;
+    }
+    return d;
+  };
+
+  int i = 0;     // current segment
+  double u = 0;  // fraction along it
+  double d = sample(0, 0);
+  if (m == 1) {
+    result.lower_bound = d;
+    return result;
+  }
+  while (i < m - 1) {
+    // Sweep budget to the next sample; with moving obstacles also a time budget.
+    double budget = std::max(options_.max_sweep_step, d - clearance);
+    double time_budget = moving ? options_.max_time_step : std::numeric_limits<double>::infinity();
+    double swept = 0;
+    while (i < m - 1) {
+      const double seg_sweep = sweep_of(i);
+      const double seg_time = std::abs(time_at(i, 1) - time_at(i, 0));
+      const double left = 1 - u;
+      // The fraction of this segment the budgets allow.
+      double f = left;
+      if (seg_sweep * left > budget) f = std::min(f, budget / seg_sweep);
+      if (moving && seg_time * left > time_budget) f = std::min(f, time_budget / seg_time);
+      budget -= seg_sweep * f;
+      time_budget -= seg_time * f;
+      swept += seg_sweep * f;
+      if (f < left) {
+        u += f;
+        break;
+      }
+      ++i;
+      u = 0;
+      if (i == m - 1 || budget <= 0 || time_budget <= 0) break;
+    }
+    const double next = sample(i, u);
+    result.lower_bound = std::min(result.lower_bound, 0.5 * (d + next - swept));
+    d = next;
+  }
+  result.lower_bound = std::min(result.lower_bound, result.min_distance);
+  return result;
+}
+
 }  // namespace kinograph::collision

@@ -38,6 +38,21 @@ struct SegmentCheckResult {
   int samples = 0;
 };
 
+// The smallest signed distance found along a path (a polyline of configurations).
+struct PathCheckResult {
+  // Smallest signed distance over the configurations checked (+inf when nothing to check).
+  double min_distance = 0;
+  // A lower bound of the true distance along the whole polyline against fixed obstacles: each
+  // stretch between two samples a, b that sweeps at most L (m) stays at least (d_a + d_b − L) / 2
+  // away. Not a bound when obstacles move.
+  double lower_bound = 0;
+  // Where min_distance occurs: polyline segment index and fraction along it.
+  int segment = 0;
+  double s = 0;
+  // Number of configurations checked.
+  int samples = 0;
+};
+
 // Checks straight segments q(s) = q0 + s (q1 − q0), s ∈ [0, 1], with obstacle time
 // t(s) = t0 + s (t1 − t0). Built once per Model; check() allocates nothing.
 class SegmentChecker {
@@ -50,6 +65,15 @@ class SegmentChecker {
                            const Eigen::Ref<const Eigen::VectorXd>& q0,
                            const Eigen::Ref<const Eigen::VectorXd>& q1, double t0 = 0,
                            double t1 = 0);
+  // Minimum signed distance along the polyline through the rows of `path` (row i at obstacle
+  // time times[i]; `times` empty = all at 0) by conservative advancement: from a sample at
+  // distance d the next one is d − clearance further along the path's sweep (at least
+  // max_sweep_step, and at most max_time_step later when obstacles move), so no stretch where
+  // the robot could come closer than `clearance` is skipped, yet clear stretches cost one
+  // query. Allocates nothing after the first call with a given joint count.
+  PathCheckResult check_path(CollisionWorld& world, dynamics::Data& data,
+                             const Eigen::Ref<const Eigen::MatrixXd>& path,
+                             const std::vector<double>& times = {}, double clearance = 0);
   // Number of intervals the segment is cut into (samples − 1); the time span counts only
   // when there are moving obstacles.
   int intervals(const Eigen::Ref<const Eigen::VectorXd>& q0,

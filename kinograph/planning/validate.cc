@@ -187,23 +187,27 @@ Validation validate(const Problem& problem, const Plan& plan,
       }
     }
     if (ok) {
+      // The validator's Hermite interpolation sampled `sub` times per interval, walked by
+      // conservative advancement: stretches far from every obstacle cost one query, and near
+      // one the samples are as dense as the segment checker's sweep step.
       collision::SegmentChecker checker(model);
       const int sub = std::max(1, thresholds.collision_samples);
-      Eigen::VectorXd a, b;
+      Eigen::MatrixXd path(N * sub + 1, n);
+      std::vector<double> times(N * sub + 1);
+      const bool timed = plan.t.size() == static_cast<size_t>(rows);
       for (int k = 0; k < N; ++k) {
-        a = plan.q.row(k).transpose();
-        for (int i = 1; i <= sub; ++i) {
+        for (int i = 0; i < sub; ++i) {
           const double s = static_cast<double>(i) / sub;
-          b = i == sub ? Eigen::VectorXd(plan.q.row(k + 1).transpose()) : hermite(plan, k, s, dt);
-          const double t0 = plan.t.size() == static_cast<size_t>(rows)
-                                ? plan.t[k] + (s - 1.0 / sub) * dt
-                                : (k + s - 1.0 / sub) * dt;
-          const collision::SegmentCheckResult r =
-              checker.check(world, data, a, b, t0, t0 + dt / sub);
-          v.min_clearance = std::min(v.min_clearance, r.min_distance);
-          a = b;
+          path.row(k * sub + i) =
+              i == 0 ? Eigen::VectorXd(plan.q.row(k).transpose()) : hermite(plan, k, s, dt);
+          times[k * sub + i] = (timed ? plan.t[k] : k * dt) + s * dt;
         }
       }
+      path.row(N * sub) = plan.q.row(N);
+      times[N * sub] = timed ? plan.t[N] : N * dt;
+      const collision::PathCheckResult r =
+          checker.check_path(world, data, path, times, thresholds.min_clearance);
+      v.min_clearance = std::min(v.min_clearance, r.min_distance);
       if (v.min_clearance < thresholds.min_clearance) {
         std::ostringstream os;
         os << "collision: clearance " << v.min_clearance << " m below " << thresholds.min_clearance;

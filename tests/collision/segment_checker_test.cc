@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -147,6 +148,97 @@ TEST(SegmentChecker, ConsecutiveSamplesRespectSweepBoundOnIiwa) {
       prev = cur;
     }
   }
+}
+
+}  // namespace
+}  // namespace kinograph::collision
+
+namespace kinograph::collision {
+namespace {
+
+// A random polyline of RR configurations (a path as the validator builds one).
+Eigen::MatrixXd random_path(std::mt19937& rng, int rows) {
+  std::uniform_real_distribution<double> u(-2, 2), step(-0.3, 0.3);
+  Eigen::MatrixXd path(rows, 2);
+  path.row(0) << u(rng), u(rng);
+  for (int i = 1; i < rows; ++i)
+    path.row(i) = path.row(i - 1) + Eigen::RowVector2d(step(rng), step(rng));
+  return path;
+}
+
+// Conservative advancement against dense sampling of the same polyline: the certified lower
+// bound is never above the densely found minimum, the sampled minimum never more than a sweep
+// step below... and a penetration dense sampling finds is always found.
+TEST_F(RrSegment, PathCheckIsBoundedByDenseSampling) {
+  CollisionWorld world(model);
+  Obstacle o;
+  o.id = 1;
+  o.shape = Shape::sphere(0.05);
+  o.pose = at(0.9, 0, 1.3);
+  ASSERT_TRUE(world.add_obstacle(o));
+  std::mt19937 rng(21);
+  const SegmentCheckOptions dense_opts{.max_joint_step = 10, .max_sweep_step = 0.0005};
+  SegmentChecker checker(model), dense(model, dense_opts);
+  int penetrating = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const Eigen::MatrixXd path = random_path(rng, 12);
+    double dense_min = std::numeric_limits<double>::infinity();
+    for (int i = 0; i + 1 < path.rows(); ++i) {
+      dense_min = std::min(
+          dense_min, dense.check(world, data, path.row(i).transpose(), path.row(i + 1).transpose())
+                         .min_distance);
+    }
+    const PathCheckResult r = checker.check_path(world, data, path);
+    EXPECT_LE(r.lower_bound, dense_min + 1e-9) << trial;
+    EXPECT_LE(r.lower_bound, r.min_distance);
+    EXPECT_GE(r.min_distance, dense_min - dense_opts.max_sweep_step) << trial;
+    if (dense_min < 0) {
+      ++penetrating;
+      EXPECT_LT(r.min_distance, 0) << trial;
+    }
+  }
+  EXPECT_GT(penetrating, 0);  // the seed must exercise the penetrating case
+}
+
+// Far from every obstacle a long path costs a handful of queries; the ends are always checked.
+TEST_F(RrSegment, PathCheckSkipsClearStretches) {
+  CollisionWorld world(model);
+  Obstacle o;
+  o.id = 1;
+  o.shape = Shape::sphere(0.05);
+  o.pose = at(0, 0, -1.5);  // below the base, out of reach
+  ASSERT_TRUE(world.add_obstacle(o));
+  Eigen::MatrixXd path(101, 2);
+  for (int i = 0; i <= 100; ++i) path.row(i) << -1.0 + 0.02 * i, 0.3;
+  SegmentChecker checker(model);
+  const PathCheckResult r = checker.check_path(world, data, path);
+  const int dense_samples = checker.intervals(path.row(0).transpose(), path.row(100).transpose());
+  EXPECT_LT(r.samples, dense_samples / 10);
+  EXPECT_GE(r.samples, 2);
+  EXPECT_GT(r.lower_bound, 0);
+  dynamics::forward_kinematics(model, data, path.row(100).transpose());
+  EXPECT_GE(world.closest(data).distance, r.min_distance);
+}
+
+// Moving obstacles: samples at most max_time_step apart in time, and the sphere that passes
+// through the arm mid-path is found.
+TEST_F(RrSegment, PathCheckFollowsMovingObstaclesInTime) {
+  CollisionWorld world(model);
+  Obstacle o;
+  o.id = 4;
+  o.shape = Shape::sphere(0.1);
+  o.trajectory = PoseTrajectory({0.0, 1.0, 2.0}, {at(0, 0, 3), at(0, 0, 1.2), at(0, 0, 3)});
+  ASSERT_TRUE(world.add_obstacle(o));
+  Eigen::MatrixXd path = Eigen::MatrixXd::Zero(3, 2);
+  path(2, 1) = 0.01;
+  SegmentChecker checker(model, {.max_time_step = 0.1});
+  const PathCheckResult r = checker.check_path(world, data, path, {0.0, 1.0, 2.0});
+  EXPECT_GE(r.samples, 21);
+  EXPECT_LT(r.min_distance, -0.1);
+  // Found while the sphere overlaps the arm (it reaches the tip at t ≈ 0.59 and leaves at 1.41).
+  const double t = r.segment + r.s;
+  EXPECT_GT(t, 0.55);
+  EXPECT_LT(t, 1.45);
 }
 
 }  // namespace
