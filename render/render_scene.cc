@@ -51,6 +51,34 @@ void RenderScene::check() const {
   if (!end_effector_frame.empty()) model->frame_index(end_effector_frame);  // throws if unknown
 }
 
+int highlight_changed_obstacles(const RenderScene& before, RenderScene& after,
+                                const Eigen::Vector4d& rgba) {
+  int marked = 0;
+  const auto same = [](const collision::Obstacle& a, const collision::Obstacle& b) {
+    if (a.shape.kind != b.shape.kind || (a.shape.size - b.shape.size).norm() > 1e-12 ||
+        a.shape.mesh_path != b.shape.mesh_path || a.is_moving() != b.is_moving()) {
+      return false;
+    }
+    // Poses are piecewise interpolated between samples: equal at both's samples, equal always.
+    std::vector<double> times = {0.0};
+    times.insert(times.end(), a.trajectory.times().begin(), a.trajectory.times().end());
+    times.insert(times.end(), b.trajectory.times().begin(), b.trajectory.times().end());
+    return std::all_of(times.begin(), times.end(), [&](double t) {
+      return (a.pose_at(t).matrix() - b.pose_at(t).matrix()).norm() < 1e-9;
+    });
+  };
+  for (SceneObstacle& o : after.obstacles) {
+    const bool unchanged = std::any_of(
+        before.obstacles.begin(), before.obstacles.end(),
+        [&](const SceneObstacle& b) { return b.name == o.name && same(b.obstacle, o.obstacle); });
+    if (!unchanged) {
+      o.rgba = rgba;
+      ++marked;
+    }
+  }
+  return marked;
+}
+
 std::optional<Eigen::Vector3d> planar_axis(const dynamics::Model& model, const Eigen::VectorXd& q) {
   if (model.nq() == 0) return std::nullopt;
   dynamics::Data data(model);

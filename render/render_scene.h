@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "kinograph/dynamics/geometry.h"
+#include "kinograph/collision/obstacle.h"
 #include "kinograph/dynamics/model.h"
 #include "render/camera.h"
 
@@ -22,12 +22,21 @@ struct Trajectory {
   std::vector<double> even_times(int count) const;
 };
 
+/// An obstacle as drawn: the planner's obstacle (shape, and a fixed pose or a motion on the
+/// plan's clock, so a moving one is drawn where it is at each frame's time) and its colour.
+struct SceneObstacle {
+  collision::Obstacle obstacle;
+  /// Plans carry no colours by default: obstacles get one blue that no robot part uses.
+  Eigen::Vector4d rgba = Eigen::Vector4d(0.30, 0.55, 0.85, 1.0);
+  std::string name;  ///< the plan file's id, to tell obstacles of two plans apart
+};
+
 /// Everything a picture of a plan depends on. The model is borrowed and must outlive the
-/// scene; obstacles are shapes with body = -1 whose `origin` is their world pose.
+/// scene.
 struct RenderScene {
   const dynamics::Model* model = nullptr;
   Trajectory trajectory;
-  std::vector<dynamics::Geometry> obstacles;
+  std::vector<SceneObstacle> obstacles;
   std::optional<Camera> camera;    ///< automatic framing when absent
   std::string end_effector_frame;  ///< frame whose path a ghost overlay draws; empty = last frame
 
@@ -35,6 +44,12 @@ struct RenderScene {
   /// empty trajectory, joint vectors of the wrong size, decreasing times).
   void check() const;
 };
+
+/// Gives `rgba` to the obstacles of `after` that `before` does not have as they are (new, or
+/// moved or reshaped under the same name), so a replanning figure shows what changed. Returns
+/// how many it marked.
+int highlight_changed_obstacles(const RenderScene& before, RenderScene& after,
+                                const Eigen::Vector4d& rgba);
 
 /// The common world direction of all joint axes when the robot is planar (every joint axis
 /// parallel, checked at configuration q), else nullopt. Such robots are best seen along it.

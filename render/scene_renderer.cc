@@ -29,6 +29,23 @@ double nice_cell(double extent) {
   return 10.0 * p;
 }
 
+Eigen::AlignedBox3d bounds_of(const std::vector<Eigen::Vector3d>& points) {
+  Eigen::AlignedBox3d bounds;
+  for (const Eigen::Vector3d& p : points) bounds.extend(p);
+  // A robot with no visual geometry (or a point) still gets a finite frame.
+  const Eigen::Vector3d pad = (Eigen::Vector3d::Constant(0.1) - bounds.sizes()).cwiseMax(0.0) / 2;
+  bounds.min() -= pad;
+  bounds.max() += pad;
+  return bounds;
+}
+
+// The end-effector frame of a scene: its named one, else the model's last frame (-1: none).
+int end_effector(const RenderScene& scene) {
+  const dynamics::Model& model = *scene.model;
+  return scene.end_effector_frame.empty() ? static_cast<int>(model.frames.size()) - 1
+                                          : model.frame_index(scene.end_effector_frame);
+}
+
 std::vector<Eigen::Vector3d> path_points(const RenderScene& scene, int frame) {
   const dynamics::Model& model = *scene.model;
   dynamics::Data data(model);
@@ -100,16 +117,42 @@ void SceneRenderer::robot_items(const dynamics::Model& model, dynamics::Data& da
   }
 }
 
-std::vector<DrawItem> SceneRenderer::obstacle_items(const RenderScene& scene) {
-  std::vector<DrawItem> items;
-  for (const Geometry& g : scene.obstacles) {
+MeshId SceneRenderer::obstacle_mesh(const collision::Shape& shape) {
+  Geometry g;
+  g.size = shape.size;
+  g.mesh_path = shape.mesh_path;
+  g.mesh_scale = shape.mesh_scale;
+  switch (shape.kind) {
+    case collision::ShapeKind::kSphere:
+      g.shape = Geometry::Shape::kSphere;
+      break;
+    case collision::ShapeKind::kBox:
+      g.shape = Geometry::Shape::kBox;
+      break;
+    case collision::ShapeKind::kCylinder:
+      g.shape = Geometry::Shape::kCylinder;
+      break;
+    case collision::ShapeKind::kCapsule:
+      g.shape = Geometry::Shape::kCapsule;
+      break;
+    case collision::ShapeKind::kMesh:
+      g.shape = Geometry::Shape::kMesh;
+      g.link_name = "obstacle";
+      break;
+  }
+  return geometry_mesh(g);
+}
+
+void SceneRenderer::obstacle_items(const RenderScene& scene, double time, bool moving_only,
+                                   std::vector<DrawItem>& items) {
+  for (const SceneObstacle& o : scene.obstacles) {
+    if (moving_only && !o.obstacle.is_moving()) continue;
     DrawItem item;
-    item.mesh = geometry_mesh(g);
-    item.pose = g.origin;
-    item.color = g.rgba.cast<float>();
+    item.mesh = obstacle_mesh(o.obstacle.shape);
+    item.pose = o.obstacle.pose_at(time);
+    item.color = o.rgba.cast<float>();
     items.push_back(item);
   }
-  return items;
 }
 
 std::vector<Eigen::Vector3d> SceneRenderer::motion_points(const RenderScene& scene) {
@@ -124,30 +167,37 @@ std::vector<Eigen::Vector3d> SceneRenderer::motion_points(const RenderScene& sce
     }
   };
   const int samples = std::min<int>(static_cast<int>(scene.trajectory.t.size()), 60);
-  for (double t : scene.trajectory.even_times(samples)) {
+  const std::vector<double> times = scene.trajectory.even_times(samples);
+  for (double t : times) {
     dynamics::forward_kinematics(model, data, scene.trajectory.at(t));
     for (const Geometry& g : model.visual) {
       add_box(renderer_.mesh_bounds(geometry_mesh(g)), geometry_pose(g, data));
     }
     for (const Eigen::Isometry3d& pose : data.body_pose) points.push_back(pose.translation());
   }
-  for (const Geometry& g : scene.obstacles)
-    add_box(renderer_.mesh_bounds(geometry_mesh(g)), g.origin);
+  for (const SceneObstacle& o : scene.obstacles) {
+    const Eigen::AlignedBox3d& box = renderer_.mesh_bounds(obstacle_mesh(o.obstacle.shape));
+    if (!o.obstacle.is_moving()) {
+      add_box(box, o.obstacle.pose);
+      continue;
+    }
+    for (double t : times) add_box(box, o.obstacle.pose_at(t));
+  }
   if (points.empty()) points.push_back(Eigen::Vector3d::Zero());
   return points;
 }
 
 Eigen::AlignedBox3d SceneRenderer::motion_bounds(const RenderScene& scene) {
-  Eigen::AlignedBox3d bounds;
-  for (const Eigen::Vector3d& p : motion_points(scene)) bounds.extend(p);
-  // A robot with no visual geometry (or a point) still gets a finite frame.
-  const Eigen::Vector3d pad = (Eigen::Vector3d::Constant(0.1) - bounds.sizes()).cwiseMax(0.0) / 2;
-  bounds.min() -= pad;
-  bounds.max() += pad;
-  return bounds;
+  return bounds_of(motion_points(scene));
 }
 
 Camera SceneRenderer::auto_camera(const RenderScene& scene, double aspect) {
+  if (scene.camera) return *scene.camera;
+  return camera_for(scene, motion_points(scene), aspect);
+}
+
+Camera SceneRenderer::camera_for(const RenderScene& scene,
+                                 const std::vector<Eigen::Vector3d>& points, double aspect) {
   if (scene.camera) return *scene.camera;
   Eigen::Vector3d view_dir(1.0, -1.25, 0.7);  // front-right, above: shows depth of 3-D arms
   Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
@@ -163,11 +213,11 @@ Camera SceneRenderer::auto_camera(const RenderScene& scene, double aspect) {
       view_dir = -a;
     }
   }
-  return frame_points(motion_points(scene), view_dir.normalized(), aspect, up);
+  return frame_points(points, view_dir.normalized(), aspect, up);
 }
 
-SceneRenderer::Floor SceneRenderer::make_floor(const RenderScene& scene, const Camera& camera) {
-  const Eigen::AlignedBox3d bounds = motion_bounds(scene);
+SceneRenderer::Floor SceneRenderer::make_floor(const Eigen::AlignedBox3d& bounds,
+                                               const Camera& camera) {
   const double extent = bounds.sizes().maxCoeff();
   const double cell = nice_cell(extent);
   const int cells = 2 * static_cast<int>(std::ceil(2.5 * extent / cell / 2.0)) + 8;
@@ -208,16 +258,16 @@ RenderResult SceneRenderer::strip(const RenderScene& scene, const FrameOptions& 
     throw std::invalid_argument(
         fmt::format("render: {} frames do not fit in {} pixels", n, options.width));
   }
-  const Camera camera = auto_camera(scene, double(panel_w) / options.height);
+  const std::vector<Eigen::Vector3d> points = motion_points(scene);
+  const Camera camera = camera_for(scene, points, double(panel_w) / options.height);
   std::vector<DrawItem> fixed;
   if (options.floor) {
-    const Floor floor = make_floor(scene, camera);
+    const Floor floor = make_floor(bounds_of(points), camera);
     DrawItem item;
     item.mesh = floor.mesh;
     item.pose = floor.pose;
     fixed.push_back(item);
   }
-  for (const DrawItem& item : obstacle_items(scene)) fixed.push_back(item);
 
   const dynamics::Model& model = *scene.model;
   dynamics::Data data(model);
@@ -232,6 +282,7 @@ RenderResult SceneRenderer::strip(const RenderScene& scene, const FrameOptions& 
     panel.time = result.times[i];
     renderer_.set_panel(panel.x, panel.y, panel.width, panel.height, camera);
     items = fixed;
+    obstacle_items(scene, panel.time, false, items);  // moving ones where they are now
     robot_items(model, data, scene.trajectory.at(panel.time), items);
     renderer_.draw(items);
     result.panels.push_back(panel);
@@ -256,37 +307,89 @@ RenderResult SceneRenderer::strip(const RenderScene& scene, const FrameOptions& 
 RenderResult SceneRenderer::ghost(const RenderScene& scene, const FrameOptions& options) {
   check_options(options);
   scene.check();
-  const dynamics::Model& model = *scene.model;
-  const int ee_frame = scene.end_effector_frame.empty()
-                           ? static_cast<int>(model.frames.size()) - 1
-                           : model.frame_index(scene.end_effector_frame);
+  Layer layer;
+  layer.scene = &scene;
+  layer.min_alpha = options.ghost_min_alpha;
+  layer.path_color = options.path_color;
+  layer.path_key = "ee_path";
+  const std::vector<Eigen::Vector3d> points = motion_points(scene);
+  const Camera camera = camera_for(scene, points, double(options.width) / options.height);
+  RenderResult result = overlay({layer}, camera, points, options);
+  if (options.labels) {
+    const double size = std::clamp(options.height * 0.04, 11.0, 26.0);
+    draw_label(result.image,
+               fmt::format("t = {:.2f} \u2192 {:.2f} s, {} poses", result.times.front(),
+                           result.times.back(), options.frames),
+               0.5 * options.width, 0.3 * size, size);
+  }
+  return result;
+}
+
+RenderResult SceneRenderer::compare(const RenderScene& before, const RenderScene& after,
+                                    const CompareOptions& options) {
+  const FrameOptions& frame = options.frame;
+  check_options(frame);
+  before.check();
+  after.check();
+  if (before.model->nq() != after.model->nq()) {
+    throw std::invalid_argument(
+        fmt::format("render: the plans to compare have robots of {} and {} joints",
+                    before.model->nq(), after.model->nq()));
+  }
+  Layer first;
+  first.scene = &before;
+  first.tint = options.before_color;
+  first.min_alpha = options.before_min_alpha;
+  first.max_alpha = std::min(options.before_max_alpha, 0.99f);  // a ghost, never solid
+  first.obstacles = false;  // the world the second plan was made for is the one that counts
+  first.path_color = options.before_path_color;
+  first.path_key = "ee_path_before";
+  RenderScene shown = after;
+  const int changed = options.changed_color
+                          ? highlight_changed_obstacles(before, shown, *options.changed_color)
+                          : 0;
+  Layer second;
+  second.scene = &shown;
+  second.min_alpha = frame.ghost_min_alpha;
+  second.path_color = frame.path_color;
+  second.path_key = "ee_path";
+  std::vector<Eigen::Vector3d> points = motion_points(after);
+  for (const Eigen::Vector3d& p : motion_points(before)) points.push_back(p);
+  const Camera camera = camera_for(after, points, double(frame.width) / frame.height);
+  RenderResult result = overlay({first, second}, camera, points, frame);
+  if (frame.labels) {
+    const double size = std::clamp(frame.height * 0.035, 11.0, 24.0);
+    const auto rgb = [](const Eigen::Vector4f& c) { return c.head<3>().cast<double>().eval(); };
+    draw_label(result.image, options.before_label, 0.5 * size, 0.4 * size, size,
+               LabelAnchor::kTopLeft, rgb(options.before_path_color));
+    draw_label(result.image, options.after_label, 0.5 * size, 1.9 * size, size,
+               LabelAnchor::kTopLeft, rgb(frame.path_color));
+    if (changed > 0) {
+      draw_label(result.image, options.changed_label, 0.5 * size, 3.4 * size, size,
+                 LabelAnchor::kTopLeft, options.changed_color->head<3>());
+    }
+  }
+  return result;
+}
+
+RenderResult SceneRenderer::overlay(const std::vector<Layer>& layers, const Camera& camera,
+                                    const std::vector<Eigen::Vector3d>& points,
+                                    const FrameOptions& options) {
   RenderResult result;
-  result.times = scene.trajectory.even_times(options.frames);
   Panel panel;
   panel.width = options.width;
   panel.height = options.height;
-  panel.camera = auto_camera(scene, double(options.width) / options.height);
-  panel.time = result.times.back();
+  panel.camera = camera;
+  const Eigen::AlignedBox3d bounds = bounds_of(points);
 
   std::vector<DrawItem> opaque;
   if (options.floor) {
-    const Floor floor = make_floor(scene, panel.camera);
+    const Floor floor = make_floor(bounds, camera);
     DrawItem item;
     item.mesh = floor.mesh;
     item.pose = floor.pose;
     opaque.push_back(item);
   }
-  for (const DrawItem& item : obstacle_items(scene)) opaque.push_back(item);
-  if (ee_frame >= 0) {
-    const double radius = std::max(0.0035 * motion_bounds(scene).diagonal().norm(), 1e-3);
-    DrawItem path;
-    path.mesh = renderer_.upload("ee_path", make_tube(path_points(scene, ee_frame), radius));
-    path.color = options.path_color;
-    opaque.push_back(path);
-  }
-  dynamics::Data data(model);
-  robot_items(model, data, scene.trajectory.at(result.times.back()), opaque);
-
   // Ghosts back to front so that nearer ones blend over farther ones.
   struct Ghost {
     std::vector<DrawItem> items;
@@ -294,17 +397,58 @@ RenderResult SceneRenderer::ghost(const RenderScene& scene, const FrameOptions& 
     double distance;
   };
   std::vector<Ghost> ghosts;
+  const double radius = std::max(0.0035 * bounds.diagonal().norm(), 1e-3);
   const int n = options.frames;
-  for (int i = 0; i + 1 < n; ++i) {
-    Ghost ghost;
-    robot_items(model, data, scene.trajectory.at(result.times[i]), ghost.items);
-    ghost.alpha = options.ghost_min_alpha + (1.f - options.ghost_min_alpha) *
-                                                static_cast<float>(i) / static_cast<float>(n - 1);
-    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-    for (const Eigen::Isometry3d& pose : data.body_pose) centre += pose.translation();
-    if (!data.body_pose.empty()) centre /= static_cast<double>(data.body_pose.size());
-    ghost.distance = (centre - panel.camera.eye).norm();
-    ghosts.push_back(std::move(ghost));
+  for (const Layer& layer : layers) {
+    const RenderScene& scene = *layer.scene;
+    const dynamics::Model& model = *scene.model;
+    const std::vector<double> times = scene.trajectory.even_times(n);
+    const int ee_frame = end_effector(scene);
+    if (ee_frame >= 0) {
+      DrawItem path;
+      path.mesh = renderer_.upload(layer.path_key, make_tube(path_points(scene, ee_frame), radius));
+      path.color = layer.path_color;
+      opaque.push_back(path);
+    }
+    // Fixed obstacles once; moving ones where they are at each pose's time, faded with it.
+    if (layer.obstacles) {
+      for (const SceneObstacle& o : scene.obstacles) {
+        if (o.obstacle.is_moving()) continue;
+        DrawItem item;
+        item.mesh = obstacle_mesh(o.obstacle.shape);
+        item.pose = o.obstacle.pose;
+        item.color = o.rgba.cast<float>();
+        opaque.push_back(item);
+      }
+    }
+    dynamics::Data data(model);
+    for (int i = 0; i < n; ++i) {
+      const float alpha = n == 1 ? layer.max_alpha
+                                 : layer.min_alpha + (layer.max_alpha - layer.min_alpha) *
+                                                         static_cast<float>(i) /
+                                                         static_cast<float>(n - 1);
+      Ghost ghost;
+      ghost.alpha = alpha;
+      robot_items(model, data, scene.trajectory.at(times[i]), ghost.items);
+      if (layer.tint) {
+        for (DrawItem& item : ghost.items) {
+          item.color = *layer.tint;
+          item.use_mesh_colors = false;
+        }
+      }
+      if (layer.obstacles) obstacle_items(scene, times[i], true, ghost.items);
+      if (alpha >= 1.f) {
+        opaque.insert(opaque.end(), ghost.items.begin(), ghost.items.end());
+        continue;
+      }
+      Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+      for (const Eigen::Isometry3d& pose : data.body_pose) centre += pose.translation();
+      if (!data.body_pose.empty()) centre /= static_cast<double>(data.body_pose.size());
+      ghost.distance = (centre - camera.eye).norm();
+      ghosts.push_back(std::move(ghost));
+    }
+    result.times = times;  // the last layer's (the plan drawn in colour)
+    panel.time = std::max(panel.time, times.back());
   }
   std::stable_sort(ghosts.begin(), ghosts.end(),
                    [](const Ghost& a, const Ghost& b) { return a.distance > b.distance; });
@@ -315,13 +459,6 @@ RenderResult SceneRenderer::ghost(const RenderScene& scene, const FrameOptions& 
   for (const Ghost& ghost : ghosts) renderer_.draw_ghost(ghost.items, ghost.alpha);
   result.image = renderer_.finish();
   result.panels.push_back(panel);
-  if (options.labels) {
-    const double size = std::clamp(options.height * 0.04, 11.0, 26.0);
-    draw_label(result.image,
-               fmt::format("t = {:.2f} \u2192 {:.2f} s, {} poses", result.times.front(),
-                           result.times.back(), n),
-               0.5 * options.width, 0.3 * size, size);
-  }
   return result;
 }
 

@@ -2,6 +2,7 @@
 // Pictures of plans: frame strips (the robot at evenly spaced times, side by side, as the
 // paper's figures) and ghost overlays (all frames in one view, fading from start to goal).
 #include <Eigen/Core>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,23 @@ struct FrameOptions {
   float ghost_min_alpha = 0.18f;  ///< opacity of the first ghost; the last pose is opaque
   Eigen::Vector4f background = Eigen::Vector4f(1.f, 1.f, 1.f, 1.f);
   Eigen::Vector4f path_color = Eigen::Vector4f(0.85f, 0.12f, 0.08f, 1.f);  ///< end-effector path
+};
+
+/// How two plans of one task are drawn in one view (the replanning figure): the first plan's
+/// poses as grey ghosts with their end-effector path, the second in the robot's colours as a
+/// ghost overlay with its own path, among the second plan's obstacles.
+struct CompareOptions {
+  FrameOptions frame;  ///< poses per plan, size, labels, floor; frame.path_color: second plan
+  Eigen::Vector4f before_color = Eigen::Vector4f(0.55f, 0.57f, 0.60f, 1.f);  ///< first's tint
+  float before_min_alpha = 0.12f;  ///< opacity of the first plan's first pose
+  float before_max_alpha = 0.40f;  ///< and of its last pose (all of its poses are ghosts)
+  Eigen::Vector4f before_path_color = Eigen::Vector4f(0.10f, 0.62f, 0.25f, 1.f);
+  /// Colour of the second plan's obstacles that the first plan did not have as they are (see
+  /// highlight_changed_obstacles); nullopt keeps their own colours.
+  std::optional<Eigen::Vector4d> changed_color = Eigen::Vector4d(0.85, 0.25, 0.65, 1.0);
+  std::string before_label = "before";  ///< legend lines (frame.labels), in the paths' colours
+  std::string after_label = "after";
+  std::string changed_label = "changed obstacles";  ///< shown when some obstacle changed
 };
 
 /// One view in a picture: its pixel rectangle (top-left origin) and the camera that drew it,
@@ -56,13 +74,19 @@ class SceneRenderer {
   /// path drawn as a tube. Throws as strip() does.
   RenderResult ghost(const RenderScene& scene, const FrameOptions& options = {});
 
+  /// Two plans in one view (see CompareOptions), framed so both motions show; `after`'s
+  /// camera, when set, is used. Throws as strip() does, or when the plans' robots differ in
+  /// joint count.
+  RenderResult compare(const RenderScene& before, const RenderScene& after,
+                       const CompareOptions& options = {});
+
   /// Corners of every shape's box over the trajectory (60 samples at most) and of the
   /// obstacles: the points a camera must see.
   std::vector<Eigen::Vector3d> motion_points(const RenderScene& scene);
   /// World bounds of motion_points (at least 0.1 m on a side).
   Eigen::AlignedBox3d motion_bounds(const RenderScene& scene);
   /// Camera framing motion_points for a viewport of ratio `aspect`: along the joint axis for
-  /// planar robots, from the front-right and above otherwise.
+  /// planar robots, from the front-right and above otherwise (the scene's camera when set).
   Camera auto_camera(const RenderScene& scene, double aspect);
 
   /// The underlying GL renderer.
@@ -73,11 +97,28 @@ class SceneRenderer {
     MeshId mesh = -1;
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   };
+  // One plan's part of an overlay view: its poses as ghosts with opacity rising from
+  // min_alpha to max_alpha (a pose at opacity 1 is drawn solid), its end-effector path.
+  struct Layer {
+    const RenderScene* scene = nullptr;
+    std::optional<Eigen::Vector4f> tint;  // one colour for the whole robot
+    float min_alpha = 0.18f, max_alpha = 1.f;
+    bool obstacles = true;  // draw this plan's obstacles
+    Eigen::Vector4f path_color;
+    std::string path_key;  // mesh key of its path tube (one per layer of a picture)
+  };
+  RenderResult overlay(const std::vector<Layer>& layers, const Camera& camera,
+                       const std::vector<Eigen::Vector3d>& points, const FrameOptions& options);
+  Camera camera_for(const RenderScene& scene, const std::vector<Eigen::Vector3d>& points,
+                    double aspect);
   MeshId geometry_mesh(const dynamics::Geometry& geometry);
+  MeshId obstacle_mesh(const collision::Shape& shape);
   void robot_items(const dynamics::Model& model, dynamics::Data& data, const Eigen::VectorXd& q,
                    std::vector<DrawItem>& items);
-  std::vector<DrawItem> obstacle_items(const RenderScene& scene);
-  Floor make_floor(const RenderScene& scene, const Camera& camera);
+  // Appends the obstacles where they are at `time`; `moving_only` leaves out fixed ones.
+  void obstacle_items(const RenderScene& scene, double time, bool moving_only,
+                      std::vector<DrawItem>& items);
+  Floor make_floor(const Eigen::AlignedBox3d& bounds, const Camera& camera);
   static void check_options(const FrameOptions& options);
 
   Renderer renderer_;

@@ -2,12 +2,13 @@
 // subplot per joint, effort limits dashed, a second plan overlaid for comparison.
 #include <spdlog/spdlog.h>
 
+#include <cmath>
 #include <filesystem>
 #include <string>
 #include <vector>
 
+#include "kinograph/planning/plan_json.h"
 #include "render/image.h"
-#include "render/plan_json.h"
 #include "render/plot.h"
 #include "tools/command_registry.h"
 
@@ -31,23 +32,28 @@ void run_plot(const PlotArgs& args) {
     options.width = args.width;
     options.height = args.height;
     for (std::size_t i = 0; i < args.plans.size(); ++i) {
-      const render::PlanFile plan = render::read_plan_json(args.plans[i]);
-      if (plan.tau.empty()) {
-        throw std::runtime_error("plan '" + args.plans[i] + "' has no 'tau' to plot");
-      }
+      const planning::PlanFile file = planning::read_plan_file(args.plans[i]);
       render::PlotSeries s;
-      s.label = i < args.labels.size() ? args.labels[i]
-                : !plan.name.empty()   ? plan.name
-                                       : std::filesystem::path(args.plans[i]).stem().string();
+      s.label = i < args.labels.size()    ? args.labels[i]
+                : !file.info.name.empty() ? file.info.name
+                                          : std::filesystem::path(args.plans[i]).stem().string();
       if (args.plans.size() == 2 && i == 1 && s.label == series.front().label) {
         s.label = std::filesystem::path(args.plans[i]).stem().string();  // keep legends apart
       }
-      s.t = plan.t;
-      s.values = plan.tau;
+      s.t = file.plan.t;
+      for (Eigen::Index k = 0; k < file.plan.tau.rows(); ++k) {
+        s.values.push_back(file.plan.tau.row(k).transpose());
+      }
       series.push_back(std::move(s));
       if (i == 0) {
-        options.joint_names = plan.joint_names;
-        options.limits = plan.effort_limits;
+        // Columns come in the robot's joint order, with the plan's (scene's) effort limits.
+        bool any_limit = false;
+        for (const dynamics::Body& body : file.model->bodies) {
+          options.joint_names.push_back(body.joint_name);
+          options.limits.push_back(body.limits.effort);
+          any_limit = any_limit || std::isfinite(body.limits.effort);
+        }
+        if (!any_limit) options.limits.clear();
       }
     }
     render::write_png(render::plot_torques(series, options), args.out);

@@ -1,12 +1,14 @@
 // `kinograph render plan.json --frames 5 --style strip|ghost --out strip.png`: draws a plan
-// headlessly (OSMesa) as a frame strip or a ghost overlay.
+// headlessly (OSMesa) as a frame strip or a ghost overlay; `--compare after.json` draws a plan
+// and its replan in one view (the replanning figure).
 #include <spdlog/spdlog.h>
 
 #include <chrono>
 #include <string>
 
+#include "kinograph/planning/plan_json.h"
 #include "render/image.h"
-#include "render/plan_json.h"
+#include "render/plan_scene.h"
 #include "render/scene_camera.h"
 #include "render/scene_renderer.h"
 #include "tools/command_registry.h"
@@ -16,10 +18,13 @@ namespace {
 
 struct RenderArgs {
   std::string plan;
+  std::string compare;
   std::string scene;
   std::string out = "strip.png";
   std::string style = "strip";
   std::string ee_frame;
+  std::string before_label = "before: grey poses, green path";
+  std::string after_label = "after: robot colours, red path";
   int frames = 5;
   int width = 1600;
   int height = 400;
@@ -31,12 +36,8 @@ struct RenderArgs {
 void run_render(const RenderArgs& args) {
   const auto start = std::chrono::steady_clock::now();
   try {
-    const render::PlanFile plan = render::read_plan_json(args.plan);
-    const dynamics::Model model = render::load_plan_model(plan);
-    render::RenderScene scene;
-    scene.model = &model;
-    scene.trajectory = render::plan_trajectory(plan, model);
-    scene.obstacles = render::plan_obstacles(plan);
+    const planning::PlanFile plan = planning::read_plan_file(args.plan);
+    render::RenderScene scene = render::plan_scene(plan);
     scene.end_effector_frame = args.ee_frame;
     if (!args.scene.empty()) scene.camera = render::read_scene_camera(args.scene);
     render::FrameOptions options;
@@ -46,8 +47,22 @@ void run_render(const RenderArgs& args) {
     options.labels = !args.no_labels;
     options.floor = !args.no_floor;
     render::SceneRenderer renderer(render::RendererOptions{.samples = args.samples});
-    const render::RenderResult result =
-        args.style == "ghost" ? renderer.ghost(scene, options) : renderer.strip(scene, options);
+    render::RenderResult result;
+    if (!args.compare.empty()) {
+      const planning::PlanFile after_plan = planning::read_plan_file(args.compare);
+      render::RenderScene after = render::plan_scene(after_plan);
+      after.end_effector_frame = args.ee_frame;
+      after.camera = scene.camera;
+      render::CompareOptions compare;
+      compare.frame = options;
+      compare.before_label = args.before_label;
+      compare.after_label = args.after_label;
+      result = renderer.compare(scene, after, compare);
+    } else if (args.style == "ghost") {
+      result = renderer.ghost(scene, options);
+    } else {
+      result = renderer.strip(scene, options);
+    }
     render::write_png(result.image, args.out);
   } catch (const std::exception& e) {
     throw CommandFailure(e.what());
@@ -55,7 +70,7 @@ void run_render(const RenderArgs& args) {
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   spdlog::info("render: wrote {} ({}x{}, {} frames, {}) in {:.3f} s", args.out, args.width,
-               args.height, args.frames, args.style, seconds);
+               args.height, args.frames, args.compare.empty() ? args.style : "compare", seconds);
 }
 
 const bool kRegistered = register_command([](CLI::App& root) {
@@ -63,6 +78,9 @@ const bool kRegistered = register_command([](CLI::App& root) {
   CLI::App* cmd = root.add_subcommand(
       "render", "Draw a plan as a frame strip or a ghost overlay PNG (headless, OSMesa)");
   cmd->add_option("plan", args->plan, "Plan file (JSON) written by the planner")->required();
+  cmd->add_option("--compare", args->compare,
+                  "Second plan file (e.g. the replan): both in one view, the first as grey "
+                  "ghosts, the second in colour among its obstacles (changed ones highlighted)");
   cmd->add_option("--scene", args->scene,
                   "Scene file (YAML); its optional 'camera' block (eye, target, up, fov_y_deg) "
                   "replaces the automatic framing");
@@ -76,8 +94,12 @@ const bool kRegistered = register_command([](CLI::App& root) {
   cmd->add_option("--out", args->out, "Output PNG")->capture_default_str();
   cmd->add_option("--ee-frame", args->ee_frame,
                   "Frame whose path a ghost overlay draws (default: the model's last frame)");
+  cmd->add_option("--before-label", args->before_label, "Legend line of the plan (--compare)")
+      ->capture_default_str();
+  cmd->add_option("--after-label", args->after_label, "Legend line of the --compare plan")
+      ->capture_default_str();
   cmd->add_option("--samples", args->samples, "MSAA samples per pixel")->capture_default_str();
-  cmd->add_flag("--no-labels", args->no_labels, "Leave out the time labels");
+  cmd->add_flag("--no-labels", args->no_labels, "Leave out the time labels and the legend");
   cmd->add_flag("--no-floor", args->no_floor, "Leave out the checker floor / backdrop");
   cmd->callback([args] { run_render(*args); });
 });

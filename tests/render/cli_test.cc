@@ -9,7 +9,6 @@
 #include <memory>
 
 #include "render/image.h"
-#include "render/plan_json.h"
 #include "tests/render/test_scenes.h"
 
 namespace kinograph::render {
@@ -41,7 +40,7 @@ class Cli : public ::testing::Test {
             ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::create_directories(dir_);
     plan_ = (dir_ / "iiwa.json").string();
-    write_plan_json(test::iiwa_test_plan(10), plan_);
+    test::write_json(test::iiwa_test_plan(10), plan_);
   }
   void TearDown() override { fs::remove_all(dir_); }
   fs::path dir_;
@@ -61,6 +60,32 @@ TEST_F(Cli, RenderStripAndGhostWritePicturesOfTheAskedSize) {
   image = read_png(ghost);
   EXPECT_EQ(image.width, 300);
   EXPECT_EQ(image.height, 240);
+}
+
+TEST_F(Cli, CompareDrawsTwoPlansInOneView) {
+  // The second plan: another goal, and a box added beside the path.
+  nlohmann::json after = test::iiwa_test_plan(10);
+  for (auto& row : after["q"]) row[0] = row[0].get<double>() * 0.5;
+  after["obstacles"].push_back(
+      {{"id", "box"}, {"shape", "box"}, {"size", {0.2, 0.2, 0.2}}, {"position", {0.3, -0.6, 0.1}}});
+  const std::string after_path = (dir_ / "after.json").string();
+  test::write_json(after, after_path);
+  const std::string out = (dir_ / "compare.png").string();
+  const CliRun r = run("render " + plan_ + " --compare " + after_path +
+                       " --frames 4 --width 640 --height 480 --out " + out);
+  ASSERT_EQ(r.status, 0) << r.output;
+  const Image image = read_png(out);
+  EXPECT_EQ(image.width, 640);
+  EXPECT_EQ(image.height, 480);
+  // The changed obstacle's highlight (magenta) shows somewhere.
+  int magenta = 0;
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      const std::uint8_t* p = image.at(x, y);
+      magenta += p[0] > p[1] + 60 && p[2] > p[1] + 40;
+    }
+  }
+  EXPECT_GT(magenta, 100);
 }
 
 TEST_F(Cli, PlotOverlaysTwoPlans) {
@@ -86,18 +111,34 @@ TEST_F(Cli, BadInputFailsWithAMessage) {
       <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
     <link name="b"><inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial>
       <visual><geometry><mesh filename="meshes/missing_part.stl"/></geometry></visual></link></robot>)";
-  PlanFile plan;
-  plan.urdf = (dir_ / "robot.urdf").string();
-  plan.t = {0.0, 1.0};
-  plan.q = {Eigen::VectorXd::Zero(1), Eigen::VectorXd::Ones(1)};
-  write_plan_json(plan, (dir_ / "mesh.json").string());
+  nlohmann::json plan = {{"robot", {{"urdf", (dir_ / "robot.urdf").string()}}},
+                         {"t", {0.0, 1.0}},
+                         {"q", {{0.0}, {1.0}}},
+                         {"qd", {{0.0}, {0.0}}},
+                         {"qdd", {{0.0}, {0.0}}},
+                         {"tau", {{0.0}, {0.0}}}};
+  test::write_json(plan, (dir_ / "mesh.json").string());
   r = run("render " + (dir_ / "mesh.json").string() + " --out " + (dir_ / "x.png").string());
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.output.find("missing_part.stl"), std::string::npos) << r.output;
 
-  r = run("plot " + (dir_ / "mesh.json").string() + " --out " + (dir_ / "x.png").string());
+  // A two-joint arm's plan without torques.
+  plan["robot"]["urdf"] = "robots/rr/rr.urdf";
+  for (const char* key : {"q", "qd", "qdd"}) plan[key] = {{0.0, 0.0}, {0.5, 0.5}};
+  plan.erase("tau");
+  test::write_json(plan, (dir_ / "notau.json").string());
+  r = run("plot " + (dir_ / "notau.json").string() + " --out " + (dir_ / "x.png").string());
   EXPECT_NE(r.status, 0);
-  EXPECT_NE(r.output.find("tau"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("notau.json"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("'tau'"), std::string::npos) << r.output;
+
+  // A comparison of plans of different robots.
+  plan["tau"] = plan["q"];
+  test::write_json(plan, (dir_ / "rr.json").string());
+  r = run("render " + plan_ + " --compare " + (dir_ / "rr.json").string() + " --out " +
+          (dir_ / "x.png").string());
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.output.find("joints"), std::string::npos) << r.output;
 }
 
 }  // namespace

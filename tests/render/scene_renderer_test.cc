@@ -36,10 +36,9 @@ class RedArm : public ::testing::Test {
     q1 << 0.9, -0.6, 1.3;
     scene_.model = model_.get();
     scene_.trajectory = test::smooth_trajectory(q0, q1);
-    dynamics::Geometry box;
-    box.shape = dynamics::Geometry::Shape::kBox;
-    box.size = Eigen::Vector3d(0.3, 0.3, 0.3);
-    box.origin.translation() = Eigen::Vector3d(0.0, -0.9, 0.15);
+    SceneObstacle box;
+    box.obstacle.shape = collision::Shape::box(0.3, 0.3, 0.3);
+    box.obstacle.pose.translation() = Eigen::Vector3d(0.0, -0.9, 0.15);
     box.rgba = Eigen::Vector4d(0.2, 0.4, 0.9, 1.0);
     scene_.obstacles.push_back(box);
   }
@@ -196,6 +195,101 @@ TEST_F(RedArm, GhostOverlayShowsFinalPoseAndPath) {
   EXPECT_GE(near_path, 3);
 }
 
+// A ball that moves from the arm's left to its right: each strip panel shows it where it is at
+// that panel's time, and no longer where it was.
+TEST_F(RedArm, MovingObstacleIsDrawnWhereItIsAtEachFrame) {
+  SceneObstacle ball;
+  ball.obstacle.shape = collision::Shape::sphere(0.12);
+  const Eigen::Vector3d from(-0.7, -0.9, 0.2), to(0.7, -0.9, 0.2);
+  ball.obstacle.trajectory = collision::PoseTrajectory(
+      {0.0, 2.0},
+      {Eigen::Isometry3d(Eigen::Translation3d(from)), Eigen::Isometry3d(Eigen::Translation3d(to))});
+  ball.rgba = Eigen::Vector4d(0.2, 0.4, 0.9, 1.0);
+  scene_.obstacles = {ball};
+  FrameOptions options;
+  options.frames = 3;
+  options.width = 960;
+  options.height = 360;
+  const RenderResult result = shared_renderer().strip(scene_, options);
+  ASSERT_EQ(result.panels.size(), 3u);
+  for (const Panel& panel : result.panels) {
+    const Eigen::Vector3d centre = from + (to - from) * panel.time / 2.0;
+    const auto pixel = panel.project(centre);
+    ASSERT_TRUE(pixel.has_value());
+    EXPECT_GE(count_near(result.image, *pixel, 2, is_blue), 20) << "t = " << panel.time;
+  }
+  const Panel &first = result.panels.front(), &last = result.panels.back();
+  const auto start = first.project(from), end = last.project(to);
+  ASSERT_TRUE(start && end);
+  // Its image moved within the panel by far more than its size ...
+  EXPECT_GT(((*end - Eigen::Vector2d(last.x, 0)) - (*start - Eigen::Vector2d(first.x, 0))).norm(),
+            100.0);
+  // ... and where it started there is no ball at the end.
+  EXPECT_EQ(count_near(result.image, *last.project(from), 2, is_blue), 0);
+  EXPECT_EQ(count_near(result.image, *first.project(to), 2, is_blue), 0);
+}
+
+// The replanning figure: the first plan as grey ghosts with a green path, the second in the
+// arm's red with its own (yellow) path, and an obstacle only the second plan has in magenta.
+TEST_F(RedArm, CompareShowsBothPathsAndTheChangedObstacle) {
+  RenderScene after = scene_;
+  Eigen::VectorXd q0(3), q2(3);
+  q0 << -0.8, 0.3, 0.9;
+  q2 << 0.9, 0.5, 0.4;
+  after.trajectory = test::smooth_trajectory(q0, q2);
+  SceneObstacle added;
+  added.name = "added";
+  added.obstacle.shape = collision::Shape::box(0.25, 0.25, 0.25);
+  added.obstacle.pose.translation() = Eigen::Vector3d(0.9, 0.6, 0.125);
+  after.obstacles.push_back(added);
+  CompareOptions options;
+  options.frame.frames = 4;
+  options.frame.width = 800;
+  options.frame.height = 600;
+  options.frame.path_color = Eigen::Vector4f(0.95f, 0.85f, 0.1f, 1.f);
+  const RenderResult result = shared_renderer().compare(scene_, after, options);
+  ASSERT_EQ(result.panels.size(), 1u);
+  EXPECT_EQ(result.image.width, 800);
+  EXPECT_EQ(result.image.height, 600);
+  const Panel& panel = result.panels.front();
+  const auto is_green = [](const std::uint8_t* p) { return p[1] > p[0] + 40 && p[1] > p[2] + 30; };
+  const auto is_yellow = [](const std::uint8_t* p) {
+    return p[0] > p[2] + 80 && p[1] > p[2] + 80 && std::abs(p[0] - p[1]) < 60;
+  };
+  const auto is_magenta = [](const std::uint8_t* p) {
+    return p[0] > p[1] + 60 && p[2] > p[1] + 40;
+  };
+  const int tip = model_->frame_index("tip");
+  dynamics::Data data(*model_);
+  const auto tip_pixel = [&](const RenderScene& scene, double t) {
+    dynamics::forward_kinematics(*model_, data, scene.trajectory.at(t));
+    return panel.project(dynamics::frame_pose(*model_, data, tip).translation());
+  };
+  int green = 0, yellow = 0;
+  for (double t : {0.3, 0.8, 1.2, 1.7}) {
+    const auto b = tip_pixel(scene_, t), a = tip_pixel(after, t);
+    ASSERT_TRUE(b && a);
+    green += count_near(result.image, *b, 2, is_green) > 0;
+    yellow += count_near(result.image, *a, 2, is_yellow) > 0;
+  }
+  EXPECT_GE(green, 3);
+  EXPECT_GE(yellow, 3);
+  // The second plan's last pose is solid red; the first's last pose is grey, not red.
+  for (const Eigen::Vector3d& p : link_midpoints(after.trajectory.q.back())) {
+    EXPECT_GE(count_near(result.image, *panel.project(p), 1, is_red), 5);
+  }
+  const Eigen::Vector3d before_elbow = link_midpoints(scene_.trajectory.q.back())[2];
+  EXPECT_EQ(count_near(result.image, *panel.project(before_elbow), 1, is_red), 0);
+  // The obstacle both plans have keeps its blue; the added one is magenta.
+  EXPECT_GE(count_near(result.image, *panel.project(Eigen::Vector3d(0.0, -0.9, 0.3)), 2, is_blue),
+            20);
+  EXPECT_GE(
+      count_near(result.image, *panel.project(Eigen::Vector3d(0.9, 0.6, 0.25)), 2, is_magenta), 20);
+  if (const char* dump = std::getenv("KINOGRAPH_RENDER_TEST_OUT")) {
+    write_png(result.image, std::string(dump) + "/compare.png");
+  }
+}
+
 TEST_F(RedArm, ZeroFramesIsAClearError) {
   FrameOptions options;
   options.frames = 0;
@@ -209,9 +303,8 @@ TEST_F(RedArm, ZeroFramesIsAClearError) {
 }
 
 TEST_F(RedArm, MissingObstacleMeshNamesTheFile) {
-  dynamics::Geometry mesh;
-  mesh.shape = dynamics::Geometry::Shape::kMesh;
-  mesh.mesh_path = "/nonexistent/kinograph/obstacle.stl";
+  SceneObstacle mesh;
+  mesh.obstacle.shape = collision::Shape::mesh("/nonexistent/kinograph/obstacle.stl");
   scene_.obstacles.push_back(mesh);
   try {
     shared_renderer().strip(scene_, FrameOptions{});

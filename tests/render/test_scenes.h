@@ -1,14 +1,18 @@
 #pragma once
-// Robots, trajectories and plans for the renderer's tests (the planner does not exist yet, so
-// plans are smooth joint-space interpolations).
+// Robots, trajectories and plan files for the renderer's tests (plans are smooth joint-space
+// interpolations, written by the planner's plan-file writer).
 #include <Eigen/Core>
 #include <cmath>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 #include "kinograph/dynamics/model.h"
+#include "kinograph/planning/plan_json.h"
+#include "kinograph/planning/scene.h"
 #include "render/image.h"
-#include "render/plan_json.h"
 #include "render/render_scene.h"
 
 namespace kinograph::render::test {
@@ -89,30 +93,39 @@ int count_near(const Image& image, const Eigen::Vector2d& at, int r, Pred pred) 
   return count;
 }
 
-/// A plan file for robots/iiwa14 (joint-space interpolation, made-up smooth torques).
-inline PlanFile iiwa_test_plan(int steps = 25) {
-  PlanFile plan;
-  plan.urdf = "robots/iiwa14/iiwa14.urdf";
-  for (int i = 1; i <= 7; ++i) plan.joint_names.push_back("iiwa_joint_" + std::to_string(i));
+/// The plan file (JSON, as the planner writes it) of robots/iiwa14 moving beside a desk
+/// (joint-space interpolation; made-up smooth torques, zero qd and qdd).
+inline nlohmann::json iiwa_test_plan(int steps = 25) {
+  planning::Scene scene;
+  scene.urdf_path = std::string(KINOGRAPH_SOURCE_DIR) + "/robots/iiwa14/iiwa14.urdf";
+  scene.problem.name = "iiwa test";
+  scene.problem.model =
+      std::make_shared<const dynamics::Model>(dynamics::Model::from_urdf_file(scene.urdf_path));
+  collision::Obstacle desk;
+  desk.shape = collision::Shape::box(0.6, 0.8, 0.4);
+  desk.pose.translation() = Eigen::Vector3d(0.7, 0.5, 0.2);
+  scene.problem.obstacles.push_back(desk);
+  scene.obstacle_names.push_back("desk");
   Eigen::VectorXd q0(7), q1(7);
   q0 << 0.0, 0.3, 0.0, -1.2, 0.0, 0.8, 0.0;
   q1 << 1.8, -0.4, 0.3, -1.6, 0.2, 1.0, 0.5;
   const Trajectory tr = smooth_trajectory(q0, q1, 2.5, steps);
+  planning::Plan plan;
   plan.t = tr.t;
-  plan.q = tr.q;
-  for (double t : plan.t) {
-    Eigen::VectorXd tau(7);
-    for (int j = 0; j < 7; ++j) tau[j] = 30.0 * std::sin(2.5 * t + j);
-    plan.tau.push_back(tau);
+  const int rows = static_cast<int>(tr.t.size());
+  plan.q.resize(rows, 7);
+  plan.tau.resize(rows, 7);
+  plan.qd = plan.qdd = Eigen::MatrixXd::Zero(rows, 7);
+  for (int k = 0; k < rows; ++k) {
+    plan.q.row(k) = tr.q[k].transpose();
+    for (int j = 0; j < 7; ++j) plan.tau(k, j) = 30.0 * std::sin(2.5 * tr.t[k] + j);
   }
-  plan.effort_limits = {320, 320, 176, 176, 110, 40, 40};
-  PlanObstacle desk;
-  desk.id = "desk";
-  desk.shape = "box";
-  desk.size = {0.6, 0.8, 0.4};
-  desk.position = Eigen::Vector3d(0.7, 0.5, 0.2);
-  plan.obstacles.push_back(desk);
-  return plan;
+  return planning::plan_to_json(plan, scene);
+}
+
+/// Writes a plan file's JSON to `path`.
+inline void write_json(const nlohmann::json& json, const std::string& path) {
+  std::ofstream(path) << json.dump(1) << "\n";
 }
 
 }  // namespace kinograph::render::test

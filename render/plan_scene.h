@@ -1,0 +1,21 @@
+#pragma once
+// Pictures of plan files: what the planner's reader (planning/plan_json.h) gives, turned into
+// what the renderer draws — the robot's trajectory and the obstacles with their colours.
+#include <vector>
+
+#include "kinograph/planning/plan.h"
+#include "kinograph/planning/plan_json.h"
+#include "render/render_scene.h"
+
+namespace kinograph::render {
+
+/// A plan file's obstacles as drawn: each with its "rgba" or the default blue, moving ones
+/// with their motion.
+std::vector<SceneObstacle> plan_obstacles(const planning::PlanFileInfo& info);
+/// A plan's joint positions over time (its t and the rows of q).
+Trajectory plan_trajectory(const planning::Plan& plan);
+/// The picture's scene of a whole plan file: its robot, trajectory and obstacles. The scene
+/// borrows `file.model`, so `file` must outlive it.
+RenderScene plan_scene(const planning::PlanFile& file);
+
+}  // namespace kinograph::render
