@@ -12,7 +12,6 @@
 
 #include "kinograph/dynamics/model.h"
 #include "render/image.h"
-#include "render/plan_json.h"
 #include "render/plot.h"
 #include "render/scene_renderer.h"
 
@@ -34,27 +33,36 @@ double median(std::vector<double> v) {
 }
 
 // The iiwa moving between two configurations (minimum-jerk), beside a desk.
-kinograph::render::PlanFile iiwa_plan() {
-  kinograph::render::PlanFile plan;
-  plan.source = "bench";
-  plan.urdf = std::string(KINOGRAPH_SOURCE_DIR) + "/robots/iiwa14/iiwa14.urdf";
+kinograph::render::RenderScene iiwa_scene(const kinograph::dynamics::Model& model) {
+  kinograph::render::RenderScene scene;
+  scene.model = &model;
   Eigen::VectorXd q0(7), q1(7);
   q0 << 0.0, 0.3, 0.0, -1.2, 0.0, 0.8, 0.0;
   q1 << 1.8, -0.4, 0.3, -1.6, 0.2, 1.0, 0.5;
   for (int k = 0; k <= 50; ++k) {
     const double s = k / 50.0, h = s * s * s * (10 - 15 * s + 6 * s * s);
-    plan.t.push_back(2.5 * s);
-    plan.q.push_back(q0 + h * (q1 - q0));
+    scene.trajectory.t.push_back(2.5 * s);
+    scene.trajectory.q.push_back(q0 + h * (q1 - q0));
+  }
+  kinograph::render::SceneObstacle desk;
+  desk.name = "desk";
+  desk.obstacle.shape = kinograph::collision::Shape::box(0.6, 0.8, 0.4);
+  desk.obstacle.pose.translation() = Eigen::Vector3d(0.7, 0.5, 0.2);
+  scene.obstacles.push_back(desk);
+  return scene;
+}
+
+// Made-up smooth torques on the same clock, for the plot.
+kinograph::render::PlotSeries iiwa_torques() {
+  kinograph::render::PlotSeries series{"plan", {}, {}};
+  for (int k = 0; k <= 50; ++k) {
+    const double s = k / 50.0;
+    series.t.push_back(2.5 * s);
     Eigen::VectorXd tau(7);
     for (int j = 0; j < 7; ++j) tau[j] = 30 * std::sin(6 * s + j);
-    plan.tau.push_back(tau);
+    series.values.push_back(tau);
   }
-  kinograph::render::PlanObstacle desk;
-  desk.id = "desk";
-  desk.size = {0.6, 0.8, 0.4};
-  desk.position = Eigen::Vector3d(0.7, 0.5, 0.2);
-  plan.obstacles.push_back(desk);
-  return plan;
+  return series;
 }
 
 }  // namespace
@@ -63,12 +71,10 @@ int main(int argc, char** argv) {
   const int runs = argc > 1 ? std::max(1, std::atoi(argv[1])) : 15;
   const std::string out =
       (std::filesystem::temp_directory_path() / "kinograph_render_bench.png").string();
-  const auto plan = iiwa_plan();
-  const kinograph::dynamics::Model model = kinograph::render::load_plan_model(plan);
-  RenderScene scene;
-  scene.model = &model;
-  scene.trajectory = kinograph::render::plan_trajectory(plan, model);
-  scene.obstacles = kinograph::render::plan_obstacles(plan);
+  const kinograph::dynamics::Model model = kinograph::dynamics::Model::from_urdf_file(
+      std::string(KINOGRAPH_SOURCE_DIR) + "/robots/iiwa14/iiwa14.urdf");
+  const RenderScene scene = iiwa_scene(model);
+  const kinograph::render::PlotSeries torques = iiwa_torques();
   const FrameOptions options;  // 5 frames, 1600×400
 
   // Cold: a fresh renderer (context, shaders JIT-compiled on first draw, meshes uploaded).
@@ -92,8 +98,7 @@ int main(int argc, char** argv) {
     kinograph::render::write_png(renderer.ghost(scene, options).image, out);
     ghost.push_back(seconds_since(start));
     start = Clock::now();
-    kinograph::render::write_png(kinograph::render::plot_torques({{"plan", plan.t, plan.tau}}, {}),
-                                 out);
+    kinograph::render::write_png(kinograph::render::plot_torques({torques}, {}), out);
     plot.push_back(seconds_since(start));
   }
   std::filesystem::remove(out);
