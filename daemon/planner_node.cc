@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <lcm/lcm-cpp.hpp>
 #include <stdexcept>
@@ -22,7 +23,8 @@ std::string upper(std::string s) {
   return s;
 }
 
-// plan_t.method names: "batch", "warm-start", "incremental", or "batch after warm-start".
+// plan_t.method names: "batch", "warm-start", "incremental", "batch after warm-start" or
+// "batch after incremental".
 std::string method_name(std::string stats_method) {
   for (auto [from, to] : {std::pair{"batch-L", "batch"}, std::pair{"batch-W", "warm-start"}}) {
     if (stats_method.rfind(from, 0) == 0) stats_method.replace(0, std::strlen(from), to);
@@ -30,10 +32,35 @@ std::string method_name(std::string stats_method) {
   return stats_method;
 }
 
+planning::IncrementalPlannerOptions incremental_options(const PlannerNodeOptions& options) {
+  planning::IncrementalPlannerOptions o = options.incremental_planner;
+  o.batch = options.planner;
+  return o;
+}
+
+bool same_obstacle(const collision::Obstacle& a, const collision::Obstacle& b) {
+  return a.id == b.id && a.shape.kind == b.shape.kind && a.shape.size == b.shape.size &&
+         a.shape.mesh_path == b.shape.mesh_path && a.shape.mesh_scale == b.shape.mesh_scale &&
+         a.pose.matrix() == b.pose.matrix() && a.trajectory.empty() && b.trajectory.empty();
+}
+
+// Largest joint change between two joint goals; infinity when either is not a joint goal.
+double joint_goal_change(const planning::Goal& a, const planning::Goal& b) {
+  using Kind = planning::Goal::Kind;
+  if (a.kind != Kind::kJoint || b.kind != Kind::kJoint || a.q.size() != b.q.size() ||
+      a.q.size() == 0) {
+    return std::numeric_limits<double>::infinity();
+  }
+  return (a.q - b.q).cwiseAbs().maxCoeff();
+}
+
 }  // namespace
 
 PlannerNode::PlannerNode(planning::Scene scene, PlannerNodeOptions options, lcm::LCM* shared)
-    : scene_(std::move(scene)), options_(std::move(options)), planner_(options_.planner) {
+    : scene_(std::move(scene)),
+      options_(std::move(options)),
+      planner_(options_.planner),
+      incremental_(incremental_options(options_)) {
   if (!scene_.problem.model) throw std::invalid_argument("PlannerNode: the scene has no robot");
   identity_.model_name = scene_.problem.model->name;
   identity_.channel_prefix =
@@ -54,12 +81,17 @@ PlannerNode::PlannerNode(planning::Scene scene, PlannerNodeOptions options, lcm:
   for (const auto& o : scene_.problem.obstacles) {
     next_obstacle_id_ = std::max(next_obstacle_id_, o.id + 1);
   }
-  lcm_->subscribe(channel("GOAL"), &PlannerNode::on_goal, this);
-  lcm_->subscribe(channel("OBSTACLES"), &PlannerNode::on_obstacles, this);
-  lcm_->subscribe(channel("STATE"), &PlannerNode::on_state, this);
+  subscriptions_ = {lcm_->subscribe(channel("GOAL"), &PlannerNode::on_goal, this),
+                    lcm_->subscribe(channel("OBSTACLES"), &PlannerNode::on_obstacles, this),
+                    lcm_->subscribe(channel("STATE"), &PlannerNode::on_state, this)};
 }
 
-PlannerNode::~PlannerNode() = default;
+// A shared LCM instance outlives the node: its handlers must not call into a destroyed node.
+PlannerNode::~PlannerNode() {
+  for (lcm::Subscription* s : subscriptions_) {
+    if (s != nullptr) lcm_->unsubscribe(s);
+  }
+}
 
 std::string PlannerNode::channel(const std::string& suffix) const {
   return identity_.channel_prefix + "_" + suffix;
@@ -164,13 +196,25 @@ void PlannerNode::on_state(const lcm::ReceiveBuffer* rbuf, const std::string& ch
   }
   std::lock_guard lock(mutex_);
   latest_state_ = std::move(state);
+  ++state_count_;
 }
 
 bool PlannerNode::apply_obstacles(const std::vector<ObstacleUpdate>& updates, bool replace_all) {
   bool changed = false;
-  if (replace_all && !live_obstacles_.empty()) {
-    live_obstacles_.clear();
-    changed = true;
+  if (replace_all) {
+    // The list is the whole world: obstacles it does not name go; the ones it names keep their
+    // ids, so that the planner sees a move rather than a removal and an addition.
+    for (auto it = live_obstacles_.begin(); it != live_obstacles_.end();) {
+      const bool named = std::any_of(updates.begin(), updates.end(), [&](const ObstacleUpdate& u) {
+        return !u.remove && u.id == it->first;
+      });
+      if (named) {
+        ++it;
+      } else {
+        it = live_obstacles_.erase(it);
+        changed = true;
+      }
+    }
   }
   for (const auto& u : updates) {
     auto it = live_obstacles_.find(u.id);
@@ -193,8 +237,100 @@ bool PlannerNode::apply_obstacles(const std::vector<ObstacleUpdate>& updates, bo
   return changed;
 }
 
+planning::Plan PlannerNode::solve_batch(const planning::Problem& problem, bool replan,
+                                        std::string& method) {
+  // An obstacle change keeps the goal: the previous plan is the natural starting point.
+  const bool warm = replan && last_plan_ && last_plan_->q.rows() == problem.steps + 1;
+  planning::Plan plan = planner_.plan(problem, warm ? &*last_plan_ : nullptr);
+  // A warm start can be trapped on the wrong side of a new obstacle; a plan from the
+  // straight line is the fallback, and its statistics say so.
+  if (warm && !plan.success()) {
+    spdlog::info("warm-started replan did not validate ({}); planning from scratch",
+                 plan.stats.reason);
+    const double warm_time = plan.stats.solve_time_s;
+    plan = planner_.plan(problem);
+    plan.stats.solve_time_s += warm_time;
+    plan.stats.method += " after warm-start";
+  }
+  method = method_name(plan.stats.method);
+  return plan;
+}
+
+planning::Plan PlannerNode::solve_incremental(const planning::Problem& problem, bool new_goal,
+                                              bool new_state, std::string& method) {
+  bool from_scratch = !incremental_ready_ || !incremental_.has_plan() ||
+                      incremental_.problem().steps != problem.steps;
+  if (!from_scratch && new_goal) {
+    const double change = joint_goal_change(incremental_.problem().goal, problem.goal);
+    // Pose goals have no joint distance (infinity here): they always replan incrementally.
+    if (std::isfinite(change) && change > options_.max_incremental_goal_change) {
+      spdlog::info("goal moved by {:.2f} rad (> {:.2f}): planning from scratch", change,
+                   options_.max_incremental_goal_change);
+      from_scratch = true;
+    }
+  }
+  if (from_scratch) {
+    planning::Plan plan = incremental_.plan(problem);
+    method = method_name(plan.stats.method);
+    incremental_ready_ = plan.success();
+    return plan;
+  }
+
+  // The change from the planner's problem to `problem`: obstacles by stable int id (fixed
+  // scene obstacles never change), the goal, the measured start, the duration.
+  planning::ProblemChange change;
+  const planning::Problem& current = incremental_.problem();
+  std::map<int, const collision::Obstacle*> planned;
+  for (const auto& o : current.obstacles) planned[o.id] = &o;
+  for (const auto& o : scene_.problem.obstacles) planned.erase(o.id);
+  for (const auto& o : problem.obstacles) {
+    const auto it = planned.find(o.id);
+    const bool fixed = std::any_of(scene_.problem.obstacles.begin(), scene_.problem.obstacles.end(),
+                                   [&](const collision::Obstacle& f) { return f.id == o.id; });
+    if (fixed) continue;
+    if (it == planned.end() || !same_obstacle(*it->second, o)) change.add_or_move.push_back(o);
+    if (it != planned.end()) planned.erase(it);
+  }
+  for (const auto& [id, o] : planned) change.remove.push_back(id);
+  if (new_goal) change.goal = problem.goal;
+  if (new_state) {
+    change.start_q = problem.start_q;
+    change.start_qd = problem.start_qd;
+  }
+  if (problem.horizon != current.horizon) change.horizon = problem.horizon;
+
+  planning::Plan plan = incremental_.replan(change);
+  // replan() reports a fallback by its batch method (last_stats() is not reset when a change is
+  // refused before it is applied, so the plan's own method is the reliable sign).
+  const bool fell_back = plan.stats.method != "incremental";
+  const planning::IncrementalStats& st = incremental_.last_stats();
+  method = fell_back ? "batch after incremental" : "incremental";
+  const bool refused = !fell_back && plan.stats.status == "invalid_problem";
+  // A refused change left the planner as it was: it can still replan. Any other failure leaves
+  // it at a trajectory that did not validate, a poor start for the next change: plan the next
+  // goal or obstacle change from scratch.
+  incremental_ready_ = plan.success() || (refused && incremental_ready_);
+  {
+    std::lock_guard lock(mutex_);
+    if (!refused) ++counters_.incremental;
+    if (fell_back) ++counters_.fallbacks;
+  }
+  if (!refused) {
+    spdlog::info(
+        "iDFGP: {} ISAM2 updates, {} multiplier rounds, {} cliques re-eliminated, {} factors "
+        "replaced, {:.1f} ms incremental{}",
+        st.updates, st.rounds, st.cliques_reeliminated, st.factors_replaced,
+        st.incremental_time_s * 1e3,
+        fell_back ? fmt::format(", fell back ({}) {:.1f} ms", st.fallback_reason,
+                                st.fallback_time_s * 1e3)
+                  : "");
+  }
+  return plan;
+}
+
 void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan) {
   planning::Problem problem = scene_.problem;
+  bool new_state = false;
   {
     std::lock_guard lock(mutex_);
     state_ = planner_status_t::PLANNING;
@@ -203,31 +339,29 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan) {
       problem.start_q = latest_state_->q;
       problem.start_qd = latest_state_->qd;
     }
+    new_state = state_count_ != used_state_count_;
+    used_state_count_ = state_count_;
   }
   for (const auto& [name, obstacle] : live_obstacles_) problem.obstacles.push_back(obstacle);
   problem.goal = goal.goal;
   if (goal.duration_s > 0) problem.horizon = goal.duration_s;
 
   planning::Plan plan;
+  std::string method;
   bool threw = false;
   std::string error;
   try {
-    // An obstacle change keeps the goal: the previous plan is the natural starting point.
-    const bool warm = replan && last_plan_ && last_plan_->q.rows() == problem.steps + 1;
-    plan = planner_.plan(problem, warm ? &*last_plan_ : nullptr);
-    // A warm start can be trapped on the wrong side of a new obstacle; a plan from the
-    // straight line is the fallback, and its statistics say so.
-    if (warm && !plan.success()) {
-      spdlog::info("goal {}: warm-started replan did not validate ({}); planning from scratch",
-                   goal.goal_id, plan.stats.reason);
-      const double warm_time = plan.stats.solve_time_s;
-      plan = planner_.plan(problem);
-      plan.stats.solve_time_s += warm_time;
-      plan.stats.method += " after warm-start";
-    }
+    plan = options_.incremental ? solve_incremental(problem, !replan, new_state, method)
+                                : solve_batch(problem, replan, method);
   } catch (const std::exception& e) {
     threw = true;
     error = e.what();
+    incremental_ready_ = false;
+  }
+  // A state the incremental planner refused (or never saw, after an exception) is offered again.
+  if (threw || !plan.success()) {
+    std::lock_guard lock(mutex_);
+    if (new_state) --used_state_count_;
   }
 
   int64_t plan_id;
@@ -249,7 +383,7 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan) {
   } else {
     msg = plan_to_message(plan, *problem.model, identity_.model_name, plan_id, goal.goal_id,
                           now_utime());
-    msg.method = method_name(plan.stats.method);
+    msg.method = method;
     spdlog::info("goal {}: plan {} {} ({}, {} iterations, {:.1f} ms)", goal.goal_id, plan_id,
                  plan.success() ? "valid" : "INVALID", msg.method, plan.stats.iterations,
                  plan.stats.solve_time_s * 1e3);

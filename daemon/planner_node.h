@@ -2,9 +2,18 @@
 // kinographd's core: one planner for one robot on an LCM network. It listens for goals,
 // obstacle updates and measured states, plans off the LCM thread (the newest goal wins), and
 // answers every goal with a plan_t — a trajectory or a failure status with its reason.
+//
+// Replanning (iDFGP). The node keeps one planning::IncrementalPlanner. The first goal, and any
+// goal after a plan that failed, is planned from scratch (batch solve, plan_t.method "batch");
+// after that a new goal, an obstacle added / moved / removed, a newly measured start state or a
+// new duration is applied as a ProblemChange to the current plan ("incremental"), and a replan
+// that does not validate is redone by a warm-started batch solve ("batch after incremental").
+// With PlannerNodeOptions::incremental off every plan is a batch solve, warm-started from the
+// current plan after an obstacle change ("warm-start", "batch after warm-start").
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -14,11 +23,13 @@
 
 #include "daemon/message_convert.h"
 #include "kinograph/planning/batch_planner.h"
+#include "kinograph/planning/incremental_planner.h"
 #include "kinograph/planning/scene.h"
 
 namespace lcm {
 class LCM;
 class ReceiveBuffer;
+class Subscription;
 }  // namespace lcm
 
 namespace kinograph::daemon {
@@ -34,8 +45,18 @@ struct PlannerNodeOptions {
   std::string channel_prefix;
   /// Period of the planner_status_t heartbeat (s).
   double status_period_s = 1.0;
-  /// Options of the batch planner used for every plan.
+  /// Options of the batch planner: every batch solve, including the incremental planner's first
+  /// plans and fallbacks (they replace incremental_planner.batch).
   planning::BatchPlannerOptions planner;
+  /// Replan incrementally (iDFGP) after the first plan; false = every plan is a batch solve (the
+  /// node's behaviour before iDFGP, kept for comparison and as a conservative mode).
+  bool incremental = true;
+  /// Options of the incremental planner (ISAM2, penalty, stopping rule, fallback).
+  planning::IncrementalPlannerOptions incremental_planner;
+  /// A new joint goal farther than this from the current plan's goal (largest joint change,
+  /// rad) is planned from scratch instead of incrementally; pose goals always replan
+  /// incrementally. Infinity = always incremental; see the measurement in planner_node.cc.
+  double max_incremental_goal_change = std::numeric_limits<double>::infinity();
 };
 
 /// What a node has done since it started (for its status and for tests).
@@ -46,6 +67,8 @@ struct NodeCounters {
   int plans_published = 0;    ///< plan_t messages sent (successes and failures)
   int failures = 0;           ///< of which not SUCCESS
   int replans = 0;            ///< plans triggered by an obstacle change for the current goal
+  int incremental = 0;        ///< plans answered by an incremental replan (validated or not)
+  int fallbacks = 0;          ///< incremental replans redone by a batch solve
 };
 
 /// The planner daemon's node: scene (robot, defaults, fixed obstacles) + LCM + worker thread.
@@ -78,6 +101,12 @@ class PlannerNode {
   void worker_loop(const std::atomic<bool>& stop);
   bool apply_obstacles(const std::vector<ObstacleUpdate>& updates, bool replace_all);
   void plan_and_publish(const GoalRequest& goal, bool replan);
+  /// The batch path: from scratch, or warm-started from the current plan for a replan.
+  planning::Plan solve_batch(const planning::Problem& problem, bool replan, std::string& method);
+  /// The incremental path: a ProblemChange from the planner's problem to `problem` when the
+  /// planner holds a usable plan, else a plan from scratch.
+  planning::Plan solve_incremental(const planning::Problem& problem, bool new_goal, bool new_state,
+                                   std::string& method);
   void publish_status();
   int64_t now_utime() const;
 
@@ -86,6 +115,7 @@ class PlannerNode {
   RobotIdentity identity_;
   std::unique_ptr<lcm::LCM> owned_lcm_;
   lcm::LCM* lcm_ = nullptr;
+  std::vector<lcm::Subscription*> subscriptions_;
   planning::BatchPlanner planner_;
 
   // Shared between the LCM thread and the worker, under mutex_.
@@ -95,6 +125,7 @@ class PlannerNode {
   std::vector<ObstacleUpdate> pending_obstacles_;
   bool pending_replace_all_ = false;
   std::optional<MeasuredState> latest_state_;
+  std::uint64_t state_count_ = 0;  // measured states received; compared with used_state_count_
   NodeCounters counters_;
   int8_t state_ = 0;  // planner_status_t::IDLE / PLANNING / ERROR
   int64_t last_goal_id_ = -1;
@@ -107,6 +138,11 @@ class PlannerNode {
   int next_obstacle_id_ = 0;
   std::optional<GoalRequest> current_goal_;
   std::optional<planning::Plan> last_plan_;
+  planning::IncrementalPlanner incremental_;
+  // The incremental planner's plan may be changed: it validated, or a change was refused
+  // before it touched the planner's state (invalid goal). False after any other failure.
+  bool incremental_ready_ = false;
+  std::uint64_t used_state_count_ = 0;  // state_count_ when the planner's start was last set
 };
 
 }  // namespace kinograph::daemon

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <lcm/lcm-cpp.hpp>
 #include <mutex>
@@ -16,6 +17,8 @@
 
 #include "kinograph/dynamics/kinematics.h"
 #include "kinograph/planner_status_t.hpp"
+#include "kinograph/planning/scene.h"
+#include "kinograph/planning/validate.h"
 #include "lcmtypes/safe_decode.h"
 
 namespace kinograph::daemon {
@@ -83,9 +86,10 @@ class Listener {
 class NodeFixture : public ::testing::Test {
  protected:
   void SetUp() override {
+    start(planning::parse_scene(kScene, std::string(KINOGRAPH_SOURCE_DIR) + "/scene.yaml"));
+  }
+  void start(planning::Scene scene, PlannerNodeOptions options = {}) {
     ASSERT_TRUE(lcm_.good());
-    auto scene = planning::parse_scene(kScene, std::string(KINOGRAPH_SOURCE_DIR) + "/scene.yaml");
-    PlannerNodeOptions options;
     options.channel_prefix = "RR";
     options.status_period_s = 0.2;
     node_ = std::make_unique<PlannerNode>(std::move(scene), options, &lcm_);
@@ -94,7 +98,7 @@ class NodeFixture : public ::testing::Test {
   }
   void TearDown() override {
     stop_ = true;
-    thread_.join();
+    if (thread_.joinable()) thread_.join();
   }
   void send_goal(int64_t id, std::vector<double> q) {
     goal_t g{};
@@ -104,6 +108,22 @@ class NodeFixture : public ::testing::Test {
     g.joint_position = std::move(q);
     g.ee_quaternion[0] = 1;
     lcm_.publish("RR_GOAL", &g);
+  }
+
+  void send_obstacle(const std::string& id, int8_t action, double radius,
+                     const Eigen::Vector3d& position, bool replace_all = false) {
+    obstacle_list_t list{};
+    obstacle_t o{};
+    o.id = id;
+    o.action = action;
+    o.shape = obstacle_t::SPHERE;
+    o.size[0] = radius;
+    for (int i = 0; i < 3; ++i) o.position[i] = position[i];
+    o.quaternion[0] = 1;
+    list.obstacles.push_back(o);
+    list.num_obstacles = 1;
+    list.replace_all = replace_all;
+    lcm_.publish("RR_OBSTACLES", &list);
   }
 
   lcm::LCM lcm_{"memq://"};
@@ -208,6 +228,243 @@ TEST_F(NodeFixture, NewestGoalWinsAndEveryGoalIsAnswered) {
   const auto newest =
       std::find_if(plans.begin(), plans.end(), [](const plan_t& p) { return p.goal_id == 23; });
   EXPECT_EQ(newest->status, plan_t::SUCCESS);
+}
+
+// Replanning on the RR reach scene (robots/scenes/rr_reach.yaml: swing from leaning left to
+// leaning right past a fixed ball above the upright pose). Fixed obstacles come from the scene;
+// the tests add a "pebble" over LCM.
+class ReplanFixture : public NodeFixture {
+ protected:
+  void SetUp() override {}
+  void start_reach(PlannerNodeOptions options = {}) {
+    scene_ =
+        planning::load_scene(std::string(KINOGRAPH_SOURCE_DIR) + "/robots/scenes/rr_reach.yaml");
+    start(scene_, options);
+  }
+  // The scene's problem with `goal` and, optionally, a pebble: what a published plan must
+  // validate against.
+  planning::Problem problem_with(const Eigen::Vector2d& goal,
+                                 std::optional<Eigen::Vector3d> pebble = std::nullopt) const {
+    planning::Problem p = scene_.problem;
+    p.goal.q = goal;
+    if (pebble) {
+      collision::Obstacle o;
+      o.id = 100;
+      o.shape = collision::Shape::sphere(kPebbleRadius);
+      o.pose.translation() = *pebble;
+      p.obstacles.push_back(o);
+    }
+    return p;
+  }
+  static planning::Validation check(const planning::Problem& problem, const plan_t& msg) {
+    return planning::validate(problem, plan_from_message(msg));
+  }
+  // Where the tip of the arm is at step k of a plan.
+  Eigen::Vector3d tip_at(const plan_t& plan, int k) const {
+    const dynamics::Model& model = *scene_.problem.model;
+    dynamics::Data data(model);
+    dynamics::forward_kinematics(model, data,
+                                 Eigen::Map<const Eigen::VectorXd>(plan.q[k].data(), 2));
+    return dynamics::frame_pose(model, data, model.frame_index("ee")).translation();
+  }
+  static std::string describe(const plan_t& p) {
+    return p.method + ", status " + std::to_string(p.status) + ": " + p.status_message;
+  }
+  // Sends a goal and returns the plan answering it (the n-th plan overall).
+  plan_t plan_goal(int64_t id, const Eigen::Vector2d& q, size_t n) {
+    send_goal(id, {q[0], q[1]});
+    auto plans = listener_->wait_plans(n);
+    EXPECT_EQ(plans.size(), n);
+    return plans.size() >= n ? plans[n - 1] : plan_t{};
+  }
+
+  static constexpr double kPebbleRadius = 0.05;
+  const Eigen::Vector2d kGoal{1.2, 0.0};  // the scene's goal
+  planning::Scene scene_;
+};
+
+// An obstacle moved onto the current plan's path: the replan is incremental, validates against
+// the scene with the obstacle where it now is, and the first plan would not have.
+TEST_F(ReplanFixture, ObstacleMovedIntoThePathReplansIncrementally) {
+  start_reach();
+  const plan_t first = plan_goal(1, kGoal, 1);
+  ASSERT_EQ(first.status, plan_t::SUCCESS) << describe(first);
+  EXPECT_EQ(first.method, "batch");
+
+  // Out of reach first (an addition), then onto the path (a move of the same obstacle).
+  send_obstacle("pebble", obstacle_t::ADD_OR_MOVE, kPebbleRadius, {0, 3, 0});
+  auto plans = listener_->wait_plans(2);
+  ASSERT_EQ(plans.size(), 2u);
+  EXPECT_EQ(plans[1].status, plan_t::SUCCESS) << describe(plans[1]);
+  EXPECT_EQ(plans[1].method, "incremental");
+
+  // On the tip's path a third of the way, pushed 5 cm outward from the shoulder: the first plan
+  // runs through it.
+  const Eigen::Vector3d tip = tip_at(first, 10);
+  const Eigen::Vector3d pebble = tip + 0.05 * tip.normalized();
+  ASSERT_FALSE(check(problem_with(kGoal, pebble), first).valid) << "the pebble must be in the way";
+  send_obstacle("pebble", obstacle_t::ADD_OR_MOVE, kPebbleRadius, pebble);
+  plans = listener_->wait_plans(3);
+  ASSERT_EQ(plans.size(), 3u);
+  const plan_t& replan = plans[2];
+  EXPECT_EQ(replan.goal_id, 1);
+  ASSERT_EQ(replan.status, plan_t::SUCCESS) << describe(replan);
+  EXPECT_EQ(replan.method, "incremental");
+  const planning::Validation v = check(problem_with(kGoal, pebble), replan);
+  EXPECT_TRUE(v.valid) << (v.failures.empty() ? "" : v.failures.front());
+  EXPECT_GE(v.min_clearance, 0.0);
+  const NodeCounters c = node_->counters();
+  EXPECT_EQ(c.replans, 2);
+  EXPECT_EQ(c.incremental, 2);
+  EXPECT_EQ(c.fallbacks, 0);
+}
+
+// A second goal near the first: an incremental replan that ends at the new goal and validates.
+TEST_F(ReplanFixture, NearbyGoalReplansIncrementally) {
+  start_reach();
+  ASSERT_EQ(plan_goal(1, kGoal, 1).status, plan_t::SUCCESS);
+  const Eigen::Vector2d goal(1.05, 0.2);
+  const plan_t p = plan_goal(2, goal, 2);
+  EXPECT_EQ(p.goal_id, 2);
+  ASSERT_EQ(p.status, plan_t::SUCCESS) << describe(p);
+  EXPECT_EQ(p.method, "incremental");
+  EXPECT_NEAR(p.q.back()[0], goal[0], 1e-2);
+  EXPECT_NEAR(p.q.back()[1], goal[1], 1e-2);
+  EXPECT_TRUE(check(problem_with(goal), p).valid);
+}
+
+// Removing the obstacle (by name, then the whole list by replace_all) replans the current goal
+// for the world without it.
+TEST_F(ReplanFixture, ObstacleRemovedReplans) {
+  start_reach();
+  const plan_t first = plan_goal(1, kGoal, 1);
+  ASSERT_EQ(first.status, plan_t::SUCCESS);
+  const Eigen::Vector3d tip = tip_at(first, 10);
+  const Eigen::Vector3d pebble = tip + 0.05 * tip.normalized();
+  send_obstacle("pebble", obstacle_t::ADD_OR_MOVE, kPebbleRadius, pebble);
+  auto plans = listener_->wait_plans(2);
+  ASSERT_EQ(plans.size(), 2u);
+  ASSERT_EQ(plans[1].status, plan_t::SUCCESS) << describe(plans[1]);
+  EXPECT_TRUE(check(problem_with(kGoal, pebble), plans[1]).valid);
+
+  send_obstacle("pebble", obstacle_t::REMOVE, kPebbleRadius, pebble);
+  plans = listener_->wait_plans(3);
+  ASSERT_EQ(plans.size(), 3u);
+  EXPECT_EQ(plans[2].goal_id, 1);
+  ASSERT_EQ(plans[2].status, plan_t::SUCCESS) << describe(plans[2]);
+  EXPECT_EQ(plans[2].method, "incremental");
+  EXPECT_TRUE(check(problem_with(kGoal), plans[2]).valid);
+  // Without the pebble the previous plan is still feasible, so the replan (a descent from it)
+  // costs no more.
+  EXPECT_LE(plans[2].cost, plans[1].cost * 1.001);
+
+  // replace_all with a new list: the pebble comes back under another name, the old name goes.
+  send_obstacle("stone", obstacle_t::ADD_OR_MOVE, kPebbleRadius, pebble, /*replace_all=*/true);
+  plans = listener_->wait_plans(4);
+  ASSERT_EQ(plans.size(), 4u);
+  ASSERT_EQ(plans[3].status, plan_t::SUCCESS) << describe(plans[3]);
+  EXPECT_TRUE(check(problem_with(kGoal, pebble), plans[3]).valid);
+  EXPECT_EQ(node_->counters().replans, 3);
+}
+
+// A measured state, then a goal: the plan starts where the robot is (incrementally re-anchored
+// after a first plan).
+TEST_F(ReplanFixture, MeasuredStateThenGoalStartsThere) {
+  start_reach();
+  ASSERT_EQ(plan_goal(1, kGoal, 1).status, plan_t::SUCCESS);
+  robot_state_t state{};
+  state.robot = "rr";
+  state.num_joints = 2;
+  state.joint_name = {"joint2", "joint1"};  // any order
+  state.position = {0.05, -1.1};
+  state.velocity = {0.0, 0.2};
+  lcm_.publish("RR_STATE", &state);
+  // A state alone does not replan; the next goal plans from it.
+  const Eigen::Vector2d goal(1.1, 0.1);
+  const plan_t p = plan_goal(2, goal, 2);
+  ASSERT_EQ(p.status, plan_t::SUCCESS) << describe(p);
+  EXPECT_EQ(p.method, "incremental");
+  EXPECT_NEAR(p.q[0][0], -1.1, 1e-6);
+  EXPECT_NEAR(p.q[0][1], 0.05, 1e-6);
+  EXPECT_NEAR(p.qd[0][0], 0.2, 1e-6);
+  EXPECT_NEAR(p.qd[0][1], 0.0, 1e-6);
+  planning::Problem problem = problem_with(goal);
+  problem.start_q = Eigen::Vector2d(-1.1, 0.05);
+  problem.start_qd = Eigen::Vector2d(0.2, 0.0);
+  EXPECT_TRUE(check(problem, p).valid);
+}
+
+// An invalid goal after a plan is answered INVALID_GOAL and leaves the planner able to replan
+// the next goal incrementally.
+TEST_F(ReplanFixture, InvalidGoalAfterAPlanKeepsServing) {
+  start_reach();
+  ASSERT_EQ(plan_goal(1, kGoal, 1).status, plan_t::SUCCESS);
+  const plan_t bad = plan_goal(2, Eigen::Vector2d(10.0, 0.0), 2);  // beyond the joint limit
+  EXPECT_EQ(bad.goal_id, 2);
+  EXPECT_EQ(bad.status, plan_t::INVALID_GOAL) << describe(bad);
+  const Eigen::Vector2d goal(1.1, 0.15);
+  const plan_t next = plan_goal(3, goal, 3);
+  EXPECT_EQ(next.goal_id, 3);
+  ASSERT_EQ(next.status, plan_t::SUCCESS) << describe(next);
+  EXPECT_EQ(next.method, "incremental");
+  EXPECT_TRUE(check(problem_with(goal), next).valid);
+}
+
+// A replan that fails (here: no ISAM2 update allowed and no fallback) does not poison the next
+// goal: it is planned from scratch and validates.
+TEST_F(ReplanFixture, AFailedReplanIsFollowedByAPlanFromScratch) {
+  PlannerNodeOptions options;
+  options.incremental_planner.max_updates = 0;
+  options.incremental_planner.fallback = false;
+  start_reach(options);
+  ASSERT_EQ(plan_goal(1, kGoal, 1).status, plan_t::SUCCESS);
+  const plan_t failed = plan_goal(2, Eigen::Vector2d(0.9, 0.5), 2);
+  EXPECT_NE(failed.status, plan_t::SUCCESS);
+  EXPECT_EQ(failed.method, "incremental");
+  const Eigen::Vector2d goal(1.1, 0.1);
+  const plan_t next = plan_goal(3, goal, 3);
+  ASSERT_EQ(next.status, plan_t::SUCCESS) << describe(next);
+  EXPECT_EQ(next.method, "batch");
+  EXPECT_TRUE(check(problem_with(goal), next).valid);
+}
+
+// With incremental replanning off, obstacle changes are warm-started batch solves and goals are
+// planned from scratch (the node before iDFGP).
+TEST_F(ReplanFixture, BatchModeWarmStartsObstacleReplans) {
+  PlannerNodeOptions options;
+  options.incremental = false;
+  start_reach(options);
+  const plan_t first = plan_goal(1, kGoal, 1);
+  ASSERT_EQ(first.status, plan_t::SUCCESS);
+  EXPECT_EQ(first.method, "batch");
+  const Eigen::Vector3d tip = tip_at(first, 10);
+  const Eigen::Vector3d pebble = tip + 0.05 * tip.normalized();
+  send_obstacle("pebble", obstacle_t::ADD_OR_MOVE, kPebbleRadius, pebble);
+  auto plans = listener_->wait_plans(2);
+  ASSERT_EQ(plans.size(), 2u);
+  ASSERT_EQ(plans[1].status, plan_t::SUCCESS) << describe(plans[1]);
+  EXPECT_TRUE(plans[1].method == "warm-start" || plans[1].method == "batch after warm-start")
+      << plans[1].method;
+  EXPECT_TRUE(check(problem_with(kGoal, pebble), plans[1]).valid);
+  const plan_t next = plan_goal(2, Eigen::Vector2d(1.1, 0.1), 3);
+  EXPECT_EQ(next.method, "batch");
+  EXPECT_EQ(node_->counters().incremental, 0);
+}
+
+// An obstacle with a NaN coordinate is rejected (a status says why) and triggers no replan.
+TEST_F(ReplanFixture, NaNObstacleIsRejectedWithoutReplanning) {
+  start_reach();
+  ASSERT_EQ(plan_goal(1, kGoal, 1).status, plan_t::SUCCESS);
+  send_obstacle("pebble", obstacle_t::ADD_OR_MOVE, kPebbleRadius, {0.0, std::nan(""), 1.0});
+  EXPECT_TRUE(listener_->wait_status_containing("non-finite size or position"));
+  // The next goal is still planned, incrementally, in the world without the pebble.
+  const Eigen::Vector2d goal(1.1, 0.1);
+  const plan_t p = plan_goal(2, goal, 2);
+  ASSERT_EQ(p.status, plan_t::SUCCESS) << describe(p);
+  EXPECT_EQ(p.method, "incremental");
+  const NodeCounters c = node_->counters();
+  EXPECT_EQ(c.messages_rejected, 1);
+  EXPECT_EQ(c.replans, 0);
 }
 
 }  // namespace
