@@ -375,10 +375,14 @@ ISAM2Result ISAM2::update(const std::vector<FactorPtr>& new_factors,
   }
   std::vector<int> groups(m, 0);
   bool constrained = false;
-  for (int s : touched) {
-    if (local[s] >= 0) {
-      groups[local[s]] = 1;
-      constrained = true;
+  int touched_here = 0;
+  for (int s : touched) touched_here += local[s] >= 0 ? 1 : 0;
+  if (touched_here <= options_.constrain_touched_fraction * m) {
+    for (int s : touched) {
+      if (local[s] >= 0) {
+        groups[local[s]] = 1;
+        constrained = true;
+      }
     }
   }
   for (const Key& k : update_options.constrained_last) {

@@ -35,6 +35,13 @@ struct ISAM2Options {
   /// Re-eliminate everything when the affected top holds more than this fraction of the
   /// variables (cheaper than detaching and reattaching most of the tree).
   double full_reelimination_fraction = 0.6;
+  /// Order the touched variables last (near the root, so the next change to them re-eliminates
+  /// little) only while they are at most this fraction of the variables re-eliminated. When a
+  /// change touches most of a chain (an obstacle near every state), forcing them last makes the
+  /// untouched ones (e.g. every accelerations of a trajectory) go first and fill one giant
+  /// clique: measured 434-dim root clique, 30 ms instead of 0.4 ms per factorization on the iiwa
+  /// desk (bench/replanning). Explicit constrained_last keys are always honoured.
+  double constrain_touched_fraction = 0.3;
   ISAM2Step step = ISAM2Step::kGaussNewton;
 
   /// Safeguard: evaluate the nonlinear error after each update (incrementally: only factors on

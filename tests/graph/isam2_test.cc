@@ -589,3 +589,86 @@ TEST(ISAM2, RelinearizationIsCheckedOnlyEveryKthUpdate) {
 
 }  // namespace
 }  // namespace kinograph::graph
+
+namespace kinograph::graph {
+namespace {
+
+Key Y(uint32_t i) { return Key('y', 0, i); }
+
+// Largest clique (frontal + separator dimension) of the tree.
+int largest_clique(const BayesTree& tree) {
+  int largest = 0;
+  for (int c = 0; c < tree.clique_capacity(); ++c) {
+    if (tree.clique(c).alive) {
+      largest = std::max(largest, tree.clique(c).frontal_dim + tree.clique(c).separator_dim);
+    }
+  }
+  return largest;
+}
+
+// A two-strand chain (x_i, y_i as a trajectory's positions and accelerations) with a unary
+// factor on every x_i (an obstacle near every state). Replacing all unary factors touches every
+// x: ordering them all last would eliminate the y strand first and fill one clique with every x.
+TEST(ISAM2, ChangeTouchingMostVariablesKeepsCliquesSmall) {
+  const int n = 40;
+  auto run = [&](double fraction, int* largest, double* error) {
+    std::mt19937 rng(3);
+    std::normal_distribution<double> n01;
+    Values values;
+    std::vector<FactorPtr> factors;
+    for (int i = 0; i < n; ++i) {
+      values.insert(X(i), Eigen::Vector2d(n01(rng), n01(rng)));
+      values.insert(Y(i), Eigen::Vector2d(n01(rng), n01(rng)));
+    }
+    factors.push_back(
+        std::make_shared<PriorFactor>(X(0), Eigen::Vector2d(0, 0), isotropic(2, 0.1)));
+    factors.push_back(
+        std::make_shared<PriorFactor>(Y(0), Eigen::Vector2d(0, 0), isotropic(2, 0.1)));
+    const Eigen::MatrixXd I = Eigen::MatrixXd::Identity(2, 2);
+    for (int i = 1; i < n; ++i) {
+      factors.push_back(std::make_shared<LinearFactor>(
+          std::vector<Key>{X(i - 1), X(i), Y(i)}, std::vector<Eigen::MatrixXd>{-I, I, -0.1 * I},
+          Eigen::Vector2d(0.1, 0), isotropic(2, 1.0)));
+      factors.push_back(std::make_shared<LinearFactor>(
+          std::vector<Key>{Y(i - 1), Y(i)}, std::vector<Eigen::MatrixXd>{-I, I},
+          Eigen::Vector2d(0, 0.05), isotropic(2, 1.0)));
+    }
+    const size_t first_unary = factors.size();
+    for (int i = 0; i < n; ++i) {
+      factors.push_back(
+          std::make_shared<PriorFactor>(X(i), Eigen::Vector2d(1, 0), isotropic(2, 5)));
+    }
+    ISAM2Options opt;
+    opt.relinearize_threshold = 1e9;
+    opt.wildfire_threshold = 0;
+    opt.constrain_touched_fraction = fraction;
+    ISAM2 isam(opt);
+    auto res = isam.update(factors, {}, values);
+    ASSERT_TRUE(res.ok());
+    std::vector<FactorPtr> moved;
+    std::vector<size_t> removed;
+    for (int i = 0; i < n; ++i) {
+      moved.push_back(
+          std::make_shared<PriorFactor>(X(i), Eigen::Vector2d(1, 0.5), isotropic(2, 5)));
+      removed.push_back(res.new_factor_indices[first_unary + i]);
+    }
+    res = isam.update(moved, removed);
+    ASSERT_TRUE(res.ok());
+    ASSERT_EQ(isam.check_invariants(), "");
+    *largest = largest_clique(isam.bayes_tree());
+    *error = (isam.estimate().vector() - dense_solve(isam.graph(), isam.estimate()))
+                 .cwiseAbs()
+                 .maxCoeff();
+  };
+  int largest = 0;
+  double error = 0;
+  run(ISAM2Options().constrain_touched_fraction, &largest, &error);
+  EXPECT_LE(largest, 12);
+  EXPECT_LT(error, 1e-9);
+  run(1.0, &largest, &error);  // always ordering the touched variables last
+  EXPECT_GT(largest, 40);
+  EXPECT_LT(error, 1e-9);
+}
+
+}  // namespace
+}  // namespace kinograph::graph
