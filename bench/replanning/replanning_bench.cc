@@ -176,6 +176,8 @@ int run(int argc, char** argv) {
   double radius = 0.2, shift = 0.05;
   bool stiff = true;
   std::string json_path;
+  spdlog::level::level_enum log_level = spdlog::level::warn;
+  planning::IncrementalPlannerOptions io;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--problems" && i + 1 < argc) {
@@ -190,15 +192,29 @@ int run(int argc, char** argv) {
       stiff = false;
     } else if (a == "--json" && i + 1 < argc) {
       json_path = argv[++i];
+    } else if (a == "--final-tol" && i + 1 < argc) {
+      io.final_relative_error_tol = std::stod(argv[++i]);
+    } else if (a == "--tol" && i + 1 < argc) {
+      io.relative_error_tol = std::stod(argv[++i]);
+    } else if (a == "--relinearize-threshold" && i + 1 < argc) {
+      io.isam2.relinearize_threshold = std::stod(argv[++i]);
+      io.relinearize_all = false;
+    } else if (a == "--polish-objective") {
+      io.stop_when_valid = false;
+    } else if (a == "--no-polish") {
+      io.polish = false;
+    } else if (a == "--log-level" && i + 1 < argc) {
+      log_level = spdlog::level::from_str(argv[++i]);
     } else {
       std::cerr << "usage: replanning_bench [--problems 50] [--obstacle-problems N] "
-                   "[--radius 0.2] [--shift 0.05] [--no-stiff] [--json FILE]\n";
+                   "[--radius 0.2] [--shift 0.05] [--no-stiff] [--json FILE] "
+                   "[--log-level warn|info|debug|trace] [--tol 1e-2] [--final-tol 1e-4] "
+                   "[--relinearize-threshold X (instead of relinearizing all)] [--no-polish] [--polish-objective]\n";
       return 1;
     }
   }
   if (obstacle_problems < 0) obstacle_problems = problems;
-  spdlog::set_level(spdlog::level::warn);
-  const planning::IncrementalPlannerOptions io;
+  spdlog::set_level(log_level);
   json result;
 
   const char* tasks[2][2] = {{"task1", "iiwa_desk.yaml"}, {"task2", "iiwa_min_torque.yaml"}};

@@ -632,6 +632,8 @@ Plan IncrementalPlanner::replan(const ProblemChange& change) {
   double round_tol = options_.relative_error_tol;
   std::vector<double> violations;
   bool polish = false;
+  std::optional<Plan> valid_plan;
+  double last_cost = previous.stats.cost;
   st.last_violation = -1;
   while (stats_.updates < options_.max_updates) {
     std::vector<graph::FactorPtr> new_factors;
@@ -673,6 +675,20 @@ Plan IncrementalPlanner::replan(const ProblemChange& change) {
     }
     // Settled at this multiplier estimate when the update's relative decrease is small (the
     // tolerance tightens with every multiplier round, as the batch planner's inner solves).
+    // A plan that validates and whose objective no longer drops by more than
+    // stop_objective_tol per update is the answer: after a small change one update usually
+    // suffices (validation costs about half an update). Removing an obstacle leaves the old
+    // plan valid; the objective test keeps it relaxing toward the cheaper path.
+    if (options_.stop_when_valid) {
+      Plan candidate = make_plan("incremental");
+      const double cost = candidate.stats.cost;
+      if (candidate.success() && cost >= (1 - options_.stop_objective_tol) * last_cost) {
+        valid_plan = std::move(candidate);
+        status = "converged";
+        break;
+      }
+      last_cost = cost;
+    }
     if (r.error_before - e > round_tol * std::max(r.error_before, 1e-12)) continue;
     // Converged at this multiplier estimate: check the constraints.
     const graph::Values& values = st.isam->estimate();
@@ -752,7 +768,7 @@ Plan IncrementalPlanner::replan(const ProblemChange& change) {
       "{:.2f} ms",
       change_s * 1e3, update_s * 1e3, stats_.incremental_time_s * 1e3);
 
-  Plan plan = make_plan("incremental");
+  Plan plan = valid_plan ? std::move(*valid_plan) : make_plan("incremental");
   spdlog::debug("iDFGP: plan made and validated at {:.2f} ms", seconds_since(t0) * 1e3);
   plan.stats.status = status;
   plan.stats.reason = reason;

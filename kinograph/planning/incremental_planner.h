@@ -86,6 +86,12 @@ struct IncrementalPlannerOptions {
   /// After the constraints hold, one more update relinearizing every moved variable (ISAM2
   /// otherwise settles near the optimum, within its relinearization threshold).
   bool polish = true;
+  /// Stop as soon as an update's plan validates (one validation, ~1 ms, per update) instead of
+  /// also polishing the objective to final_relative_error_tol; measured: the same torques within
+  /// 0.5 % on the iiwa tasks, a third of the updates (bench/replanning).
+  bool stop_when_valid = true;
+  /// ... and when the update lowered the objective (soft cost) by less than this fraction.
+  double stop_objective_tol = 1e-2;
   /// Fall back to a warm-started batch solve when the incremental plan does not validate.
   bool fallback = true;
   /// The Bayes tree is rebuilt (one full elimination) when the ISAM2 graph holds more than this
