@@ -325,6 +325,18 @@ planning::Plan PlannerNode::solve_incremental(const planning::Problem& problem, 
                                 st.fallback_time_s * 1e3)
                   : "");
   }
+  // The planner's own fallback is warm-started from the previous plan, which a far goal or an
+  // obstacle across the path can leave on the wrong side; a solve from scratch (straight line
+  // and detours) is the last resort before answering with a failure.
+  if (!plan.success() && !refused && options_.retry_from_scratch) {
+    spdlog::info("replan did not validate ({}); planning from scratch", plan.stats.reason);
+    const double spent = plan.stats.solve_time_s;
+    planning::Plan fresh = incremental_.plan(problem);
+    fresh.stats.solve_time_s += spent;
+    incremental_ready_ = fresh.success();
+    method = "batch after incremental";
+    return fresh;
+  }
   return plan;
 }
 

@@ -57,6 +57,9 @@ struct PlannerNodeOptions {
   /// rad) is planned from scratch instead of incrementally; pose goals always replan
   /// incrementally. Infinity = always incremental; see the measurement in planner_node.cc.
   double max_incremental_goal_change = std::numeric_limits<double>::infinity();
+  /// When a replan does not validate even after the incremental planner's warm-started
+  /// fallback, plan the same request once more from scratch before answering.
+  bool retry_from_scratch = true;
 };
 
 /// What a node has done since it started (for its status and for tests).

@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
 # The daemon demo, end to end over real LCM: kinographd serves the iiwa of robots/scenes/
-# iiwa_desk.yaml; the CLI sends it a goal, then drops a box into the workspace, and the daemon
-# replans; lcm-logger records the session. Plans and pictures go to out/daemon/.
+# iiwa_desk.yaml; the CLI sends it a goal (planned from scratch), then drops a ball into the
+# workspace (the daemon replans goal 1 incrementally, iDFGP), then sends a second goal near the
+# first (an incremental replan too); lcm-logger records the session. Each answer prints its
+# method ("batch", "incremental", "batch after incremental") and solve time. Plans and pictures
+# go to out/daemon/.
 # As root it runs in a private network namespace whose loopback carries the multicast group,
 # so no packet leaves this machine; otherwise it uses the in-process-free default URL with
 # ttl=0 (packets stay on this host).
@@ -41,15 +44,20 @@ echo "== a ball appears above the desk edge: the daemon replans goal 1"
 "$KG" send-obstacle --prefix IIWA --lcm-url "$URL" --id ball --shape sphere --size 0.05 \
   --position 0.35,0.25,0.62 --goal-id 1 --wait 120 --scene "$SCENE" \
   --out "$OUT/goal1_replan.json" || rc=$?
+echo "== goal 2, near goal 1 (the base turned 0.15 rad): replanned incrementally around the ball"
+"$KG" send-goal --prefix IIWA --lcm-url "$URL" --id 2 \
+  --q 0.921,0.335,-0.570,-1.046,-0.686,0.356,-0.122 --wait 120 \
+  --scene "$SCENE" --out "$OUT/goal2.json" || rc=$?
 
 kill -TERM "$DAEMON"
 wait "$DAEMON" || true
 kill -INT "$LOGGER"
 wait "$LOGGER" || true
-tail -n 4 "$OUT/kinographd.log"
+echo "== the daemon's log: one line per plan (method, time) and the iDFGP statistics"
+grep -E "goal [0-9]+: plan|iDFGP:|fell back|stopped after" "$OUT/kinographd.log" | cut -c 27-
 "$KG" log-plans "$OUT/session.lcmlog" --channel IIWA_PLAN --scene "$SCENE" --out-dir "$OUT/plans" \
   >/dev/null
-for plan in goal1 goal1_replan; do
+for plan in goal1 goal1_replan goal2; do
   if [ -f "$OUT/$plan.json" ]; then
     "$KG" render "$OUT/$plan.json" --scene "$SCENE" --frames 5 --out "$OUT/${plan}_strip.png"
   fi

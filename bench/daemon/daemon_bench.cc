@@ -6,8 +6,9 @@
 //   2. an obstacle move: a ball (r = 5 cm) added far from the arm, then moved onto the first
 //      plan's path (touching the block at mid-course), timed on the move,
 //      and removed again (replace_all with an empty list),
-//   3. a nearby goal (every joint moved within ±radius of the first goal), a medium one
-//      (within ±2.5·radius of the first goal), and a far goal (an independent sampled goal).
+//   3. a nearby goal (every joint moved within ±radius of the first goal), a medium and a large
+//      one (within ±2.5·radius and ±5·radius of the first goal), and a far goal (an independent
+//      sampled goal). Each goal change is measured from the previous goal (JSON samples).
 // Both the incremental node (PlannerNodeOptions::incremental, the default) and the batch node
 // (incremental = false) run the same sequence. Latency = publish to receipt of the plan_t,
 // medians over the runs that validated. Prints one JSON document, then a Markdown table.
@@ -196,7 +197,9 @@ int main(int argc, char** argv) {
   planning::GoalSampler checker(problem, goal_options(99));
   const int payload = problem.model->frame_index("payload");
 
-  const std::vector<std::string> kinds = {"first goal", "obstacle move", "nearby goal", "far goal"};
+  const std::vector<std::string> kinds = {"first goal",  "obstacle move", "obstacle remove",
+                                          "nearby goal", "medium goal",   "large goal",
+                                          "far goal"};
   const std::vector<std::string> modes = {"incremental", "batch"};
   std::map<std::string, std::map<std::string, Row>> rows;  // [mode][kind]
   std::vector<std::pair<Eigen::VectorXd, Eigen::VectorXd>> goals;
@@ -210,6 +213,7 @@ int main(int argc, char** argv) {
     const auto& [a, b] = goals[i];
     const auto near = nearby_goal(checker, a, radius, 1000 + i);
     const auto medium = nearby_goal(checker, a, 2.5 * radius, 2000 + i);
+    const auto large = nearby_goal(checker, a, 5 * radius, 3000 + i);
     for (const std::string& mode : modes) {
       lcm::LCM lcm("memq://");
       daemon::PlannerNodeOptions options;
@@ -257,6 +261,9 @@ int main(int argc, char** argv) {
         if (near) record("nearby goal", client.request("IIWA_GOAL", joint_goal(2, *near)), *near);
         if (medium) {
           record("medium goal", client.request("IIWA_GOAL", joint_goal(3, *medium)), *medium);
+        }
+        if (large) {
+          record("large goal", client.request("IIWA_GOAL", joint_goal(5, *large)), *large);
         }
         record("far goal", client.request("IIWA_GOAL", joint_goal(4, b)), b);
       }

@@ -410,12 +410,13 @@ TEST_F(ReplanFixture, InvalidGoalAfterAPlanKeepsServing) {
   EXPECT_TRUE(check(problem_with(goal), next).valid);
 }
 
-// A replan that fails (here: no ISAM2 update allowed and no fallback) does not poison the next
-// goal: it is planned from scratch and validates.
+// A replan that fails (here: no ISAM2 update allowed, no fallback, no retry) does not poison
+// the next goal: it is planned from scratch and validates.
 TEST_F(ReplanFixture, AFailedReplanIsFollowedByAPlanFromScratch) {
   PlannerNodeOptions options;
   options.incremental_planner.max_updates = 0;
   options.incremental_planner.fallback = false;
+  options.retry_from_scratch = false;
   start_reach(options);
   ASSERT_EQ(plan_goal(1, kGoal, 1).status, plan_t::SUCCESS);
   const plan_t failed = plan_goal(2, Eigen::Vector2d(0.9, 0.5), 2);
@@ -426,6 +427,22 @@ TEST_F(ReplanFixture, AFailedReplanIsFollowedByAPlanFromScratch) {
   ASSERT_EQ(next.status, plan_t::SUCCESS) << describe(next);
   EXPECT_EQ(next.method, "batch");
   EXPECT_TRUE(check(problem_with(goal), next).valid);
+}
+
+// The same failing replan with the retry on: the request itself is planned again from scratch
+// and answered with a valid plan.
+TEST_F(ReplanFixture, AFailedReplanIsRetriedFromScratch) {
+  PlannerNodeOptions options;
+  options.incremental_planner.max_updates = 0;
+  options.incremental_planner.fallback = false;
+  start_reach(options);
+  ASSERT_EQ(plan_goal(1, kGoal, 1).status, plan_t::SUCCESS);
+  const Eigen::Vector2d goal(0.9, 0.5);
+  const plan_t p = plan_goal(2, goal, 2);
+  ASSERT_EQ(p.status, plan_t::SUCCESS) << describe(p);
+  EXPECT_EQ(p.method, "batch after incremental");
+  EXPECT_TRUE(check(problem_with(goal), p).valid);
+  EXPECT_EQ(node_->counters().incremental, 1);
 }
 
 // With incremental replanning off, obstacle changes are warm-started batch solves and goals are
