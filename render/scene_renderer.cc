@@ -344,6 +344,12 @@ RenderResult SceneRenderer::compare(const RenderScene& before, const RenderScene
   first.obstacles = false;  // the world the second plan was made for is the one that counts
   first.path_color = options.before_path_color;
   first.path_key = "ee_path_before";
+  first.path_radius = options.path_radius;
+  for (const SceneObstacle& o : before.obstacles) {
+    const bool kept = std::any_of(after.obstacles.begin(), after.obstacles.end(),
+                                  [&](const SceneObstacle& a) { return a.name == o.name; });
+    if (!kept) first.faded.push_back(o);
+  }
   RenderScene shown = after;
   const int changed = options.changed_color
                           ? highlight_changed_obstacles(before, shown, *options.changed_color)
@@ -353,20 +359,30 @@ RenderResult SceneRenderer::compare(const RenderScene& before, const RenderScene
   second.min_alpha = frame.ghost_min_alpha;
   second.path_color = frame.path_color;
   second.path_key = "ee_path";
+  second.path_radius = options.path_radius;
   std::vector<Eigen::Vector3d> points = motion_points(after);
   for (const Eigen::Vector3d& p : motion_points(before)) points.push_back(p);
-  const Camera camera = camera_for(after, points, double(frame.width) / frame.height);
+  const double aspect = double(frame.width) / frame.height;
+  Camera camera = camera_for(after, points, aspect);
+  if (after.camera && options.reframe_camera) {
+    camera = frame_points(points, (camera.eye - camera.target).normalized(), aspect, camera.up,
+                          camera.fov_y_deg);
+  }
   RenderResult result = overlay({first, second}, camera, points, frame);
   if (frame.labels) {
+    // The legend in the bottom-left corner, where a view from above shows only floor.
     const double size = std::clamp(frame.height * 0.035, 11.0, 24.0);
-    const auto rgb = [](const Eigen::Vector4f& c) { return c.head<3>().cast<double>().eval(); };
-    draw_label(result.image, options.before_label, 0.5 * size, 0.4 * size, size,
-               LabelAnchor::kTopLeft, rgb(options.before_path_color));
-    draw_label(result.image, options.after_label, 0.5 * size, 1.9 * size, size,
-               LabelAnchor::kTopLeft, rgb(frame.path_color));
-    if (changed > 0) {
-      draw_label(result.image, options.changed_label, 0.5 * size, 3.4 * size, size,
-                 LabelAnchor::kTopLeft, options.changed_color->head<3>());
+    std::vector<std::pair<std::string, Eigen::Vector3d>> lines = {
+        {options.before_label, options.before_path_color.head<3>().cast<double>()},
+        {options.after_label, frame.path_color.head<3>().cast<double>()}};
+    if (changed > 0) lines.emplace_back(options.changed_label, options.changed_color->head<3>());
+    if (!first.faded.empty()) {
+      lines.emplace_back(options.removed_label, first.faded.front().rgba.head<3>());
+    }
+    double y = frame.height - (1.5 * static_cast<double>(lines.size() - 1) + 2.4) * size;
+    for (const auto& [text, color] : lines) {
+      draw_label(result.image, text, 0.5 * size, y, size, LabelAnchor::kTopLeft, color);
+      y += 1.5 * size;
     }
   }
   return result;
@@ -397,7 +413,6 @@ RenderResult SceneRenderer::overlay(const std::vector<Layer>& layers, const Came
     double distance;
   };
   std::vector<Ghost> ghosts;
-  const double radius = std::max(0.0035 * bounds.diagonal().norm(), 1e-3);
   const int n = options.frames;
   for (const Layer& layer : layers) {
     const RenderScene& scene = *layer.scene;
@@ -405,6 +420,7 @@ RenderResult SceneRenderer::overlay(const std::vector<Layer>& layers, const Came
     const std::vector<double> times = scene.trajectory.even_times(n);
     const int ee_frame = end_effector(scene);
     if (ee_frame >= 0) {
+      const double radius = std::max(layer.path_radius * bounds.diagonal().norm(), 1e-3);
       DrawItem path;
       path.mesh = renderer_.upload(layer.path_key, make_tube(path_points(scene, ee_frame), radius));
       path.color = layer.path_color;
@@ -420,6 +436,15 @@ RenderResult SceneRenderer::overlay(const std::vector<Layer>& layers, const Came
         item.color = o.rgba.cast<float>();
         opaque.push_back(item);
       }
+    }
+    if (!layer.faded.empty()) {
+      Ghost ghost;
+      ghost.alpha = layer.min_alpha;
+      RenderScene faded;
+      faded.obstacles = layer.faded;
+      obstacle_items(faded, times.front(), false, ghost.items);
+      ghost.distance = (bounds.center() - camera.eye).norm();
+      ghosts.push_back(std::move(ghost));
     }
     dynamics::Data data(model);
     for (int i = 0; i < n; ++i) {

@@ -32,8 +32,8 @@ struct FrameOptions {
 struct CompareOptions {
   FrameOptions frame;  ///< poses per plan, size, labels, floor; frame.path_color: second plan
   Eigen::Vector4f before_color = Eigen::Vector4f(0.55f, 0.57f, 0.60f, 1.f);  ///< first's tint
-  float before_min_alpha = 0.12f;  ///< opacity of the first plan's first pose
-  float before_max_alpha = 0.40f;  ///< and of its last pose (all of its poses are ghosts)
+  float before_min_alpha = 0.15f;  ///< opacity of the first plan's first pose
+  float before_max_alpha = 0.45f;  ///< and of its last pose (all of its poses are ghosts)
   Eigen::Vector4f before_path_color = Eigen::Vector4f(0.10f, 0.62f, 0.25f, 1.f);
   /// Colour of the second plan's obstacles that the first plan did not have as they are (see
   /// highlight_changed_obstacles); nullopt keeps their own colours.
@@ -41,6 +41,13 @@ struct CompareOptions {
   std::string before_label = "before";  ///< legend lines (frame.labels), in the paths' colours
   std::string after_label = "after";
   std::string changed_label = "changed obstacles";  ///< shown when some obstacle changed
+  /// Shown when the first plan has obstacles (by name) the second has not; they are drawn
+  /// faded, as the first plan's poses.
+  std::string removed_label = "removed obstacles (faded)";
+  /// With a fixed camera (a scene's), keep its direction, up and field of view but move it
+  /// to frame both motions: a scene's camera is set up for strip panels, not for this view.
+  bool reframe_camera = true;
+  double path_radius = 0.005;  ///< of both path tubes, as a fraction of the view's diagonal
 };
 
 /// One view in a picture: its pixel rectangle (top-left origin) and the camera that drew it,
@@ -105,7 +112,9 @@ class SceneRenderer {
     float min_alpha = 0.18f, max_alpha = 1.f;
     bool obstacles = true;  // draw this plan's obstacles
     Eigen::Vector4f path_color;
-    std::string path_key;  // mesh key of its path tube (one per layer of a picture)
+    std::string path_key;              // mesh key of its path tube (one per layer of a picture)
+    double path_radius = 0.0035;       // of the tube, as a fraction of the view's bounds' diagonal
+    std::vector<SceneObstacle> faded;  // obstacles drawn as ghosts at the layer's first opacity
   };
   RenderResult overlay(const std::vector<Layer>& layers, const Camera& camera,
                        const std::vector<Eigen::Vector3d>& points, const FrameOptions& options);
