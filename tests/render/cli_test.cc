@@ -35,10 +35,7 @@ CliRun run(const std::string& args) {
 class Cli : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           (std::string("kinograph_render_cli_test") + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
+    dir_ = test::make_test_dir("kinograph_render_cli_test");
     plan_ = (dir_ / "iiwa.json").string();
     test::write_json(test::iiwa_test_plan(10), plan_);
   }

@@ -1,8 +1,11 @@
 #pragma once
 // Robots, trajectories and plan files for the renderer's tests (plans are smooth joint-space
 // interpolations, written by the planner's plan-file writer).
+#include <gtest/gtest.h>
+
 #include <Eigen/Core>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -121,6 +124,16 @@ inline nlohmann::json iiwa_test_plan(int steps = 25) {
     for (int j = 0; j < 7; ++j) plan.tau(k, j) = 30.0 * std::sin(2.5 * tr.t[k] + j);
   }
   return planning::plan_to_json(plan, scene);
+}
+
+/// A fresh temporary folder for the running test, named after it: ctest -j runs the tests of
+/// one fixture in parallel processes, which must not share (and remove) each other's files.
+inline std::filesystem::path make_test_dir(const std::string& prefix) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() /
+      (prefix + "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  std::filesystem::create_directories(dir);
+  return dir;
 }
 
 /// Writes a plan file's JSON to `path`.
