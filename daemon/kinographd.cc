@@ -1,5 +1,6 @@
 // kinographd: the kinograph planner daemon for one robot on an LCM network.
 //   kinographd SCENE.yaml [--prefix IIWA] [--lcm-url URL] [--status-period 1.0]
+//              [--batch-only] [--max-goal-change RAD]
 // The scene gives the robot, default horizon and steps, start, fixed obstacles and objective
 // weights; goals, obstacle updates and measured states arrive over LCM.
 #include <spdlog/spdlog.h>
@@ -31,7 +32,14 @@ int main(int argc, char** argv) {
   app.add_option("--status-period", options.status_period_s, "status heartbeat period (s)")
       ->check(CLI::PositiveNumber);
   app.add_option("--log-level", level, "trace, debug, info, warn, error");
+  bool batch_only = false;
+  app.add_flag("--batch-only", batch_only,
+               "plan every request with a batch solve (no incremental replanning)");
+  app.add_option("--max-goal-change", options.max_incremental_goal_change,
+                 "plan joint goals that moved more than this (rad) from scratch (default: never)")
+      ->check(CLI::PositiveNumber);
   CLI11_PARSE(app, argc, argv);
+  options.incremental = !batch_only;
   spdlog::set_level(spdlog::level::from_str(level));
 
   std::signal(SIGINT, on_signal);
@@ -41,8 +49,11 @@ int main(int argc, char** argv) {
     node.run(g_stop);
     const auto c = node.counters();
     if (g_signal != 0) spdlog::info("kinographd: signal {} received", g_signal.load());
-    spdlog::info("kinographd: stopped after {} goals, {} plans ({} failed), {} rejected messages",
-                 c.goals_received, c.plans_published, c.failures, c.messages_rejected);
+    spdlog::info(
+        "kinographd: stopped after {} goals, {} plans ({} failed, {} incremental replans, {} "
+        "fallbacks), {} rejected messages",
+        c.goals_received, c.plans_published, c.failures, c.incremental, c.fallbacks,
+        c.messages_rejected);
   } catch (const std::exception& e) {
     std::cerr << "kinographd: error: " << e.what() << "\n";
     return 1;

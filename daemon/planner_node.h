@@ -106,6 +106,9 @@ class PlannerNode {
   void plan_and_publish(const GoalRequest& goal, bool replan);
   /// The batch path: from scratch, or warm-started from the current plan for a replan.
   planning::Plan solve_batch(const planning::Problem& problem, bool replan, std::string& method);
+  /// A plan from scratch that also becomes the incremental planner's current plan (when it
+  /// validates on the planner's graph).
+  planning::Plan plan_from_scratch(const planning::Problem& problem, std::string& method);
   /// The incremental path: a ProblemChange from the planner's problem to `problem` when the
   /// planner holds a usable plan, else a plan from scratch.
   planning::Plan solve_incremental(const planning::Problem& problem, bool new_goal, bool new_state,

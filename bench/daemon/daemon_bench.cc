@@ -183,6 +183,8 @@ int main(int argc, char** argv) {
   app.add_option("--radius", radius, "nearby goal: largest joint change (rad)");
   app.add_option("--json", json_path, "also write the JSON here");
   bool samples = false;
+  int only = -1;
+  app.add_option("--only", only, "run only this problem (index from 0; to look at one case)");
   app.add_flag("--samples", samples, "list every request in the JSON (goal change, outcome)");
   app.add_option("--log-level", level, "the node's log level (info shows every plan)");
   CLI11_PARSE(app, argc, argv);
@@ -210,6 +212,7 @@ int main(int argc, char** argv) {
     goals.emplace_back(*a, *b);
   }
   for (int i = 0; i < static_cast<int>(goals.size()); ++i) {
+    if (only >= 0 && i != only) continue;
     const auto& [a, b] = goals[i];
     const auto near = nearby_goal(checker, a, radius, 1000 + i);
     const auto medium = nearby_goal(checker, a, 2.5 * radius, 2000 + i);
