@@ -76,11 +76,13 @@ struct Method {
               {"time_s_max", max_of(ok_times)},
               {"time_s_median_all", median(all_times)},
               {"time_s_mean_all", mean(all_times)},
-              {"total_torque_mean", mean(torque)}};
+              {"total_torque_mean", mean(torque)},
+              {"time_s_all", all_times}};
     if (!updates.empty()) {
       j["incremental_successes"] = incremental_ok;
       j["fell_back"] = fell_back;
       j["isam2_updates_median"] = median(updates);
+      j["isam2_updates"] = updates;  // per run, in run order (with time_s_all)
     }
     return j;
   }

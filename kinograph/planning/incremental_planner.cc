@@ -97,6 +97,12 @@ double soft_cost(const graph::FactorGraph& graph, const graph::Values& values) {
   for (const auto& f : graph.factors()) {
     if (!f) continue;
     if (auto* c = dynamic_cast<const ConstrainedFactor*>(f.get())) {
+      // Most constraint factors (collision, limits) have no soft rows: skip their evaluation.
+      const auto& rows = c->rows();
+      if (std::none_of(rows.begin(), rows.end(),
+                       [](const RowSpec& r) { return r.kind == RowKind::kSoft; })) {
+        continue;
+      }
       c->values_at(values, z);
       for (int i = 0; i < c->residual_dim(); ++i) {
         const RowSpec& row = c->rows()[i];
@@ -204,7 +210,7 @@ std::vector<Entry> timing_entries(const Problem& p, const IncrementalPlannerOpti
 
 }  // namespace
 
-Plan IncrementalPlanner::make_plan(const std::string& method) {
+Plan IncrementalPlanner::make_plan(const std::string& method, bool with_stats) {
   const graph::Values& values = state_->isam->estimate();
   const int n = problem_.model->nq(), N = problem_.steps;
   const Trajectory tr = read_trajectory(values, N, n);
@@ -222,14 +228,20 @@ Plan IncrementalPlanner::make_plan(const std::string& method) {
                           .transpose();
   }
   plan.stats.method = method;
+  // Without stats this is the stopping rule's check, which needs only the verdict.
+  plan.validation = validate(problem_, plan, options_.batch.validation, !with_stats);
+  if (with_stats) fill_stats(plan);
+  return plan;
+}
+
+void IncrementalPlanner::fill_stats(Plan& plan) const {
+  const graph::Values& values = state_->isam->estimate();
   plan.stats.cost = soft_cost(state_->isam->graph(), values);
   double worst = 0;
   for (const Entry& e : state_->entries) {
     if (e.constrained) worst = std::max(worst, e.constrained->violation(values));
   }
   plan.stats.max_constraint_violation = worst;
-  plan.validation = validate(problem_, plan, options_.batch.validation);
-  return plan;
 }
 
 Plan IncrementalPlanner::batch_solve(const Problem& problem, const Eigen::MatrixXd* q,
@@ -680,14 +692,17 @@ Plan IncrementalPlanner::replan(const ProblemChange& change) {
     // suffices (validation costs about half an update). Removing an obstacle leaves the old
     // plan valid; the objective test keeps it relaxing toward the cheaper path.
     if (options_.stop_when_valid) {
-      Plan candidate = make_plan("incremental");
-      const double cost = candidate.stats.cost;
-      if (candidate.success() && cost >= (1 - options_.stop_objective_tol) * last_cost) {
-        valid_plan = std::move(candidate);
-        status = "converged";
-        break;
+      Plan candidate = make_plan("incremental", /*with_stats=*/false);
+      if (candidate.success()) {
+        const double cost = soft_cost(st.isam->graph(), st.isam->estimate());
+        if (cost >= (1 - options_.stop_objective_tol) * last_cost) {
+          fill_stats(candidate);  // a valid plan's validation is complete
+          valid_plan = std::move(candidate);
+          status = "converged";
+          break;
+        }
+        last_cost = cost;
       }
-      last_cost = cost;
     }
     if (r.error_before - e > round_tol * std::max(r.error_before, 1e-12)) continue;
     // Converged at this multiplier estimate: check the constraints.

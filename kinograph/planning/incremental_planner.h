@@ -166,7 +166,9 @@ class IncrementalPlanner {
   struct State;
   Plan batch_solve(const Problem& problem, const Eigen::MatrixXd* q, const Eigen::MatrixXd* qd,
                    const Eigen::MatrixXd* qdd, const std::string& method, bool keep_multipliers);
-  Plan make_plan(const std::string& method);
+  /// The plan at the current estimate, validated; with_stats adds its cost and worst violation.
+  Plan make_plan(const std::string& method, bool with_stats = true);
+  void fill_stats(Plan& plan) const;
 
   IncrementalPlannerOptions options_;
   Problem problem_;

@@ -36,7 +36,7 @@ Eigen::VectorXd hermite(const Plan& plan, int k, double s, double dt) {
 }  // namespace
 
 Validation validate(const Problem& problem, const Plan& plan,
-                    const ValidationThresholds& thresholds) {
+                    const ValidationThresholds& thresholds, bool verdict_only) {
   Validation v;
   auto fail = [&v](std::string why) { v.failures.push_back(std::move(why)); };
   if (!problem.model) {
@@ -175,8 +175,9 @@ Validation validate(const Problem& problem, const Plan& plan,
       fail(fmt(("task constraint on '" + task.frame + "'").c_str(), worst, task.tolerance));
   }
 
-  // Collision: every step and dense samples along the validator's Hermite interpolation.
-  if (!problem.obstacles.empty()) {
+  // Collision: every step and dense samples along the validator's Hermite interpolation. The
+  // only costly check; a caller that only needs the verdict skips it once another failed.
+  if (!problem.obstacles.empty() && !(verdict_only && !v.failures.empty())) {
     collision::CollisionWorld world(model);
     bool ok = true;
     for (const collision::Obstacle& o : problem.obstacles) {

@@ -24,7 +24,9 @@ struct ValidationThresholds {
 
 /// Validates `plan` for `problem`: fills every figure of Validation, lists each failed check
 /// in failures, and sets valid. Malformed plans (wrong sizes, NaN) are invalid, never a crash.
+/// With verdict_only, the collision check (the costly one) is skipped when another check has
+/// already failed, so min_clearance may be left unset then.
 Validation validate(const Problem& problem, const Plan& plan,
-                    const ValidationThresholds& thresholds = {});
+                    const ValidationThresholds& thresholds = {}, bool verdict_only = false);
 
 }  // namespace kinograph::planning
