@@ -280,6 +280,16 @@ planning::Plan PlannerNode::solve_incremental(const planning::Problem& problem, 
                                               bool new_state, std::string& method) {
   bool from_scratch = !incremental_ready_ || !incremental_.has_plan() ||
                       incremental_.problem().steps != problem.steps;
+  // Far goals. Measured with bench/daemon on the iiwa desk (20 problems, 18 with a valid first
+  // plan): independent far goals (largest joint change 1.9–5.1 rad) replanned incrementally
+  // validated 18/18 (13 directly, 4 after the planner's warm batch fallback, 1 from scratch after
+  // an earlier failure), median 92 ms end to end; the batch path (BatchPlanner from the straight
+  // line) 18/18, median 103 ms. A fallback costs about 0.5 s, but planning far goals from scratch
+  // here would cost IncrementalPlanner::plan's median 235 ms every time (a batch solve, its
+  // re-solve on the incremental graph, and settling). Goals within 1.3 rad replanned at 8–55 ms
+  // median against 127–155 ms for the batch path. So every goal replans incrementally by default
+  // (max_incremental_goal_change = ∞); the option remains for robots where far goals fall back
+  // more often.
   if (!from_scratch && new_goal) {
     const double change = joint_goal_change(incremental_.problem().goal, problem.goal);
     // Pose goals have no joint distance (infinity here): they always replan incrementally.
@@ -332,9 +342,9 @@ planning::Plan PlannerNode::solve_incremental(const planning::Problem& problem, 
   }
   if (!refused) {
     spdlog::info(
-        "iDFGP: {} ISAM2 updates, {} multiplier rounds, {} cliques re-eliminated, {} factors "
-        "replaced, {:.1f} ms incremental{}",
-        st.updates, st.rounds, st.cliques_reeliminated, st.factors_replaced,
+        "iDFGP: {} ISAM2 updates, {} multiplier rounds, {} cliques re-eliminated, factors {} "
+        "replaced + {} added, {:.1f} ms incremental{}",
+        st.updates, st.rounds, st.cliques_reeliminated, st.factors_replaced, st.factors_added,
         st.incremental_time_s * 1e3,
         fell_back ? fmt::format(", fell back ({}) {:.1f} ms", st.fallback_reason,
                                 st.fallback_time_s * 1e3)
