@@ -1,6 +1,8 @@
 #pragma once
 // Pictures of plans: frame strips (the robot at evenly spaced times, side by side, as the
-// paper's figures) and ghost overlays (all frames in one view, fading from start to goal).
+// paper's figures), ghost overlays (all frames in one view, fading from start to goal) and two
+// plans compared in one view (the replanning figure). Moving obstacles are drawn where they are
+// at each pose's time.
 #include <Eigen/Core>
 #include <optional>
 #include <string>

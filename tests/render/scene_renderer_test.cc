@@ -229,6 +229,33 @@ TEST_F(RedArm, MovingObstacleIsDrawnWhereItIsAtEachFrame) {
   EXPECT_EQ(count_near(result.image, *first.project(to), 2, is_blue), 0);
 }
 
+// In a ghost overlay a moving obstacle is solid where it is at the end and faded where it was
+// at the first pose.
+TEST_F(RedArm, GhostOverlayFadesAMovingObstacleAlongItsWay) {
+  SceneObstacle ball;
+  ball.obstacle.shape = collision::Shape::sphere(0.12);
+  const Eigen::Vector3d from(-0.7, -0.9, 0.2), to(0.7, -0.9, 0.2);
+  ball.obstacle.trajectory = collision::PoseTrajectory(
+      {0.0, 2.0}, {Eigen::Isometry3d(Eigen::Translation3d(from)),
+                   Eigen::Isometry3d(Eigen::Translation3d(to))});
+  ball.rgba = Eigen::Vector4d(0.2, 0.4, 0.9, 1.0);
+  scene_.obstacles = {ball};
+  FrameOptions options;
+  options.frames = 3;
+  options.width = 700;
+  options.height = 500;
+  options.floor = false;
+  const RenderResult result = shared_renderer().ghost(scene_, options);
+  const Panel& panel = result.panels.front();
+  EXPECT_GE(count_near(result.image, *panel.project(to), 2, is_blue), 20);
+  // The first ghost (opacity 0.18 over white): bluish, but far from the solid colour.
+  const auto faded_blue = [](const std::uint8_t* p) {
+    return p[2] > p[0] + 12 && p[0] > 150 && p[2] > 200;
+  };
+  EXPECT_GE(count_near(result.image, *panel.project(from), 2, faded_blue), 20);
+  EXPECT_EQ(count_near(result.image, *panel.project(from), 2, is_blue), 0);
+}
+
 // The replanning figure: the first plan as grey ghosts with a green path, the second in the
 // arm's red with its own (yellow) path, and an obstacle only the second plan has in magenta.
 TEST_F(RedArm, CompareShowsBothPathsAndTheChangedObstacle) {
