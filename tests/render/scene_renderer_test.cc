@@ -236,8 +236,8 @@ TEST_F(RedArm, GhostOverlayFadesAMovingObstacleAlongItsWay) {
   ball.obstacle.shape = collision::Shape::sphere(0.12);
   const Eigen::Vector3d from(-0.7, -0.9, 0.2), to(0.7, -0.9, 0.2);
   ball.obstacle.trajectory = collision::PoseTrajectory(
-      {0.0, 2.0}, {Eigen::Isometry3d(Eigen::Translation3d(from)),
-                   Eigen::Isometry3d(Eigen::Translation3d(to))});
+      {0.0, 2.0},
+      {Eigen::Isometry3d(Eigen::Translation3d(from)), Eigen::Isometry3d(Eigen::Translation3d(to))});
   ball.rgba = Eigen::Vector4d(0.2, 0.4, 0.9, 1.0);
   scene_.obstacles = {ball};
   FrameOptions options;
