@@ -22,7 +22,10 @@ struct CliRun {
 };
 
 CliRun run(const std::string& args) {
-  const std::string command = std::string(KINOGRAPH_CLI) + " " + args + " 2>&1";
+  // Under AddressSanitizer, third-party leaks at exit (fontconfig, OSMesa) are suppressed.
+  const std::string command = "LSAN_OPTIONS=suppressions=" + std::string(KINOGRAPH_SOURCE_DIR) +
+                              "/tests/render/lsan.supp " + std::string(KINOGRAPH_CLI) + " " + args +
+                              " 2>&1";
   CliRun result;
   FILE* pipe = popen(command.c_str(), "r");
   if (pipe == nullptr) return result;
