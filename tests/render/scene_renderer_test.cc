@@ -55,6 +55,19 @@ class RedArm : public ::testing::Test {
     return points;
   }
 
+  // A blue ball in front of the arm, moving from kBallFrom to kBallTo over the plan's 2 s.
+  static SceneObstacle moving_ball() {
+    SceneObstacle ball;
+    ball.obstacle.shape = collision::Shape::sphere(0.12);
+    ball.obstacle.trajectory =
+        collision::PoseTrajectory({0.0, 2.0}, {Eigen::Isometry3d(Eigen::Translation3d(kBallFrom)),
+                                               Eigen::Isometry3d(Eigen::Translation3d(kBallTo))});
+    ball.rgba = Eigen::Vector4d(0.2, 0.4, 0.9, 1.0);
+    return ball;
+  }
+  inline static const Eigen::Vector3d kBallFrom{-0.7, -0.9, 0.2};
+  inline static const Eigen::Vector3d kBallTo{0.7, -0.9, 0.2};
+
   std::unique_ptr<dynamics::Model> model_;
   RenderScene scene_;
 };
@@ -198,14 +211,8 @@ TEST_F(RedArm, GhostOverlayShowsFinalPoseAndPath) {
 // A ball that moves from the arm's left to its right: each strip panel shows it where it is at
 // that panel's time, and no longer where it was.
 TEST_F(RedArm, MovingObstacleIsDrawnWhereItIsAtEachFrame) {
-  SceneObstacle ball;
-  ball.obstacle.shape = collision::Shape::sphere(0.12);
-  const Eigen::Vector3d from(-0.7, -0.9, 0.2), to(0.7, -0.9, 0.2);
-  ball.obstacle.trajectory = collision::PoseTrajectory(
-      {0.0, 2.0},
-      {Eigen::Isometry3d(Eigen::Translation3d(from)), Eigen::Isometry3d(Eigen::Translation3d(to))});
-  ball.rgba = Eigen::Vector4d(0.2, 0.4, 0.9, 1.0);
-  scene_.obstacles = {ball};
+  const Eigen::Vector3d from = kBallFrom, to = kBallTo;
+  scene_.obstacles = {moving_ball()};
   FrameOptions options;
   options.frames = 3;
   options.width = 960;
@@ -232,14 +239,8 @@ TEST_F(RedArm, MovingObstacleIsDrawnWhereItIsAtEachFrame) {
 // In a ghost overlay a moving obstacle is solid where it is at the end and faded where it was
 // at the first pose.
 TEST_F(RedArm, GhostOverlayFadesAMovingObstacleAlongItsWay) {
-  SceneObstacle ball;
-  ball.obstacle.shape = collision::Shape::sphere(0.12);
-  const Eigen::Vector3d from(-0.7, -0.9, 0.2), to(0.7, -0.9, 0.2);
-  ball.obstacle.trajectory = collision::PoseTrajectory(
-      {0.0, 2.0},
-      {Eigen::Isometry3d(Eigen::Translation3d(from)), Eigen::Isometry3d(Eigen::Translation3d(to))});
-  ball.rgba = Eigen::Vector4d(0.2, 0.4, 0.9, 1.0);
-  scene_.obstacles = {ball};
+  const Eigen::Vector3d from = kBallFrom, to = kBallTo;
+  scene_.obstacles = {moving_ball()};
   FrameOptions options;
   options.frames = 3;
   options.width = 700;
