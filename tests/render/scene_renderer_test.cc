@@ -318,6 +318,40 @@ TEST_F(RedArm, CompareShowsBothPathsAndTheChangedObstacle) {
   }
 }
 
+// A scene's fixed camera keeps its direction in the replanning figure but is moved to frame both
+// plans' motions.
+TEST_F(RedArm, CompareReframesAFixedCameraAlongItsDirection) {
+  RenderScene after = scene_;
+  after.trajectory =
+      test::smooth_trajectory(scene_.trajectory.q.front(), Eigen::Vector3d(0.9, 0.5, 0.4));
+  Camera fixed;
+  fixed.eye = Eigen::Vector3d(20, -5, 3);  // far too far: the arm would be a few pixels
+  fixed.target = Eigen::Vector3d(0, 0, 0.5);
+  fixed.fov_y_deg = 35;
+  after.camera = fixed;
+  CompareOptions options;
+  options.frame.width = 400;
+  options.frame.height = 300;
+  const Camera camera = shared_renderer().compare(scene_, after, options).panels.front().camera;
+  EXPECT_TRUE((camera.eye - camera.target)
+                  .normalized()
+                  .isApprox((fixed.eye - fixed.target).normalized(), 1e-9));
+  EXPECT_EQ(camera.fov_y_deg, fixed.fov_y_deg);
+  EXPECT_LT((camera.eye - camera.target).norm(), 0.5 * (fixed.eye - fixed.target).norm());
+  for (const RenderScene* scene : {&scene_, &after}) {
+    for (const Eigen::Vector3d& p : shared_renderer().motion_points(*scene)) {
+      const auto pixel = camera.project(p, 400, 300);
+      ASSERT_TRUE(pixel.has_value());
+      EXPECT_TRUE(pixel->x() > -1e-6 && pixel->x() < 400 + 1e-6 && pixel->y() > -1e-6 &&
+                  pixel->y() < 300 + 1e-6)
+          << pixel->transpose();
+    }
+  }
+  options.reframe_camera = false;  // then the scene's camera is used as it is
+  const Camera kept = shared_renderer().compare(scene_, after, options).panels.front().camera;
+  EXPECT_EQ(kept.eye, fixed.eye);
+}
+
 TEST_F(RedArm, ZeroFramesIsAClearError) {
   FrameOptions options;
   options.frames = 0;
