@@ -1,4 +1,6 @@
 // The `kinograph` command-line tool: dispatches to the verbs in cmd_*.cc.
+#include <spdlog/spdlog.h>
+
 #include <iostream>
 
 #include "tools/command_registry.h"
@@ -20,6 +22,13 @@ bool register_command(CommandSetup setup) {
 int main(int argc, char** argv) {
   CLI::App app{"kinograph: kinodynamic motion planning on dynamic factor graphs"};
   app.require_subcommand(1);
+  // Library messages (solver progress, per-update timing at debug) go to stderr via spdlog.
+  app.add_option_function<std::string>(
+         "--log-level",
+         [](const std::string& level) { spdlog::set_level(spdlog::level::from_str(level)); },
+         "Library log level: trace, debug, info, warn (default), error, off")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
+  spdlog::set_level(spdlog::level::warn);
   for (const auto& setup : kinograph::tools::command_registry()) setup(app);
   try {
     app.parse(argc, argv);
