@@ -427,7 +427,6 @@ json plan_to_json(const Plan& plan, const Scene& scene) {
   json names = json::array();
   json lower = json::array(), upper = json::array(), velocity = json::array(),
        acceleration = json::array(), effort = json::array();
-  bool finite_effort = true;
   if (problem.model) {
     for (const dynamics::Body& b : problem.model->bodies) {
       names.push_back(b.joint_name);
@@ -436,7 +435,6 @@ json plan_to_json(const Plan& plan, const Scene& scene) {
       velocity.push_back(number(b.limits.velocity));
       acceleration.push_back(number(b.limits.acceleration));
       effort.push_back(number(b.limits.effort));
-      finite_effort = finite_effort && std::isfinite(b.limits.effort);
     }
   }
   j["joint_names"] = names;
@@ -445,9 +443,11 @@ json plan_to_json(const Plan& plan, const Scene& scene) {
   j["qd"] = matrix_rows(plan.qd);
   j["qdd"] = matrix_rows(plan.qdd);
   j["tau"] = matrix_rows(plan.tau);
-  j["limits"] = {
-      {"lower", lower}, {"upper", upper}, {"velocity", velocity}, {"acceleration", acceleration}};
-  if (finite_effort) j["limits"]["effort"] = effort;
+  j["limits"] = {{"lower", lower},
+                 {"upper", upper},
+                 {"velocity", velocity},
+                 {"acceleration", acceleration},
+                 {"effort", effort}};
   j["stats"] = to_json(plan.stats);
   j["validation"] = to_json(plan.validation);
   return j;

@@ -13,9 +13,8 @@
 //             "effort": [...]}, "stats": {...}, "validation": {...}}
 //
 // JSON has no infinity: an infinite limit or clearance is written as null and read back as
-// infinity; "limits.effort" is left out when any effort limit is infinite (the renderer reads
-// it as plain numbers). NaN trajectory values are written as null and read back as NaN, so a
-// broken plan still round-trips to the validator.
+// infinity (-infinity for a lower joint limit). NaN trajectory values are written as null and
+// read back as NaN, so a broken plan still round-trips to the validator.
 #include <Eigen/Core>
 #include <memory>
 #include <nlohmann/json.hpp>

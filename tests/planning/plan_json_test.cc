@@ -164,8 +164,9 @@ obstacles:
   ASSERT_EQ(j["obstacles"][2]["motion"].size(), 2u);
   EXPECT_EQ(j["obstacles"][2]["motion"][1]["t"], 1.0);
   EXPECT_EQ(j["obstacles"][2]["motion"][1]["position"], json({0.0, 1.0, 2.0}));
-  // An infinite effort limit leaves "effort" out (the renderer wants numbers); others are null.
-  EXPECT_FALSE(j["limits"].contains("effort"));
+  // Infinite limits are null.
+  EXPECT_TRUE(j["limits"]["effort"][0].is_null());
+  EXPECT_EQ(j["limits"]["effort"][1], scene.problem.model->bodies[1].limits.effort);
   EXPECT_TRUE(j["limits"]["lower"][0].is_null());
   EXPECT_TRUE(j["validation"]["min_clearance"].is_null());
   EXPECT_TRUE(j["q"][2][1].is_null());
@@ -174,6 +175,11 @@ obstacles:
   EXPECT_EQ(back.validation.min_clearance, std::numeric_limits<double>::infinity());
   EXPECT_TRUE(std::isnan(back.q(2, 1)));
   EXPECT_EQ(back.q(2, 0), plan.q(2, 0));
+  // Read whole, the robot gets the scene's limits back, the infinite ones included.
+  const PlanFile file = plan_file_from_json(json::parse(j.dump()));
+  EXPECT_EQ(file.model->bodies[0].limits.effort, std::numeric_limits<double>::infinity());
+  EXPECT_EQ(file.model->bodies[0].limits.lower, -std::numeric_limits<double>::infinity());
+  EXPECT_EQ(file.model->bodies[1].limits.effort, scene.problem.model->bodies[1].limits.effort);
 }
 
 TEST(PlanJson, ColumnsFollowJointNames) {
