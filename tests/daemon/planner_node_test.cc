@@ -333,6 +333,32 @@ TEST_F(ReplanFixture, NearbyGoalReplansIncrementally) {
   EXPECT_TRUE(check(problem_with(goal), p).valid);
 }
 
+// A goal naming a duration changes the horizon (same step count) within the incremental replan;
+// the next goal without one returns to the scene's horizon.
+TEST_F(ReplanFixture, GoalDurationChangesTheHorizon) {
+  start_reach();
+  ASSERT_EQ(plan_goal(1, kGoal, 1).status, plan_t::SUCCESS);
+  goal_t g{};
+  g.goal_id = 2;
+  g.kind = goal_t::KIND_JOINT_CONFIGURATION;
+  g.num_joints = 2;
+  g.joint_position = {1.1, 0.1};
+  g.ee_quaternion[0] = 1;
+  g.duration_s = 3.5;
+  lcm_.publish("RR_GOAL", &g);
+  auto plans = listener_->wait_plans(2);
+  ASSERT_EQ(plans.size(), 2u);
+  ASSERT_EQ(plans[1].status, plan_t::SUCCESS) << describe(plans[1]);
+  EXPECT_EQ(plans[1].method, "incremental");
+  EXPECT_NEAR(plans[1].t.back(), 3.5, 1e-9);
+  planning::Problem longer = problem_with(Eigen::Vector2d(1.1, 0.1));
+  longer.horizon = 3.5;
+  EXPECT_TRUE(check(longer, plans[1]).valid);
+  const plan_t back = plan_goal(3, kGoal, 3);
+  ASSERT_EQ(back.status, plan_t::SUCCESS) << describe(back);
+  EXPECT_NEAR(back.t.back(), scene_.problem.horizon, 1e-9);
+}
+
 // Removing the obstacle (by name, then the whole list by replace_all) replans the current goal
 // for the world without it.
 TEST_F(ReplanFixture, ObstacleRemovedReplans) {
