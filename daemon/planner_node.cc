@@ -283,11 +283,11 @@ planning::Plan PlannerNode::solve_incremental(const planning::Problem& problem, 
   // Far goals. Measured with bench/daemon on the iiwa desk (20 problems, 18 with a valid first
   // plan): independent far goals (largest joint change 1.9–5.1 rad) replanned incrementally
   // validated 18/18 (13 directly, 4 after the planner's warm batch fallback, 1 from scratch after
-  // an earlier failure), median 92 ms end to end; the batch path (BatchPlanner from the straight
-  // line) 18/18, median 103 ms. A fallback costs about 0.5 s, but planning far goals from scratch
-  // here would cost IncrementalPlanner::plan's median 235 ms every time (a batch solve, its
-  // re-solve on the incremental graph, and settling). Goals within 1.3 rad replanned at 8–55 ms
-  // median against 127–155 ms for the batch path. So every goal replans incrementally by default
+  // an earlier failure), median 97 ms end to end; the batch path (BatchPlanner from the straight
+  // line) 18/18, median 98 ms. A fallback costs about 0.5 s, but planning far goals from scratch
+  // here would cost IncrementalPlanner::plan's median 236 ms every time (a batch solve, its
+  // re-solve on the incremental graph, and settling). Goals within 1.3 rad replanned at 23–47 ms
+  // median against 134–156 ms for the batch path. So every goal replans incrementally by default
   // (max_incremental_goal_change = ∞); the option remains for robots where far goals fall back
   // more often.
   if (!from_scratch && new_goal) {
