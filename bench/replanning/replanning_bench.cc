@@ -52,7 +52,7 @@ double seconds_since(Clock::time_point t0) {
 
 // One method's runs on a set of replanning problems.
 struct Method {
-  std::vector<double> ok_times, all_times, torque;
+  std::vector<double> ok_times, all_times, torque, cost;
   int runs = 0, ok = 0;
   int incremental_ok = 0;  // iDFGP: validated without the batch fallback
   int fell_back = 0;
@@ -65,6 +65,7 @@ struct Method {
       ++ok;
       ok_times.push_back(wall_s);
       torque.push_back(plan.tau.cwiseAbs().sum());
+      cost.push_back(plan.stats.cost);
     }
   }
   json to_json() const {
@@ -77,6 +78,7 @@ struct Method {
               {"time_s_median_all", median(all_times)},
               {"time_s_mean_all", mean(all_times)},
               {"total_torque_mean", mean(torque)},
+              {"objective_mean", mean(cost)},
               {"time_s_all", all_times}};
     if (!updates.empty()) {
       j["incremental_successes"] = incremental_ok;
@@ -210,6 +212,8 @@ int run(int argc, char** argv) {
       io.relinearize_all = false;
     } else if (a == "--max-penalty" && i + 1 < argc) {
       io.max_penalty = std::stod(argv[++i]);
+    } else if (a == "--stop-rise" && i + 1 < argc) {
+      io.stop_objective_rise = std::stod(argv[++i]);
     } else if (a == "--polish-objective") {
       io.stop_when_valid = false;
     } else if (a == "--no-polish") {
@@ -220,7 +224,7 @@ int run(int argc, char** argv) {
       std::cerr << "usage: replanning_bench [--problems 50] [--obstacle-problems N] "
                    "[--radius 0.2] [--shift 0.05] [--no-stiff] [--json FILE] "
                    "[--log-level warn|info|debug|trace] [--tol 1e-2] [--final-tol 1e-4] "
-                   "[--relinearize-threshold X (instead of relinearizing all)] [--no-polish] [--polish-objective] [--max-penalty 1e4]\n";
+                   "[--relinearize-threshold X (instead of relinearizing all)] [--no-polish] [--polish-objective] [--max-penalty 1e4] [--stop-rise 0.25]\n";
       return 1;
     }
   }

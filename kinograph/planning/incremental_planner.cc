@@ -479,6 +479,15 @@ Plan IncrementalPlanner::plan(const Problem& problem, const Plan* warm) {
     }
     stats_.method = p.stats.method;
   }
+  if (!p.success() && batch.success()) {
+    // The re-solve on the incremental graph missed what the batch plan reached: answer with the
+    // batch plan (the tree stays at the re-solve's estimate, near it, for the next replan).
+    const SolveStats own = p.stats;
+    p = batch;  // the counts are the re-solve's plus (below) the batch plan's
+    p.stats.iterations = own.iterations;
+    p.stats.outer_iterations = own.outer_iterations;
+    p.stats.linear_solves = own.linear_solves;
+  }
   p.stats.iterations += batch.stats.iterations;
   p.stats.outer_iterations += batch.stats.outer_iterations;
   p.stats.linear_solves += batch.stats.linear_solves;
@@ -489,6 +498,8 @@ Plan IncrementalPlanner::plan(const Problem& problem, const Plan* warm) {
 
 Plan IncrementalPlanner::replan(const ProblemChange& change) {
   const auto t0 = Clock::now();
+  stats_ = IncrementalStats();  // a refused change must not report the previous replan's figures
+  stats_.method = "incremental";
   if (!state_) return failed("incremental", "no_plan", "replan needs a plan first");
   State& st = *state_;
   const int n = problem_.model->nq(), N = problem_.steps;
@@ -687,22 +698,27 @@ Plan IncrementalPlanner::replan(const ProblemChange& change) {
     }
     // Settled at this multiplier estimate when the update's relative decrease is small (the
     // tolerance tightens with every multiplier round, as the batch planner's inner solves).
-    // A plan that validates and whose objective no longer drops by more than
-    // stop_objective_tol per update is the answer: after a small change one update usually
-    // suffices (validation costs about half an update). Removing an obstacle leaves the old
-    // plan valid; the objective test keeps it relaxing toward the cheaper path.
+    // A plan that validates, whose objective (soft cost) dropped by less than
+    // stop_objective_tol and rose by less than stop_objective_rise since the previous update
+    // (for the first, since the previous plan), is the answer: after a small change one update
+    // usually suffices (validation costs about half an update). A valid plan whose objective
+    // still falls is not yet the optimum (removing an obstacle leaves the old plan valid but no
+    // longer cheapest); one whose objective jumped is a poor iterate (the first update after a
+    // goal change on the RR arm: valid, cost 700× the optimum).
     if (options_.stop_when_valid) {
-      Plan candidate = make_plan("incremental", /*with_stats=*/false);
-      if (candidate.success()) {
-        const double cost = soft_cost(st.isam->graph(), st.isam->estimate());
-        if (cost >= (1 - options_.stop_objective_tol) * last_cost) {
+      const double cost = soft_cost(st.isam->graph(), st.isam->estimate());
+      const double ref = std::max(last_cost, 1e-12);
+      if (cost >= (1 - options_.stop_objective_tol) * ref &&
+          cost <= (1 + options_.stop_objective_rise) * ref) {
+        Plan candidate = make_plan("incremental", /*with_stats=*/false);
+        if (candidate.success()) {
           fill_stats(candidate);  // a valid plan's validation is complete
           valid_plan = std::move(candidate);
           status = "converged";
           break;
         }
-        last_cost = cost;
       }
+      last_cost = cost;
     }
     if (r.error_before - e > round_tol * std::max(r.error_before, 1e-12)) continue;
     // Converged at this multiplier estimate: check the constraints.
