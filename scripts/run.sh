@@ -43,14 +43,14 @@ if $KG plot --help >/dev/null 2>&1; then
     --label "without min torque" --title "iiwa task 2: joint torques" \
     --out out/iiwa_task2_torque.png
 fi
-# The replanning figure: the desk plan, then a box put on the desk and a leg taken away
-# (robots/scenes/changes/iiwa_desk_add_box.yaml) and the plan replanned incrementally; both in
-# one view (first plan grey, replan in colour, the changed obstacle highlighted).
+# The replanning figure: the desk plan, then a ball appears on the block's way up
+# (robots/scenes/changes/iiwa_desk_ball.yaml) and the plan is replanned incrementally; both in
+# one view (first plan grey, replan in colour, the new obstacle highlighted).
 if $KG render --help 2>/dev/null | grep -- --compare >/dev/null; then
-  echo "== replan robots/scenes/iiwa_desk.yaml + changes/iiwa_desk_add_box.yaml"
+  echo "== replan robots/scenes/iiwa_desk.yaml + changes/iiwa_desk_ball.yaml"
   rm -f out/iiwa_desk_replan_before.json out/iiwa_desk_replan_after.json
   rc=0
-  $KG replan robots/scenes/iiwa_desk.yaml robots/scenes/changes/iiwa_desk_add_box.yaml \
+  $KG replan robots/scenes/iiwa_desk.yaml robots/scenes/changes/iiwa_desk_ball.yaml \
     --out-before out/iiwa_desk_replan_before.json --out-after out/iiwa_desk_replan_after.json \
     --quiet || rc=$?
   if [ "$rc" -eq 2 ]; then

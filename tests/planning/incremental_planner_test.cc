@@ -296,7 +296,7 @@ TEST(ReplanChange, ShippedChangeFiles) {
     EXPECT_TRUE(re.success()) << name << ": " << failures(re);
   }
   const Scene desk = load_scene(kScenes + "iiwa_desk.yaml");
-  for (const char* name : {"iiwa_desk_goal", "iiwa_desk_add_box"}) {
+  for (const char* name : {"iiwa_desk_goal", "iiwa_desk_add_box", "iiwa_desk_ball"}) {
     EXPECT_NO_THROW(load_change(kScenes + "changes/" + name + ".yaml", desk)) << name;
   }
 }
