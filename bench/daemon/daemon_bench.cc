@@ -29,6 +29,8 @@
 #include <random>
 #include <thread>
 
+#include "bench/common/bench_stats.h"
+#include "bench/common/iiwa_goals.h"
 #include "daemon/planner_node.h"
 #include "kinograph/dynamics/kinematics.h"
 #include "kinograph/planning/goal_sampler.h"
@@ -40,39 +42,6 @@ namespace {
 
 using nlohmann::json;
 using Clock = std::chrono::steady_clock;
-
-double median(std::vector<double> v) {
-  if (v.empty()) return std::nan("");
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-double max_of(const std::vector<double>& v) {
-  return v.empty() ? std::nan("") : *std::max_element(v.begin(), v.end());
-}
-
-planning::GoalSamplerOptions goal_options(std::uint64_t seed) {
-  planning::GoalSamplerOptions o;
-  o.seed = seed;
-  o.limit_margin = 0.2;
-  o.self_collision_excluded = {{4, 6}};  // the iiwa's wrist pair (robots/README.md)
-  o.region_frame = "payload";
-  o.region = Eigen::AlignedBox3d(Eigen::Vector3d(0.3, -0.6, 0.75), Eigen::Vector3d(0.9, 0.6, 1.1));
-  return o;
-}
-
-std::optional<Eigen::VectorXd> nearby_goal(planning::GoalSampler& sampler,
-                                           const Eigen::VectorXd& goal, double radius,
-                                           std::uint64_t seed) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u(-radius, radius);
-  for (int t = 0; t < 10000; ++t) {
-    Eigen::VectorXd q = goal;
-    for (int j = 0; j < q.size(); ++j) q[j] += u(rng);
-    if (sampler.accepts(q)) return q;
-  }
-  return std::nullopt;
-}
 
 // The client side: publishes and waits for the next plan_t on the plan channel.
 class Client {
@@ -194,9 +163,9 @@ int main(int argc, char** argv) {
       std::string(KINOGRAPH_SOURCE_DIR) + "/robots/scenes/iiwa_desk.yaml";
   const planning::Scene scene = planning::load_scene(scene_path);
   const planning::Problem& problem = scene.problem;
-  planning::GoalSampler first_goals(problem, goal_options(1));
-  planning::GoalSampler far_goals(problem, goal_options(7));
-  planning::GoalSampler checker(problem, goal_options(99));
+  planning::GoalSampler first_goals(problem, iiwa_goal_options(1));
+  planning::GoalSampler far_goals(problem, iiwa_goal_options(7));
+  planning::GoalSampler checker(problem, iiwa_goal_options(99));
   const int payload = problem.model->frame_index("payload");
 
   const std::vector<std::string> kinds = {"first goal",  "obstacle move", "obstacle remove",

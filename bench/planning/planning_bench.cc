@@ -15,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include "bench/common/bench_stats.h"
+#include "bench/common/iiwa_goals.h"
 #include "kinograph/planning/batch_planner.h"
 #include "kinograph/planning/goal_sampler.h"
 #include "kinograph/planning/plan_json.h"
@@ -28,19 +30,6 @@ using planning::Plan;
 using planning::Problem;
 
 const std::string kScenes = std::string(KINOGRAPH_SOURCE_DIR) + "/robots/scenes/";
-
-double median(std::vector<double> v) {
-  if (v.empty()) return std::nan("");
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-double mean(const std::vector<double>& v) {
-  return v.empty() ? std::nan("") : std::accumulate(v.begin(), v.end(), 0.0) / v.size();
-}
-double max_of(const std::vector<double>& v) {
-  return v.empty() ? std::nan("") : *std::max_element(v.begin(), v.end());
-}
 
 // The paper's "total torque" of a run (N·m): Σ_k Σ_j |τ_kj| over every state and joint.
 double total_torque(const Plan& plan) { return plan.tau.cwiseAbs().sum(); }
@@ -78,16 +67,6 @@ json summary(const std::vector<Run>& runs) {
           {"time_s_max", max_of(ok_times)},
           {"time_s_median_all", median(all_times)},
           {"iterations_median", median(iterations)}};
-}
-
-planning::GoalSamplerOptions iiwa_goal_options(std::uint64_t seed) {
-  planning::GoalSamplerOptions o;
-  o.seed = seed;
-  o.limit_margin = 0.2;
-  o.self_collision_excluded = {{4, 6}};  // the iiwa's wrist pair (robots/README.md)
-  o.region_frame = "payload";
-  o.region = Eigen::AlignedBox3d(Eigen::Vector3d(0.3, -0.6, 0.75), Eigen::Vector3d(0.9, 0.6, 1.1));
-  return o;
 }
 
 json failures_of(const std::vector<Run>& runs) {

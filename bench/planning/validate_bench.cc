@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/common/bench_stats.h"
 #include "kinograph/collision/collision_world.h"
 #include "kinograph/collision/segment_checker.h"
 #include "kinograph/planning/batch_planner.h"
@@ -18,14 +19,10 @@
 #include "kinograph/planning/validate.h"
 
 using namespace kinograph;
+using bench::median;
 using Clock = std::chrono::steady_clock;
 
 namespace {
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
 
 template <typename F>
 double median_ms(int reps, F&& f) {

@@ -19,6 +19,8 @@
 #include <string>
 #include <vector>
 
+#include "bench/common/bench_stats.h"
+#include "bench/common/iiwa_goals.h"
 #include "kinograph/planning/batch_planner.h"
 #include "kinograph/planning/goal_sampler.h"
 #include "kinograph/planning/incremental_planner.h"
@@ -34,18 +36,6 @@ using Clock = std::chrono::steady_clock;
 
 const std::string kScenes = std::string(KINOGRAPH_SOURCE_DIR) + "/robots/scenes/";
 
-double median(std::vector<double> v) {
-  if (v.empty()) return std::nan("");
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-double mean(const std::vector<double>& v) {
-  return v.empty() ? std::nan("") : std::accumulate(v.begin(), v.end(), 0.0) / v.size();
-}
-double max_of(const std::vector<double>& v) {
-  return v.empty() ? std::nan("") : *std::max_element(v.begin(), v.end());
-}
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
@@ -90,31 +80,6 @@ struct Method {
   }
 };
 
-planning::GoalSamplerOptions iiwa_goal_options(std::uint64_t seed) {
-  planning::GoalSamplerOptions o;
-  o.seed = seed;
-  o.limit_margin = 0.2;
-  o.self_collision_excluded = {{4, 6}};  // the iiwa's wrist pair (robots/README.md)
-  o.region_frame = "payload";
-  o.region = Eigen::AlignedBox3d(Eigen::Vector3d(0.3, -0.6, 0.75), Eigen::Vector3d(0.9, 0.6, 1.1));
-  return o;
-}
-
-// A new goal near `goal`: every joint moved uniformly within ±radius, kept only if the sampler
-// accepts it (limits, region, clearance, self-collision). Seeded; empty after 10000 tries.
-std::optional<Eigen::VectorXd> nearby_goal(planning::GoalSampler& sampler,
-                                           const Eigen::VectorXd& goal, double radius,
-                                           std::uint64_t seed) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u(-radius, radius);
-  for (int t = 0; t < 10000; ++t) {
-    Eigen::VectorXd q = goal;
-    for (int j = 0; j < q.size(); ++j) q[j] += u(rng);
-    if (sampler.accepts(q)) return q;
-  }
-  return std::nullopt;
-}
-
 struct Row {
   Method L, W, inc;
   Method stiff;  // iDFGP with the other penalty cap (alt_penalty()), no fallback
@@ -122,9 +87,12 @@ struct Row {
 };
 
 json row_json(const Row& r) {
-  return {{"problems", r.problems},          {"first_plan_failed", r.first_failed},
-          {"no_nearby_change", r.no_change}, {"DFGP-L", r.L.to_json()},
-          {"DFGP-W", r.W.to_json()},         {"iDFGP", r.inc.to_json()},
+  return {{"problems", r.problems},
+          {"first_plan_failed", r.first_failed},
+          {"no_nearby_change", r.no_change},
+          {"DFGP-L", r.L.to_json()},
+          {"DFGP-W", r.W.to_json()},
+          {"iDFGP", r.inc.to_json()},
           {"iDFGP_other_penalty_cap", r.stiff.to_json()}};
 }
 
@@ -224,7 +192,8 @@ int run(int argc, char** argv) {
       std::cerr << "usage: replanning_bench [--problems 50] [--obstacle-problems N] "
                    "[--radius 0.2] [--shift 0.05] [--no-stiff] [--json FILE] "
                    "[--log-level warn|info|debug|trace] [--tol 1e-2] [--final-tol 1e-4] "
-                   "[--relinearize-threshold X (instead of relinearizing all)] [--no-polish] [--polish-objective] [--max-penalty 1e4] [--stop-rise 0.25]\n";
+                   "[--relinearize-threshold X (instead of relinearizing all)] [--no-polish] "
+                   "[--polish-objective] [--max-penalty 1e4] [--stop-rise 0.25]\n";
       return 1;
     }
   }
