@@ -1,8 +1,10 @@
 #pragma once
-// Summary statistics of the benchmarks' samples; NaN for no samples, so tables show "–".
+// Summary statistics of the benchmarks' samples (NaN for no samples) and their table cells.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numeric>
+#include <string>
 #include <vector>
 
 namespace kinograph::bench {
@@ -20,6 +22,14 @@ inline double mean(const std::vector<double>& v) {
 
 inline double max_of(const std::vector<double>& v) {
   return v.empty() ? std::nan("") : *std::max_element(v.begin(), v.end());
+}
+
+/// A Markdown table cell: v·scale with `precision` decimals, "–" for NaN (no samples).
+inline std::string cell(double v, double scale = 1.0, int precision = 0) {
+  if (std::isnan(v)) return "–";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", precision, v * scale);
+  return buf;
 }
 
 }  // namespace kinograph::bench

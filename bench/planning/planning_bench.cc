@@ -82,13 +82,6 @@ json failures_of(const std::vector<Run>& runs) {
   return out;
 }
 
-std::string cell(double v, double scale = 1.0, int precision = 0) {
-  if (std::isnan(v)) return "–";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", precision, v * scale);
-  return buf;
-}
-
 int run(int argc, char** argv) {
   int goals = 50, acrobot_repeats = 5;
   std::string json_path;

@@ -143,13 +143,6 @@ void replan_all(Row& row, const Problem& first_problem, const Problem& changed,
   if (s.success()) ++row.stiff.incremental_ok;
 }
 
-std::string cell(double v, double scale = 1.0, int precision = 0) {
-  if (std::isnan(v)) return "–";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", precision, v * scale);
-  return buf;
-}
-
 int run(int argc, char** argv) {
   int problems = 50, obstacle_problems = -1;
   double radius = 0.2, shift = 0.05;

@@ -292,20 +292,7 @@ Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init,
   // The plan: trajectory from the values; τ from inverse dynamics in the condensed formulation
   // (which eliminates it, so it equals RNEA exactly), the DFG's own τ variables otherwise (so
   // the validator's dynamics residual checks the DFG's equations of motion).
-  Plan plan;
-  const Trajectory tr = read_trajectory(pg.values, N, n);
-  plan.q = tr.q;
-  plan.qd = tr.qd;
-  plan.qdd = tr.qdd;
-  plan.tau.resize(N + 1, n);
-  plan.t.resize(N + 1);
-  dynamics::Data data(*problem.model);
-  for (int k = 0; k <= N; ++k) {
-    plan.t[k] = problem.dt() * k;
-    plan.tau.row(k) = dynamics::rnea(*problem.model, data, tr.q.row(k).transpose(),
-                                     tr.qd.row(k).transpose(), tr.qdd.row(k).transpose())
-                          .transpose();
-  }
+  Plan plan = plan_from_trajectory(problem, read_trajectory(pg.values, N, n));
   for (const DfgConstraintStep& s : dfg_steps) {
     plan.tau.row(s.step) =
         dfg_torques(pg.values, *problem.model, s.step, options_.dfg.keys).transpose();

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "kinograph/dynamics/inverse_dynamics.h"
 #include "kinograph/planning/dynamics_factors.h"
 #include "kinograph/planning/pose_factors.h"
 #include "kinograph/planning/trajectory_factors.h"
@@ -129,6 +130,25 @@ Trajectory read_trajectory(const graph::Values& values, int steps, int nq) {
     tr.qdd.row(k) = values.at(a_key(k)).transpose();
   }
   return tr;
+}
+
+Plan plan_from_trajectory(const Problem& problem, const Trajectory& trajectory) {
+  const int n = problem.model->nq(), N = problem.steps;
+  Plan plan;
+  plan.q = trajectory.q;
+  plan.qd = trajectory.qd;
+  plan.qdd = trajectory.qdd;
+  plan.tau.resize(N + 1, n);
+  plan.t.resize(N + 1);
+  dynamics::Data data(*problem.model);
+  for (int k = 0; k <= N; ++k) {
+    plan.t[k] = problem.dt() * k;
+    plan.tau.row(k) =
+        dynamics::rnea(*problem.model, data, trajectory.q.row(k).transpose(),
+                       trajectory.qd.row(k).transpose(), trajectory.qdd.row(k).transpose())
+            .transpose();
+  }
+  return plan;
 }
 
 }  // namespace kinograph::planning

@@ -9,6 +9,7 @@
 #include "kinograph/planning/collision_factors.h"
 #include "kinograph/planning/constrained_factor.h"
 #include "kinograph/planning/initialization.h"
+#include "kinograph/planning/plan.h"
 #include "kinograph/planning/problem.h"
 
 namespace kinograph::planning {
@@ -47,5 +48,9 @@ PlanningGraph build_graph(const Problem& problem, const Trajectory& init,
 
 /// Reads q, q̇, q̈ of every state back from the values.
 Trajectory read_trajectory(const graph::Values& values, int steps, int nq);
+
+/// A plan of `trajectory`: its states, the step times, and τ from inverse dynamics (exact for the
+/// condensed formulation, which eliminates τ). Stats and validation are left empty.
+Plan plan_from_trajectory(const Problem& problem, const Trajectory& trajectory);
 
 }  // namespace kinograph::planning

@@ -213,11 +213,7 @@ std::vector<Entry> timing_entries(const Problem& p, const IncrementalPlannerOpti
 Plan IncrementalPlanner::make_plan(const std::string& method, bool with_stats) {
   const graph::Values& values = state_->isam->estimate();
   const int n = problem_.model->nq(), N = problem_.steps;
-  const Trajectory tr = read_trajectory(values, N, n);
-  Plan plan;
-  plan.q = tr.q;
-  plan.qd = tr.qd;
-  plan.qdd = tr.qdd;
+  Trajectory tr = read_trajectory(values, N, n);
   // The start is data, not a variable: its soft prior (start_weight) holds x_0 to ~1e-6, at
   // the validator's threshold after a large change (measured: 1.07e-6 and 1.14e-6 failed two
   // daemon replans). The plan starts at the measured state itself when the estimate is that
@@ -225,21 +221,13 @@ Plan IncrementalPlanner::make_plan(const std::string& method, bool with_stats) {
   const Eigen::VectorXd qd0 =
       problem_.start_qd.size() == n ? problem_.start_qd : Eigen::VectorXd::Zero(n);
   const double start_gap =
-      std::max((plan.q.row(0).transpose() - problem_.start_q).cwiseAbs().maxCoeff(),
-               (plan.qd.row(0).transpose() - qd0).cwiseAbs().maxCoeff());
+      std::max((tr.q.row(0).transpose() - problem_.start_q).cwiseAbs().maxCoeff(),
+               (tr.qd.row(0).transpose() - qd0).cwiseAbs().maxCoeff());
   if (start_gap <= 1e-4) {
-    plan.q.row(0) = problem_.start_q.transpose();
-    plan.qd.row(0) = qd0.transpose();
+    tr.q.row(0) = problem_.start_q.transpose();
+    tr.qd.row(0) = qd0.transpose();
   }
-  plan.tau.resize(N + 1, n);
-  plan.t.resize(N + 1);
-  dynamics::Data data(*problem_.model);
-  for (int k = 0; k <= N; ++k) {
-    plan.t[k] = problem_.dt() * k;
-    plan.tau.row(k) = dynamics::rnea(*problem_.model, data, tr.q.row(k).transpose(),
-                                     tr.qd.row(k).transpose(), tr.qdd.row(k).transpose())
-                          .transpose();
-  }
+  Plan plan = plan_from_trajectory(problem_, tr);
   plan.stats.method = method;
   // Without stats this is the stopping rule's check, which needs only the verdict.
   plan.validation = validate(problem_, plan, options_.batch.validation, !with_stats);
@@ -424,22 +412,7 @@ Plan IncrementalPlanner::batch_solve(const Problem& problem, const Eigen::Matrix
   // The plan is the batch result (validated); the tree continues from its own estimate.
   problem_ = problem;
   state_ = std::move(state);
-  Plan plan;
-  {
-    const Trajectory tr = read_trajectory(values, N, n);
-    plan.q = tr.q;
-    plan.qd = tr.qd;
-    plan.qdd = tr.qdd;
-    plan.tau.resize(N + 1, n);
-    plan.t.resize(N + 1);
-    dynamics::Data data(*problem.model);
-    for (int k = 0; k <= N; ++k) {
-      plan.t[k] = problem.dt() * k;
-      plan.tau.row(k) = dynamics::rnea(*problem.model, data, tr.q.row(k).transpose(),
-                                       tr.qd.row(k).transpose(), tr.qdd.row(k).transpose())
-                            .transpose();
-    }
-  }
+  Plan plan = plan_from_trajectory(problem, read_trajectory(values, N, n));
   stats.cost = soft_cost(graph, values);
   stats.max_constraint_violation = worst.violation;
   plan.stats = stats;
