@@ -676,7 +676,14 @@ Plan IncrementalPlanner::replan(const ProblemChange& change) {
         r.trials, r.lambda, r.total_s * 1e3, r.linearize_s * 1e3, r.eliminate_s * 1e3,
         r.solve_s * 1e3);
     if (spdlog::should_log(spdlog::level::trace)) {
-      spdlog::trace("iDFGP full error {:.6g}", st.isam->error());
+      // Which kinds of factor hold the error (what the next updates still have to reduce).
+      std::map<std::string, double> by_kind;
+      for (const auto& f : st.isam->graph().factors()) {
+        if (f) by_kind[f->name()] += f->error(st.isam->estimate());
+      }
+      std::ostringstream os;
+      for (const auto& [kind, err] : by_kind) os << ' ' << kind << ' ' << err;
+      spdlog::trace("iDFGP full error {:.6g}:{}", st.isam->error(), os.str());
     }
     if (polish) {
       status = "converged";
