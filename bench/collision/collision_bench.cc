@@ -4,8 +4,14 @@
 // pair. Random configurations within the joint limits (seeded). Each configuration is timed
 // `repeats` times and keeps its median (the machine is shared, so single runs see
 // preemption); the table gives the median, p10 and p90 of those over configurations, in µs
-// per configuration. Heap allocations inside the timed loops are counted too (the queries
-// promise none after warm-up).
+// per configuration. These cases run with the query memo off, so repeats measure fresh
+// queries. Two cases follow the planners: the desk scene of robots/scenes/iiwa_desk.yaml as one
+// world per obstacle (the incremental planner's CollisionContexts), and the optimizer's pattern
+// of an error pass then a linearization pass (with gradients) over a block of 64 configurations
+// with the memo at its default, timed per block (one block per `repeats`-th of the
+// configurations, each seen once). Heap allocations inside the timed loops are counted too (the
+// queries promise none after warm-up). The source also builds against a CollisionWorld
+// without the memo option (for before/after figures).
 //
 //   bench_collision [--configs N] [--repeats R]   → JSON on stdout, then a Markdown table
 // Replacing the global operator new/delete pair confuses GCC's mismatch analysis of inlined
@@ -19,6 +25,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <functional>
+#include <memory>
 #include <new>
 #include <nlohmann/json.hpp>
 #include <random>
@@ -42,6 +49,13 @@ void operator delete(void* p) noexcept { std::free(p); }
 void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 
 namespace {
+
+// Sets the query memo's size where the library has one (the same source builds against older
+// versions of CollisionWorld for before/after figures).
+template <typename Options>
+void set_memo(Options& o, int entries) {
+  if constexpr (requires { o.memo_entries; }) o.memo_entries = entries;
+}
 
 using kinograph::collision::CollisionWorld;
 using kinograph::collision::CollisionWorldOptions;
@@ -90,13 +104,28 @@ int main(int argc, char** argv) {
       obstacle(3, Shape::cylinder(0.06, 0.6), -0.3, -0.5, 0.5),
       obstacle(4, Shape::capsule(0.05, 0.5), 0.2, -0.6, 1.0, 0.7)};
   CollisionWorldOptions culled_opts;  // defaults: query distance 0.3 m, culling on
-  CollisionWorldOptions all_opts;
+  set_memo(culled_opts, 0);
+  CollisionWorldOptions all_opts = culled_opts;
   all_opts.cull = false;
   all_opts.query_distance = INFINITY;
   CollisionWorld culled(model, culled_opts), all(model, all_opts);
   for (const Obstacle& o : obstacles) {
     culled.add_obstacle(o);
     all.add_obstacle(o);
+  }
+  // robots/scenes/iiwa_desk.yaml: tabletop and four legs, one world each.
+  const std::vector<Obstacle> desk = {obstacle(0, Shape::box(0.5, 1.0, 0.04), 0.75, 0, 0.64),
+                                      obstacle(1, Shape::box(0.04, 0.04, 0.62), 0.52, 0.48, 0.31),
+                                      obstacle(2, Shape::box(0.04, 0.04, 0.62), 0.52, -0.48, 0.31),
+                                      obstacle(3, Shape::box(0.04, 0.04, 0.62), 0.98, 0.48, 0.31),
+                                      obstacle(4, Shape::box(0.04, 0.04, 0.62), 0.98, -0.48, 0.31)};
+  std::vector<std::unique_ptr<CollisionWorld>> desk_worlds, desk_memo_worlds;
+  CollisionWorldOptions memo_opts;  // the planners' defaults, memo included
+  for (const Obstacle& o : desk) {
+    desk_worlds.push_back(std::make_unique<CollisionWorld>(model, culled_opts));
+    desk_worlds.back()->add_obstacle(o);
+    desk_memo_worlds.push_back(std::make_unique<CollisionWorld>(model, memo_opts));
+    desk_memo_worlds.back()->add_obstacle(o);
   }
   DistanceGradientWorkspace ws(model);
   Eigen::VectorXd grad(model.nq());
@@ -143,6 +172,17 @@ int main(int argc, char** argv) {
          dyn::forward_kinematics(model, data, q);
          sink += culled.closest(data).distance;
        }},
+      {"desk_world_per_obstacle_with_gradients",
+       [&](const Eigen::VectorXd& q) {
+         dyn::forward_kinematics(model, data, q);
+         for (auto& w : desk_worlds) {
+           for (const Proximity& p : w->query(data)) {
+             kinograph::collision::distance_gradient(model, data, p, ws, grad);
+             sink += p.distance + grad[0];
+             ++pairs_total;
+           }
+         }
+       }},
   };
 
   nlohmann::json out;
@@ -175,6 +215,50 @@ int main(int argc, char** argv) {
                             {"p90_us", s.p90},
                             {"mean_pairs", double(pairs_total) / (double(configs) * repeats)},
                             {"heap_allocations", allocations}});
+  }
+  {
+    // The optimizer's pattern: an error pass over a block of configurations, then a
+    // linearization pass (with gradients) at the same configurations.
+    constexpr int kBlock = 64;
+    const int blocks = std::max(1, configs / kBlock);
+    auto pass = [&](int b, bool gradients) {
+      for (int i = b * kBlock; i < std::min(configs, (b + 1) * kBlock); ++i) {
+        dyn::forward_kinematics(model, data, qs[i]);
+        for (auto& w : desk_memo_worlds) {
+          for (const Proximity& p : w->query(data)) {
+            sink += p.distance;
+            ++pairs_total;
+            if (gradients) {
+              kinograph::collision::distance_gradient(model, data, p, ws, grad);
+              sink += grad[0];
+            }
+          }
+        }
+      }
+    };
+    pass(0, false);  // warm-up (block 0 is not timed)
+    pass(0, true);
+    pairs_total = 0;
+    std::vector<double> us;
+    us.reserve(blocks);
+    const long alloc_before = g_allocations.load();
+    for (int b = 1; b < blocks; ++b) {
+      const auto t0 = std::chrono::steady_clock::now();
+      pass(b, false);
+      pass(b, true);
+      const auto t1 = std::chrono::steady_clock::now();
+      us.push_back(std::chrono::duration<double, std::micro>(t1 - t0).count() / kBlock);
+    }
+    const long allocations = g_allocations.load() - alloc_before;
+    if (!us.empty()) {
+      const Stats s = stats(us);
+      out["cases"].push_back({{"name", "desk_error_then_linearize_pass"},
+                              {"median_us", s.median},
+                              {"p10_us", s.p10},
+                              {"p90_us", s.p90},
+                              {"mean_pairs", double(pairs_total) / (double(blocks - 1) * kBlock)},
+                              {"heap_allocations", allocations}});
+    }
   }
   std::printf("%s\n\n", out.dump(2).c_str());
   std::printf("iiwa14 (%zu collision geometries) vs %zu obstacles, %d configurations x %d\n\n",

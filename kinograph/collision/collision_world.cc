@@ -3,6 +3,8 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -14,6 +16,19 @@ namespace kinograph::collision {
 namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
+// Culling keeps pairs whose lower bound is within this of the threshold, so a bound that rounds
+// a hair above an exact distance (sphere against sphere or box face) cannot drop a pair at the
+// cut-off. GJK decides those pairs.
+constexpr double kCullSlack = 1e-9;
+constexpr int kMemoWays = 4;
+// Doubles of the memo key per body pose (the Isometry's 4 × 4 matrix), plus two for the query
+// distance and time.
+constexpr int kPoseKey = 16;
+
+uint64_t mix(uint64_t h, uint64_t v) {
+  h = (h ^ v) * 0x9E3779B97F4A7C15ull;
+  return h ^ (h >> 31);
+}
 
 ConvexShape make_robot_shape(const dynamics::Geometry& g, size_t index) {
   try {
@@ -49,8 +64,10 @@ CollisionWorld::CollisionWorld(const dynamics::Model& model, CollisionWorldOptio
       throw std::invalid_argument("collision geometry " + std::to_string(i) + " of link '" +
                                   g.link_name + "' names body " + std::to_string(g.body));
     }
+    ConvexShape shape = make_robot_shape(g, i);
+    const Eigen::Vector3d local_centre = g.origin * shape.bound_center();
     robot_.push_back(
-        RobotGeom{g.body, g.origin, make_robot_shape(g, i), g.origin, g.origin.translation()});
+        RobotGeom{g.body, g.origin, std::move(shape), local_centre, g.origin, local_centre, 0});
   }
   if (options_.self_collision) {
     for (int a = 0; a < static_cast<int>(robot_.size()); ++a) {
@@ -72,7 +89,74 @@ CollisionWorld::CollisionWorld(const dynamics::Model& model, CollisionWorldOptio
 }
 
 void CollisionWorld::reserve_output() {
-  out_.reserve(robot_.size() * obstacles_.size() + self_pairs_.size());
+  const size_t max_results = robot_.size() * obstacles_.size() + self_pairs_.size();
+  out_.reserve(max_results);
+  candidates_.reserve(max_results);
+  if (options_.memo_entries > 0) {
+    const size_t entries = (options_.memo_entries + kMemoWays - 1) / kMemoWays * kMemoWays;
+    const size_t key = kPoseKey * model_.bodies.size() + 2;
+    memo_.assign(entries, MemoEntry{});
+    memo_keys_.assign(entries * key, 0.0);
+    memo_key_.assign(key, 0.0);
+    // Room for the typical few pairs per entry; older entries give way when it wraps.
+    memo_arena_.resize(4 * entries + max_results);
+    memo_write_ = 0;
+  }
+}
+
+void CollisionWorld::memo_clear() {
+  for (MemoEntry& e : memo_) e.valid = false;
+}
+
+const CollisionWorld::MemoEntry* CollisionWorld::memo_find(const dynamics::Data& data, double t,
+                                                           double query_distance) {
+  double* k = memo_key_.data();
+  for (const Eigen::Isometry3d& T : data.body_pose) {
+    std::memcpy(k, T.data(), kPoseKey * sizeof(double));
+    k += kPoseKey;
+  }
+  k[0] = query_distance;
+  k[1] = has_moving_obstacles() ? t : 0.0;  // fixed obstacles do not depend on t
+  uint64_t h = 0;
+  for (const double v : memo_key_) {
+    uint64_t bits;
+    std::memcpy(&bits, &v, sizeof bits);
+    h = mix(h, bits);
+  }
+  memo_hash_ = h;
+  const size_t key = memo_key_.size();
+  const size_t set = (h >> 17) % (memo_.size() / kMemoWays) * kMemoWays;
+  for (size_t w = set; w < set + kMemoWays; ++w) {
+    MemoEntry& e = memo_[w];
+    if (!e.valid || e.hash != h) continue;
+    if (memo_write_ > e.begin + memo_arena_.size()) {  // its results were overwritten
+      e.valid = false;
+      continue;
+    }
+    if (std::memcmp(&memo_keys_[w * key], memo_key_.data(), key * sizeof(double)) != 0) continue;
+    e.used = ++memo_tick_;
+    return &e;
+  }
+  return nullptr;
+}
+
+void CollisionWorld::memo_store() {
+  const size_t key = memo_key_.size();
+  const size_t set = (memo_hash_ >> 17) % (memo_.size() / kMemoWays) * kMemoWays;
+  size_t victim = set;
+  for (size_t w = set; w < set + kMemoWays; ++w) {
+    if (!memo_[w].valid) {
+      victim = w;
+      break;
+    }
+    if (memo_[w].used < memo_[victim].used) victim = w;
+  }
+  const size_t n = out_.size(), size = memo_arena_.size();
+  if (memo_write_ % size + n > size) memo_write_ += size - memo_write_ % size;  // keep it whole
+  std::copy(out_.begin(), out_.end(), memo_arena_.begin() + memo_write_ % size);
+  std::copy(memo_key_.begin(), memo_key_.end(), memo_keys_.begin() + victim * key);
+  memo_[victim] = MemoEntry{true, memo_hash_, ++memo_tick_, memo_write_, static_cast<int>(n)};
+  memo_write_ += n;
 }
 
 int CollisionWorld::find_index(int id) const {
@@ -97,6 +181,7 @@ Status CollisionWorld::add_obstacle(const Obstacle& obstacle) {
   entry.place(obstacle.pose_at(0));
   obstacles_.push_back(std::move(entry));
   reserve_output();
+  memo_clear();
   return Status::success();
 }
 
@@ -107,6 +192,7 @@ Status CollisionWorld::move_obstacle(int id, const Eigen::Isometry3d& pose) {
   o.obstacle.pose = pose;
   o.obstacle.trajectory = PoseTrajectory();
   o.place(pose);
+  memo_clear();
   return Status::success();
 }
 
@@ -116,6 +202,7 @@ Status CollisionWorld::set_obstacle_trajectory(int id, PoseTrajectory trajectory
   ObstacleEntry& o = obstacles_[i];
   o.obstacle.trajectory = std::move(trajectory);
   o.place(o.obstacle.pose_at(0));
+  memo_clear();
   return Status::success();
 }
 
@@ -123,10 +210,14 @@ Status CollisionWorld::remove_obstacle(int id) {
   const int i = find_index(id);
   if (i < 0) return Status::failure("no obstacle with id " + std::to_string(id));
   obstacles_.erase(obstacles_.begin() + i);
+  memo_clear();
   return Status::success();
 }
 
-void CollisionWorld::clear_obstacles() { obstacles_.clear(); }
+void CollisionWorld::clear_obstacles() {
+  obstacles_.clear();
+  memo_clear();
+}
 
 const Obstacle* CollisionWorld::find_obstacle(int id) const {
   const int i = find_index(id);
@@ -139,10 +230,11 @@ bool CollisionWorld::has_moving_obstacles() const {
 }
 
 void CollisionWorld::update_poses(const dynamics::Data& data, double t) {
+  ++pose_stamp_;
   for (RobotGeom& g : robot_) {
-    g.world = g.body < 0 ? g.origin : data.body_pose[g.body] * g.origin;
-    g.centre = g.world * g.shape.bound_center();
+    if (g.body >= 0) g.centre = data.body_pose[g.body] * g.local_centre;
   }
+  data_ = &data;
   for (ObstacleEntry& o : obstacles_) {
     if (!o.obstacle.is_moving()) continue;  // fixed poses are set on add and move
     o.place(o.obstacle.trajectory.at(t));
@@ -153,6 +245,15 @@ void CollisionWorld::ObstacleEntry::place(const Eigen::Isometry3d& pose) {
   world = pose;
   centre = pose * shape.bound_center();
   shape.world_aabb(pose, lo, hi);
+}
+
+const Eigen::Isometry3d& CollisionWorld::geom_world(int g) {
+  RobotGeom& rg = robot_[g];
+  if (rg.body >= 0 && rg.posed != pose_stamp_) {
+    rg.world = data_->body_pose[rg.body] * rg.origin;
+    rg.posed = pose_stamp_;
+  }
+  return rg.world;
 }
 
 double CollisionWorld::lower_bound(int g, const ObstacleEntry& o) const {
@@ -171,10 +272,29 @@ double CollisionWorld::lower_bound(int a, int b) const {
          robot_[b].shape.bound_radius();
 }
 
+bool CollisionWorld::beyond(int g, const ObstacleEntry& o, double threshold) const {
+  // lower_bound(g, o) > threshold, compared in squares where both sides are non-negative.
+  const RobotGeom& rg = robot_[g];
+  const double r = rg.shape.bound_radius();
+  const double a = threshold + r + o.shape.bound_radius();
+  const Eigen::Vector3d dc = rg.centre - o.centre;
+  if (a >= 0 ? dc.squaredNorm() > a * a : dc.norm() > a) return true;
+  const double gap2 = (o.lo - rg.centre).cwiseMax(rg.centre - o.hi).cwiseMax(0.0).squaredNorm();
+  if (!(gap2 > 0)) return false;
+  const double b = threshold + r;
+  return b >= 0 ? gap2 > b * b : std::sqrt(gap2) > b;
+}
+
+bool CollisionWorld::beyond(int a, int b, double threshold) const {
+  const double s = threshold + robot_[a].shape.bound_radius() + robot_[b].shape.bound_radius();
+  const Eigen::Vector3d dc = robot_[a].centre - robot_[b].centre;
+  return s >= 0 ? dc.squaredNorm() > s * s : dc.norm() > s;
+}
+
 bool CollisionWorld::robot_obstacle(int g, const ObstacleEntry& o, double max_distance,
-                                    Proximity& out) const {
+                                    Proximity& out) {
   const PairDistance d =
-      pair_distance(robot_[g].shape, robot_[g].world, o.shape, o.world, max_distance);
+      pair_distance(robot_[g].shape, geom_world(g), o.shape, o.world, max_distance);
   if (!d.valid) return false;
   out.robot_geom = g;
   out.obstacle = o.obstacle.id;
@@ -186,9 +306,9 @@ bool CollisionWorld::robot_obstacle(int g, const ObstacleEntry& o, double max_di
   return true;
 }
 
-bool CollisionWorld::robot_robot(int a, int b, double max_distance, Proximity& out) const {
-  const PairDistance d = pair_distance(robot_[a].shape, robot_[a].world, robot_[b].shape,
-                                       robot_[b].world, max_distance);
+bool CollisionWorld::robot_robot(int a, int b, double max_distance, Proximity& out) {
+  const PairDistance d =
+      pair_distance(robot_[a].shape, geom_world(a), robot_[b].shape, geom_world(b), max_distance);
   if (!d.valid) return false;
   out.robot_geom = a;
   out.obstacle = -1;
@@ -206,22 +326,34 @@ std::span<const Proximity> CollisionWorld::query(const dynamics::Data& data, dou
 
 std::span<const Proximity> CollisionWorld::query(const dynamics::Data& data, double t,
                                                  double query_distance) {
+  if (!memo_.empty()) {
+    if (const MemoEntry* e = memo_find(data, t, query_distance)) {
+      // Copied to the output buffer, so every answer lives at the same address.
+      const auto first = memo_arena_.begin() + e->begin % memo_arena_.size();
+      out_.assign(first, first + e->count);
+      return {out_.data(), out_.size()};
+    }
+  }
   update_poses(data, t);
   out_.clear();
-  // Without culling every pair goes through GJK to the end: the brute-force reference.
-  const double gjk_max = options_.cull ? query_distance : kInfinity;
+  // Without culling every pair goes through GJK to the end: the brute-force reference. GJK's
+  // early exit gets the slack too: its core-distance bound can round past a pair's distance
+  // exactly at the cut-off. The cut-off itself is exact (distance <= query_distance).
+  const double cull_at = query_distance + kCullSlack;
+  const double gjk_max = options_.cull ? cull_at : kInfinity;
   Proximity p;
   for (int g = 0; g < static_cast<int>(robot_.size()); ++g) {
     if (!checks_obstacles(g)) continue;
     for (const ObstacleEntry& o : obstacles_) {
-      if (options_.cull && lower_bound(g, o) > query_distance) continue;
+      if (options_.cull && beyond(g, o, cull_at)) continue;
       if (robot_obstacle(g, o, gjk_max, p) && p.distance <= query_distance) out_.push_back(p);
     }
   }
   for (const auto& [a, b] : self_pairs_) {
-    if (options_.cull && lower_bound(a, b) > query_distance) continue;
+    if (options_.cull && beyond(a, b, cull_at)) continue;
     if (robot_robot(a, b, gjk_max, p) && p.distance <= query_distance) out_.push_back(p);
   }
+  if (!memo_.empty()) memo_store();
   return {out_.data(), out_.size()};
 }
 
@@ -230,19 +362,59 @@ Proximity CollisionWorld::closest(const dynamics::Data& data, double t) {
   Proximity best;
   best.distance = kInfinity;
   Proximity p;
-  // Each pair only needs checking to the best distance so far.
+  if (!options_.cull) {  // the brute-force reference: every pair to the end, in order
+    for (int g = 0; g < static_cast<int>(robot_.size()); ++g) {
+      if (!checks_obstacles(g)) continue;
+      for (const ObstacleEntry& o : obstacles_) {
+        if (robot_obstacle(g, o, kInfinity, p) && p.distance < best.distance) best = p;
+      }
+    }
+    for (const auto& [a, b] : self_pairs_) {
+      if (robot_robot(a, b, kInfinity, p) && p.distance < best.distance) best = p;
+    }
+    return best;
+  }
+  // Pairs in order of their lower bounds, each checked only up to the best distance so far
+  // (plus the slack, so that a tie still reports and the earlier pair of equals wins, as in the
+  // brute-force order): usually the first pair settles it and the rest are culled unchecked.
+  candidates_.clear();
+  int order = 0;
   for (int g = 0; g < static_cast<int>(robot_.size()); ++g) {
     if (!checks_obstacles(g)) continue;
-    for (const ObstacleEntry& o : obstacles_) {
-      if (options_.cull && lower_bound(g, o) >= best.distance) continue;
-      const double gjk_max = options_.cull ? best.distance : kInfinity;
-      if (robot_obstacle(g, o, gjk_max, p) && p.distance < best.distance) best = p;
+    for (int o = 0; o < static_cast<int>(obstacles_.size()); ++o) {
+      candidates_.push_back(Candidate{lower_bound(g, obstacles_[o]), order++, g, o});
     }
   }
   for (const auto& [a, b] : self_pairs_) {
-    if (options_.cull && lower_bound(a, b) >= best.distance) continue;
-    const double gjk_max = options_.cull ? best.distance : kInfinity;
-    if (robot_robot(a, b, gjk_max, p) && p.distance < best.distance) best = p;
+    candidates_.push_back(Candidate{lower_bound(a, b), order++, a, ~b});
+  }
+  if (candidates_.empty()) return best;
+  int best_order = order;
+  auto check = [&](const Candidate& c) {
+    const double max = best.distance + kCullSlack;
+    const bool valid =
+        c.b >= 0 ? robot_obstacle(c.a, obstacles_[c.b], max, p) : robot_robot(c.a, ~c.b, max, p);
+    if (valid &&
+        (p.distance < best.distance || (p.distance == best.distance && c.order < best_order))) {
+      best = p;
+      best_order = c.order;
+    }
+  };
+  auto first =
+      std::min_element(candidates_.begin(), candidates_.end(),
+                       [](const Candidate& x, const Candidate& y) { return x.bound < y.bound; });
+  const Candidate head = *first;
+  check(head);
+  // Only pairs whose bound does not exceed the best distance can beat it or tie.
+  auto keep_end = std::remove_if(candidates_.begin(), candidates_.end(), [&](const Candidate& c) {
+    return c.order == head.order || c.bound > best.distance + kCullSlack;
+  });
+  std::sort(candidates_.begin(), keep_end, [](const Candidate& x, const Candidate& y) {
+    return x.bound < y.bound || (x.bound == y.bound && x.order < y.order);
+  });
+  for (auto it = candidates_.begin(); it != keep_end; ++it) {
+    if (it->bound > best.distance + kCullSlack) break;
+    check(*it);
   }
   return best;
 }

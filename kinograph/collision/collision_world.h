@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <cstdint>
 #include <limits>
 #include <span>
 #include <utility>
@@ -32,6 +33,12 @@ struct CollisionWorldOptions {
   // Include geometry fixed to the base (body -1) in robot-versus-obstacle pairs. Default off:
   // the base cannot move, so such a distance has no gradient and belongs to scene checks.
   bool base_vs_obstacles = false;
+  // query() remembers this many recent results, keyed by the exact body poses, query distance
+  // and (with moving obstacles) time, and answers a repeated query from memory: the optimizers
+  // evaluate a factor's error at a trial point and then linearize it at the same point, so about
+  // half of the planner's queries repeat. Answers are bitwise those of a fresh query. 0 = off.
+  // Default 256 (the planners' working set per world is about 100–200 configurations).
+  int memo_entries = 256;
 };
 
 // The collision scene of one robot: its collision geometry (from the Model, Bullet shapes made
@@ -84,8 +91,25 @@ class CollisionWorld {
     int body = -1;
     Eigen::Isometry3d origin;  // in its body's frame
     ConvexShape shape;
-    Eigen::Isometry3d world;  // after update_poses
-    Eigen::Vector3d centre;   // bounding sphere centre, world
+    Eigen::Vector3d local_centre;  // bounding sphere centre in the body's frame
+    Eigen::Isometry3d world;       // valid when posed == pose_stamp_
+    Eigen::Vector3d centre;        // bounding sphere centre, world (after update_poses)
+    uint64_t posed = 0;
+  };
+  // One remembered query: its result lives in memo_arena_ at monotonic positions
+  // [begin, begin + count) and is intact while memo_write_ <= begin + arena size.
+  struct MemoEntry {
+    bool valid = false;
+    uint64_t hash = 0;
+    uint64_t used = 0;  // LRU tick
+    uint64_t begin = 0;
+    int count = 0;
+  };
+  // A pair that survived culling in closest(), ordered by its lower bound.
+  struct Candidate {
+    double bound;
+    int order;  // position in the brute-force visiting order (ties keep the earlier pair)
+    int a, b;   // robot geometry and obstacle index, or two robot geometries (b < 0: ~b)
   };
   struct ObstacleEntry {
     Obstacle obstacle;
@@ -96,12 +120,23 @@ class CollisionWorld {
     void place(const Eigen::Isometry3d& pose);
   };
 
+  // Sets the bounding-sphere centres and moving obstacles; full geometry poses are made only
+  // for pairs that survive culling (geom_world).
   void update_poses(const dynamics::Data& data, double t);
+  const Eigen::Isometry3d& geom_world(int g);
   void reserve_output();
+  // True when the bounds prove the pair's signed distance exceeds `threshold` (no square roots
+  // when threshold + radii >= 0).
+  bool beyond(int g, const ObstacleEntry& o, double threshold) const;
+  bool beyond(int a, int b, double threshold) const;
+  // Memo of query(): fills memo_key_ and returns the entry holding that key, or nullptr.
+  const MemoEntry* memo_find(const dynamics::Data& data, double t, double query_distance);
+  void memo_store();
+  void memo_clear();
   int find_index(int id) const;
   // Fills `out` with the pair's signed distance if it is at most max_distance.
-  bool robot_obstacle(int g, const ObstacleEntry& o, double max_distance, Proximity& out) const;
-  bool robot_robot(int a, int b, double max_distance, Proximity& out) const;
+  bool robot_obstacle(int g, const ObstacleEntry& o, double max_distance, Proximity& out);
+  bool robot_robot(int a, int b, double max_distance, Proximity& out);
   // A lower bound of the pair's signed distance from bounding spheres and boxes.
   double lower_bound(int g, const ObstacleEntry& o) const;
   double lower_bound(int a, int b) const;
@@ -114,6 +149,17 @@ class CollisionWorld {
   std::vector<std::pair<int, int>> self_pairs_;  // robot geometry index pairs
   std::vector<ObstacleEntry> obstacles_;
   std::vector<Proximity> out_;
+  std::vector<Candidate> candidates_;
+  uint64_t pose_stamp_ = 0;
+  const dynamics::Data* data_ = nullptr;  // of the current query, for geom_world
+  // query() memo: memo_entries_ slots in sets of kMemoWays, the key of each slot (body poses,
+  // query distance, time) in memo_keys_, results in a ring arena.
+  std::vector<MemoEntry> memo_;
+  std::vector<double> memo_keys_;
+  std::vector<double> memo_key_;  // key of the current query
+  uint64_t memo_hash_ = 0;
+  std::vector<Proximity> memo_arena_;
+  uint64_t memo_write_ = 0, memo_tick_ = 0;
 };
 
 }  // namespace kinograph::collision

@@ -1,0 +1,248 @@
+// The fast paths of CollisionWorld (culling without square roots, geometry poses made only for
+// pairs that survive culling, the query memo, closest() in order of lower bounds) against a
+// plain reference: every (robot geometry, obstacle) pair through pair_distance at poses made
+// here from the forward kinematics. Answers must agree bit for bit, including pairs exactly at
+// the query-distance cut-off and penetrating pairs.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "kinograph/collision/collision_world.h"
+#include "kinograph/collision/convex_shape.h"
+#include "kinograph/collision/pair_distance.h"
+#include "kinograph/dynamics/kinematics.h"
+
+namespace kinograph::collision {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+Obstacle box_at(int id, double sx, double sy, double sz, double x, double y, double z) {
+  Obstacle o;
+  o.id = id;
+  o.shape = Shape::box(sx, sy, sz);
+  o.pose.translation() = Eigen::Vector3d(x, y, z);
+  return o;
+}
+
+// The desk of robots/scenes/iiwa_desk.yaml: tabletop and four legs.
+std::vector<Obstacle> desk_scene() {
+  return {box_at(0, 0.5, 1.0, 0.04, 0.75, 0, 0.64), box_at(1, 0.04, 0.04, 0.62, 0.52, 0.48, 0.31),
+          box_at(2, 0.04, 0.04, 0.62, 0.52, -0.48, 0.31),
+          box_at(3, 0.04, 0.04, 0.62, 0.98, 0.48, 0.31),
+          box_at(4, 0.04, 0.04, 0.62, 0.98, -0.48, 0.31)};
+}
+
+class IiwaDesk : public testing::Test {
+ protected:
+  IiwaDesk()
+      : model(dynamics::Model::from_urdf_file(std::string(KINOGRAPH_SOURCE_DIR) +
+                                              "/robots/iiwa14/iiwa14.urdf")),
+        data(model),
+        obstacles(desk_scene()) {
+    for (const Obstacle& o : obstacles) shapes.push_back(std::make_unique<ConvexShape>(o.shape));
+  }
+
+  Eigen::VectorXd random_q(std::mt19937& rng) const {
+    Eigen::VectorXd q(model.nq());
+    for (int j = 0; j < model.nq(); ++j) {
+      const auto& lim = model.bodies[j].limits;
+      q[j] = std::uniform_real_distribution<double>(lim.lower, lim.upper)(rng);
+    }
+    return q;
+  }
+
+  // Every moving robot geometry against `only` (or every obstacle when -1), in query() order,
+  // at most query_distance away.
+  std::vector<Proximity> reference(const CollisionWorld& world, double query_distance,
+                                   int only = -1) const {
+    std::vector<Proximity> out;
+    for (int g = 0; g < static_cast<int>(model.collision.size()); ++g) {
+      const dynamics::Geometry& geom = model.collision[g];
+      if (geom.body < 0) continue;
+      const Eigen::Isometry3d pose = data.body_pose[geom.body] * geom.origin;
+      for (size_t o = 0; o < obstacles.size(); ++o) {
+        if (only >= 0 && static_cast<int>(o) != only) continue;
+        const PairDistance d =
+            pair_distance(world.robot_shape(g), pose, *shapes[o], obstacles[o].pose);
+        if (!d.valid || d.distance > query_distance) continue;
+        Proximity p;
+        p.robot_geom = g;
+        p.obstacle = obstacles[o].id;
+        p.distance = d.distance;
+        p.point_on_robot = d.point_on_a;
+        p.point_on_obstacle = d.point_on_b;
+        p.normal = d.normal;
+        out.push_back(p);
+      }
+    }
+    return out;
+  }
+
+  dynamics::Model model;
+  dynamics::Data data;
+  std::vector<Obstacle> obstacles;
+  std::vector<std::unique_ptr<ConvexShape>> shapes;
+};
+
+void expect_same(std::span<const Proximity> a, const std::vector<Proximity>& b,
+                 const std::string& what) {
+  ASSERT_EQ(a.size(), b.size()) << what;
+  for (size_t i = 0; i < a.size(); ++i) {
+    SCOPED_TRACE(what + " pair " + std::to_string(i));
+    EXPECT_EQ(a[i].robot_geom, b[i].robot_geom);
+    EXPECT_EQ(a[i].obstacle, b[i].obstacle);
+    EXPECT_EQ(a[i].other_geom, b[i].other_geom);
+    EXPECT_EQ(a[i].distance, b[i].distance);
+    EXPECT_EQ(a[i].point_on_robot, b[i].point_on_robot);
+    EXPECT_EQ(a[i].point_on_obstacle, b[i].point_on_obstacle);
+    EXPECT_EQ(a[i].normal, b[i].normal);
+  }
+}
+
+// One world with the whole desk (batch planner) and one world per desk part (incremental
+// planner), with and without the memo, against the reference on random configurations.
+TEST_F(IiwaDesk, QueriesMatchPairwiseReferenceBitForBit) {
+  CollisionWorldOptions memo_opts;  // defaults: query distance 0.3 m, culling, memo
+  CollisionWorldOptions plain_opts = memo_opts;
+  plain_opts.memo_entries = 0;
+  CollisionWorld all_memo(model, memo_opts), all_plain(model, plain_opts);
+  std::vector<std::unique_ptr<CollisionWorld>> single;
+  for (const Obstacle& o : obstacles) {
+    ASSERT_TRUE(all_memo.add_obstacle(o));
+    ASSERT_TRUE(all_plain.add_obstacle(o));
+    single.push_back(std::make_unique<CollisionWorld>(model, memo_opts));
+    ASSERT_TRUE(single.back()->add_obstacle(o));
+  }
+  std::mt19937 rng(7);
+  int reported = 0, penetrating = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    dynamics::forward_kinematics(model, data, random_q(rng));
+    const std::vector<Proximity> ref = reference(all_plain, 0.3);
+    const std::string what = "trial " + std::to_string(trial);
+    expect_same(all_plain.query(data), ref, what + " plain");
+    expect_same(all_memo.query(data), ref, what + " memo");
+    expect_same(all_memo.query(data), ref, what + " memo repeat");
+    for (size_t o = 0; o < single.size(); ++o) {
+      expect_same(single[o]->query(data), reference(all_plain, 0.3, static_cast<int>(o)),
+                  what + " single world " + std::to_string(o));
+    }
+    reported += static_cast<int>(ref.size());
+    for (const Proximity& p : ref) penetrating += p.distance < 0;
+  }
+  EXPECT_GT(reported, 200);
+  EXPECT_GT(penetrating, 10);  // random configurations reach into the desk
+}
+
+// A query distance equal to a pair's distance reports it; the next smaller double does not.
+TEST_F(IiwaDesk, PairsExactlyAtTheCutOff) {
+  CollisionWorldOptions opts;
+  CollisionWorld world(model, opts);
+  for (const Obstacle& o : obstacles) ASSERT_TRUE(world.add_obstacle(o));
+  std::mt19937 rng(11);
+  int checked = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    dynamics::forward_kinematics(model, data, random_q(rng));
+    const std::vector<Proximity> all = reference(world, kInf);
+    for (const Proximity& p : all) {
+      if (std::abs(p.distance) > 0.3) continue;
+      const double below = std::nextafter(p.distance, -kInf);
+      expect_same(world.query(data, 0, p.distance), reference(world, p.distance),
+                  "at " + std::to_string(p.distance));
+      expect_same(world.query(data, 0, below), reference(world, below),
+                  "below " + std::to_string(p.distance));
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 100);
+}
+
+// closest() visits pairs in order of their bounds; it must give the brute-force minimum and,
+// among equals, the same pair as the brute-force order.
+TEST_F(IiwaDesk, ClosestMatchesBruteForce) {
+  CollisionWorldOptions opts;
+  opts.self_collision = true;
+  CollisionWorldOptions brute_opts = opts;
+  brute_opts.cull = false;
+  CollisionWorld fast(model, opts), brute(model, brute_opts);
+  for (const Obstacle& o : obstacles) {
+    ASSERT_TRUE(fast.add_obstacle(o));
+    ASSERT_TRUE(brute.add_obstacle(o));
+  }
+  std::mt19937 rng(5);
+  int penetrating = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    dynamics::forward_kinematics(model, data, random_q(rng));
+    const Proximity a = fast.closest(data), b = brute.closest(data);
+    SCOPED_TRACE("trial " + std::to_string(trial));
+    EXPECT_EQ(a.distance, b.distance);
+    EXPECT_EQ(a.robot_geom, b.robot_geom);
+    EXPECT_EQ(a.obstacle, b.obstacle);
+    EXPECT_EQ(a.other_geom, b.other_geom);
+    EXPECT_EQ(a.point_on_robot, b.point_on_robot);
+    EXPECT_EQ(a.normal, b.normal);
+    penetrating += a.distance < 0;
+  }
+  EXPECT_GT(penetrating, 5);
+}
+
+// The memo answers repeats (interleaved, as the optimizers evaluate many factors between an
+// error and a linearization at the same point) exactly as a fresh query, keys moving obstacles
+// by time, and forgets everything when an obstacle changes.
+TEST_F(IiwaDesk, MemoAnswersAsAFreshQuery) {
+  CollisionWorldOptions memo_opts;
+  memo_opts.memo_entries = 8;  // small, so entries are also evicted and overwritten
+  CollisionWorldOptions plain_opts = memo_opts;
+  plain_opts.memo_entries = 0;
+  CollisionWorld memo(model, memo_opts), plain(model, plain_opts);
+  for (const Obstacle& o : obstacles) {
+    ASSERT_TRUE(memo.add_obstacle(o));
+    ASSERT_TRUE(plain.add_obstacle(o));
+  }
+  // A ball sweeping through the workspace, so the answer depends on time.
+  Obstacle ball;
+  ball.id = 9;
+  ball.shape = Shape::sphere(0.15);
+  Eigen::Isometry3d a = Eigen::Isometry3d::Identity(), b = a;
+  a.translation() = Eigen::Vector3d(0.4, -0.4, 0.6);
+  b.translation() = Eigen::Vector3d(0.4, 0.4, 0.9);
+  ball.trajectory = PoseTrajectory({0.0, 1.0}, {a, b});
+  ASSERT_TRUE(memo.add_obstacle(ball));
+  ASSERT_TRUE(plain.add_obstacle(ball));
+
+  std::mt19937 rng(3);
+  std::vector<Eigen::VectorXd> qs;
+  for (int i = 0; i < 24; ++i) qs.push_back(random_q(rng));
+  int reported = 0;
+  auto compare = [&](const std::string& what) {
+    for (int pass = 0; pass < 3; ++pass) {
+      for (size_t i = 0; i < qs.size(); ++i) {
+        dynamics::forward_kinematics(model, data, qs[i]);
+        const double t = 0.1 * static_cast<double>(i % 4) + 0.05 * (pass == 2);
+        const std::vector<Proximity> fresh(plain.query(data, t).begin(),
+                                           plain.query(data, t).end());
+        expect_same(memo.query(data, t), fresh,
+                    what + " pass " + std::to_string(pass) + " config " + std::to_string(i));
+        reported += static_cast<int>(fresh.size());
+      }
+    }
+  };
+  compare("initial");
+  Eigen::Isometry3d raised = obstacles[0].pose;
+  raised.translation().z() += 0.05;
+  ASSERT_TRUE(memo.move_obstacle(0, raised));
+  ASSERT_TRUE(plain.move_obstacle(0, raised));
+  compare("tabletop moved");
+  ASSERT_TRUE(memo.remove_obstacle(9));
+  ASSERT_TRUE(plain.remove_obstacle(9));
+  compare("ball removed");
+  EXPECT_GT(reported, 100);
+}
+
+}  // namespace
+}  // namespace kinograph::collision
