@@ -1,19 +1,40 @@
 #pragma once
 // Internal helpers shared by the kinematics and dynamics sources (not installed API).
 #include <Eigen/Geometry>
+#include <cmath>
 
 #include "kinograph/dynamics/data.h"
 #include "kinograph/dynamics/model.h"
 
 namespace kinograph::dynamics::detail {
 
+/// Columns i, j of P · Rot_k(θ) for the coordinate axis k after which i, j follow cyclically
+/// (x: y, z; y: z, x; z: x, y): the rotation mixes only those two columns, and column k stays.
+inline void rotate_columns(const Eigen::Matrix3d& P, int i, int j, double c, double s,
+                           Eigen::Matrix3d& out) {
+  out.col(i) = c * P.col(i) + s * P.col(j);
+  out.col(j) = c * P.col(j) - s * P.col(i);
+}
+
 /// T_parent,body(q) = parent_to_joint · exp([A] q) for a unit revolute or prismatic screw A.
+/// Revolute joints about a coordinate axis (every joint of the iiwa, most URDFs) skip the
+/// general axis-angle matrix and its 3 × 3 product: two columns of parent_to_joint mix.
 inline void joint_transform(const Body& b, double q, Eigen::Isometry3d& out) {
   if (b.joint_type == JointType::kRevolute) {
     const Eigen::Vector3d axis = b.screw_axis.head<3>();
-    out.linear().noalias() =
-        b.parent_to_joint.linear() * Eigen::AngleAxisd(q, axis).toRotationMatrix();
+    const Eigen::Matrix3d& P = b.parent_to_joint.linear();
     out.translation() = b.parent_to_joint.translation();
+    for (int k = 0; k < 3; ++k) {
+      const int i = (k + 1) % 3, j = (k + 2) % 3;
+      if (axis[i] != 0 || axis[j] != 0 || std::abs(axis[k]) != 1) continue;
+      const double c = std::cos(q), s = axis[k] * std::sin(q);
+      Eigen::Matrix3d R;
+      R.col(k) = P.col(k);
+      rotate_columns(P, i, j, c, s, R);
+      out.linear() = R;
+      return;
+    }
+    out.linear().noalias() = P * Eigen::AngleAxisd(q, axis).toRotationMatrix();
   } else {
     out.linear() = b.parent_to_joint.linear();
     out.translation() =
