@@ -117,12 +117,22 @@ const CollisionWorld::MemoEntry* CollisionWorld::memo_find(const dynamics::Data&
   }
   k[0] = query_distance;
   k[1] = has_moving_obstacles() ? t : 0.0;  // fixed obstacles do not depend on t
+  // The hash reads each pose's first rotation column and translation (every joint moves one of
+  // them) and the last two entries; the full key is compared on a hit.
   uint64_t h = 0;
-  for (const double v : memo_key_) {
-    uint64_t bits;
-    std::memcpy(&bits, &v, sizeof bits);
-    h = mix(h, bits);
+  auto add = [&h](const double* v, int n) {
+    for (int i = 0; i < n; ++i) {
+      uint64_t bits;
+      std::memcpy(&bits, v + i, sizeof bits);
+      h = mix(h, bits);
+    }
+  };
+  const double* key_begin = memo_key_.data();
+  for (; key_begin != k; key_begin += kPoseKey) {
+    add(key_begin, 3);       // rotation column 0
+    add(key_begin + 12, 3);  // translation
   }
+  add(k, 2);
   memo_hash_ = h;
   const size_t key = memo_key_.size();
   const size_t set = (h >> 17) % (memo_.size() / kMemoWays) * kMemoWays;
