@@ -103,6 +103,10 @@ std::string check_problem(const Problem& p) {
 BatchPlanner::BatchPlanner(BatchPlannerOptions options) : options_(std::move(options)) {}
 
 Plan BatchPlanner::plan(const Problem& problem, const Plan* warm) const {
+  return plan(problem, warm, nullptr);
+}
+
+Plan BatchPlanner::plan(const Problem& problem, const Plan* warm, BatchSolution* solution) const {
   const auto t0 = std::chrono::steady_clock::now();
   auto elapsed = [&t0] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -156,8 +160,9 @@ Plan BatchPlanner::plan(const Problem& problem, const Plan* warm) const {
   }
   Plan best;
   SolveStats total;
+  BatchSolution attempt;
   for (size_t a = 0; a < inits.size(); ++a) {
-    Plan p = solve(problem, inits[a], method);
+    Plan p = solve(problem, inits[a], method, solution != nullptr ? &attempt : nullptr);
     if (a == 0) {
       total = p.stats;
     } else {
@@ -172,6 +177,7 @@ Plan BatchPlanner::plan(const Problem& problem, const Plan* warm) const {
     if (first || p.success() ||
         p.stats.max_constraint_violation < best.stats.max_constraint_violation) {
       best = std::move(p);
+      if (solution != nullptr) *solution = std::move(attempt);
     }
     if (best.success() || best.stats.status == "invalid_problem") break;
     add_detours(false);
@@ -186,9 +192,10 @@ Plan BatchPlanner::plan(const Problem& problem, const Plan* warm) const {
   return best;
 }
 
-Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init,
-                         const std::string& method) const {
+Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init, const std::string& method,
+                         BatchSolution* solution) const {
   const auto t0 = std::chrono::steady_clock::now();
+  if (solution != nullptr) *solution = BatchSolution();  // empty unless the solve runs
   auto elapsed = [&t0] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   };
@@ -333,6 +340,11 @@ Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init,
       1e3 * timing.factorize, 1e3 * timing.solve, 1e3 * timing.evaluate, 1e3 * timing.lm_wall,
       1e3 * timing.al, 1e3 * (t_loop - t_built - timing.lm_wall - timing.al),
       1e3 * (t_solved - t_loop), 1e3 * (plan.stats.solve_time_s - t_solved));
+  if (solution != nullptr) {
+    solution->penalty = al.penalty();
+    solution->condensed = dfg_steps.empty();
+    solution->graph = std::move(pg);
+  }
   return plan;
 }
 

@@ -60,6 +60,15 @@ struct BatchPlannerOptions {
   DetourOptions detour;
 };
 
+/// Where the solve of a plan ended: its graph (whose constraint factors hold the final
+/// multipliers), values and penalty μ. The incremental planner starts its Bayes tree from this
+/// instead of solving the problem again.
+struct BatchSolution {
+  PlanningGraph graph;
+  double penalty = 0;     ///< μ of the augmented Lagrangian at the end
+  bool condensed = true;  ///< false: the DFG formulation's graph (other variables and factors)
+};
+
 /// Plans a trajectory for a Problem from a straight-line (L) or warm-start (W) initialization.
 class BatchPlanner {
  public:
@@ -70,12 +79,17 @@ class BatchPlanner {
   /// "infeasible" (constraints still violated at the iteration limit) and a reason. Always
   /// runs validate().
   Plan plan(const Problem& problem, const Plan* warm_start = nullptr) const;
+  /// The same plan, and (when `solution` is non-null) the final state of the attempt it came
+  /// from; numerically identical to plan().
+  Plan plan(const Problem& problem, const Plan* warm_start, BatchSolution* solution) const;
 
   const BatchPlannerOptions& options() const { return options_; }
 
  private:
-  /// One augmented-Lagrangian solve from `init`, validated.
-  Plan solve(const Problem& problem, const Trajectory& init, const std::string& method) const;
+  /// One augmented-Lagrangian solve from `init`, validated; its final state goes to `solution`
+  /// when that is non-null.
+  Plan solve(const Problem& problem, const Trajectory& init, const std::string& method,
+             BatchSolution* solution = nullptr) const;
 
   BatchPlannerOptions options_;
 };

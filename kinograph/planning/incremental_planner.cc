@@ -208,6 +208,55 @@ std::vector<Entry> timing_entries(const Problem& p, const IncrementalPlannerOpti
   return out;
 }
 
+// Changes the penalty of `f` to `mu` keeping the force λ + μc of every constraint row at
+// `values` (bounds clipped at 0), so that a point stationary for the old augmented Lagrangian
+// stays stationary for the new one. Exact for mu ≤ f.penalty(), the only use here (the batch's
+// final μ clamped from above).
+void change_penalty_keeping_forces(ConstrainedFactor& f, const graph::Values& values, double mu,
+                                   Eigen::VectorXd& z) {
+  const double d = f.penalty() - mu;
+  if (d != 0 && f.has_constraints()) {
+    f.values_at(values, z);
+    Eigen::VectorXd lo = f.multipliers(), up = f.multipliers_upper();
+    for (int i = 0; i < f.residual_dim(); ++i) {
+      const RowSpec& row = f.rows()[i];
+      if (row.kind == RowKind::kEquality) {
+        lo[i] += d * (z[i] - row.lower) / row.scale;
+      } else if (row.kind == RowKind::kBounds) {
+        if (std::isfinite(row.lower))
+          lo[i] = std::max(0.0, lo[i] + d * (row.lower - z[i]) / row.scale);
+        if (std::isfinite(row.upper))
+          up[i] = std::max(0.0, up[i] + d * (z[i] - row.upper) / row.scale);
+      }
+    }
+    f.set_multipliers(lo, up);
+  }
+  f.set_penalty(mu);
+}
+
+// The joint goal's multipliers are the force that held q_N fixed: stationarity of the augmented
+// Lagrangian at c = 0 gives λ/s = −∂(rest of the cost)/∂q_N.
+void set_goal_multipliers(const std::vector<Entry>& entries, const graph::Values& values, int N,
+                          int n, double goal_scale) {
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(n);
+  Eigen::VectorXd r;
+  Eigen::MatrixXd J;
+  ConstrainedFactor* goal = nullptr;
+  for (const Entry& e : entries) {
+    if (e.role == Role::kGoal) {
+      goal = e.constrained.get();
+      continue;
+    }
+    const auto& keys = e.factor->keys();
+    const auto it = std::find(keys.begin(), keys.end(), q_key(N));
+    if (it == keys.end()) continue;
+    e.factor->linearize(values, r, J);
+    const int col = e.factor->block_offsets()[it - keys.begin()];
+    g += J.middleCols(col, n).transpose() * r;
+  }
+  if (goal != nullptr) goal->set_multipliers(-goal_scale * g, Eigen::VectorXd::Zero(n));
+}
+
 }  // namespace
 
 Plan IncrementalPlanner::make_plan(const std::string& method, bool with_stats) {
@@ -377,29 +426,7 @@ Plan IncrementalPlanner::batch_solve(const Problem& problem, const Eigen::Matrix
   values.set_fixed(q_key(0), false);
   values.set_fixed(v_key(0), false);
   values.set_fixed(q_key(N), false);
-  if (joint_goal) {
-    // The joint goal's multipliers are the force that held q_N: stationarity of the augmented
-    // Lagrangian at c = 0 gives λ/s = −∂(rest of the cost)/∂q_N.
-    Eigen::VectorXd g = Eigen::VectorXd::Zero(n);
-    Eigen::VectorXd r;
-    Eigen::MatrixXd J;
-    ConstrainedFactor* goal = nullptr;
-    for (const Entry& e : state->entries) {
-      if (e.role == Role::kGoal) {
-        goal = e.constrained.get();
-        continue;
-      }
-      const auto& keys = e.factor->keys();
-      const auto it = std::find(keys.begin(), keys.end(), q_key(N));
-      if (it == keys.end()) continue;
-      e.factor->linearize(values, r, J);
-      const int col = e.factor->block_offsets()[it - keys.begin()];
-      g += J.middleCols(col, n).transpose() * r;
-    }
-    if (goal != nullptr) {
-      goal->set_multipliers(-options_.goal_scale * g, Eigen::VectorXd::Zero(n));
-    }
-  }
+  if (joint_goal) set_goal_multipliers(state->entries, values, N, n, options_.goal_scale);
   state->isam = std::make_unique<graph::ISAM2>(options_.isam2);
   std::vector<graph::FactorPtr> all;
   for (const Entry& e : state->entries) all.push_back(e.factor);
@@ -426,6 +453,112 @@ Plan IncrementalPlanner::batch_solve(const Problem& problem, const Eigen::Matrix
   return plan;
 }
 
+bool IncrementalPlanner::adopt(const Problem& problem, BatchSolution& solution) {
+  PlanningGraph& pg = solution.graph;
+  const int n = problem.model->nq(), N = problem.steps;
+  if (!solution.condensed || pg.steps != N || pg.nq != n || pg.values.size() == 0) return false;
+  const bool joint_goal = problem.goal.kind == Goal::Kind::kJoint;
+  const double mu = std::clamp(options_.carried_penalty_fraction * solution.penalty,
+                               options_.penalty, options_.max_penalty);
+  const graph::Values& values = pg.values;
+
+  // The batch graph's factors, in build_graph's order, are the incremental graph's own (same
+  // factors, same workspace) except for the goal and the collision factors; each constraint
+  // factor's penalty drops to μ with its forces kept.
+  auto state = std::make_unique<State>();
+  state->workspace = pg.dynamics_workspace;
+  state->mu = mu;
+  std::vector<std::shared_ptr<CollisionFactor>> batch_collision;
+  std::optional<Entry> goal;
+  Eigen::VectorXd z;
+  for (const graph::FactorPtr& f : pg.graph.factors()) {
+    if (!f) continue;
+    if (auto c = std::dynamic_pointer_cast<CollisionFactor>(f)) {
+      change_penalty_keeping_forces(*c, values, mu, z);
+      batch_collision.push_back(std::move(c));
+      continue;
+    }
+    if (auto c = std::dynamic_pointer_cast<ConstrainedFactor>(f)) {
+      change_penalty_keeping_forces(*c, values, mu, z);
+    }
+    // A pose goal is build_graph's first factor, the only one on q_N alone before the GP priors.
+    if (!joint_goal && !goal && state->entries.empty() && dynamic_cast<PoseFactor*>(f.get()) &&
+        f->keys().size() == 1 && f->keys().front() == q_key(N)) {
+      goal = make_entry(f, Role::kGoal);
+      continue;
+    }
+    const bool timing = dynamic_cast<const GpPriorFactor*>(f.get()) != nullptr ||
+                        dynamic_cast<const CollocationFactor*>(f.get()) != nullptr;
+    state->entries.push_back(make_entry(f, timing ? Role::kTiming : Role::kOther));
+  }
+  if (!joint_goal && !goal) return false;
+  state->entries.push_back(start_entry(problem, options_));
+  state->entries.push_back(joint_goal ? goal_entry(problem, state->workspace, options_) : *goal);
+
+  // Per-obstacle collision factors: the batch's factor i of the same (state, sub-step) holds
+  // every obstacle's rows; each (robot geometry, obstacle) row's multipliers move over.
+  const CollisionContext* batch_ctx = pg.collision.get();
+  std::set<int> ids;
+  for (const collision::Obstacle& o : problem.obstacles) {
+    if (!ids.insert(o.id).second) return false;
+    std::shared_ptr<CollisionContext> ctx;
+    std::vector<Entry> es = obstacle_entries(problem, o, options_, ctx);
+    state->contexts[o.id] = ctx;
+    int slot = -1;  // the obstacle's column in the batch context
+    if (batch_ctx != nullptr) {
+      const auto& bid = batch_ctx->obstacle_ids;
+      const auto it = std::find(bid.begin(), bid.end(), o.id);
+      if (it != bid.end()) slot = static_cast<int>(it - bid.begin());
+    }
+    const bool carry = slot >= 0 && es.size() == batch_collision.size();
+    if (!es.empty() && !carry) {
+      spdlog::warn("incremental planner: obstacle {}'s collision multipliers not carried", o.id);
+    }
+    for (size_t i = 0; i < es.size(); ++i) {
+      ConstrainedFactor& to = *es[i].constrained;
+      to.set_penalty(mu);
+      if (carry) {
+        const ConstrainedFactor& from = *batch_collision[i];
+        Eigen::VectorXd lo = to.multipliers(), up = to.multipliers_upper();
+        for (int g : ctx->geoms) {
+          const int a = ctx->row_of[g][0], b = batch_ctx->row_of[g][slot];
+          if (a < 0 || b < 0) continue;
+          lo[a] = from.multipliers()[b];
+          up[a] = from.multipliers_upper()[b];
+        }
+        to.set_multipliers(lo, up);
+      }
+      state->entries.push_back(std::move(es[i]));
+    }
+  }
+
+  // The start and goal become factors (their variables free), then one full elimination at the
+  // batch solution.
+  graph::Values start_values = values;
+  start_values.set_fixed(q_key(0), false);
+  start_values.set_fixed(v_key(0), false);
+  start_values.set_fixed(q_key(N), false);
+  for (Entry& e : state->entries) {
+    if (e.constrained) e.constrained->set_penalty(mu);
+  }
+  if (joint_goal) set_goal_multipliers(state->entries, start_values, N, n, options_.goal_scale);
+  state->isam = std::make_unique<graph::ISAM2>(options_.isam2);
+  std::vector<graph::FactorPtr> all;
+  all.reserve(state->entries.size());
+  for (const Entry& e : state->entries) all.push_back(e.factor);
+  const graph::ISAM2Result r = state->isam->update(all, {}, start_values);
+  if (!r.ok()) {
+    spdlog::warn("incremental planner: building the Bayes tree: {}", r.reason);
+    return false;
+  }
+  for (size_t i = 0; i < state->entries.size(); ++i) {
+    state->entries[i].index = r.new_factor_indices[i];
+  }
+  problem_ = problem;
+  state_ = std::move(state);
+  return true;
+}
+
 Plan IncrementalPlanner::plan(const Problem& problem, const Plan* warm) {
   if (warm != nullptr) {
     Trajectory init;
@@ -436,14 +569,56 @@ Plan IncrementalPlanner::plan(const Problem& problem, const Plan* warm) {
     }
     return batch_solve(problem, &init.q, &init.qd, &init.qdd, "batch-W", false);
   }
-  // The batch planner's own initializations (straight line, detours) find the way; the solve on
-  // the incremental graph, warm-started there, then recovers the multipliers.
+  // The batch planner's own initializations (straight line, detours) find the way; its final
+  // graph, values and multipliers become the incremental graph's (no second solve).
   const auto t0 = Clock::now();
-  const Plan batch = BatchPlanner(options_.batch).plan(problem);
+  BatchSolution solution;
+  const Plan batch = BatchPlanner(options_.batch).plan(problem, nullptr, &solution);
   if (batch.stats.status == "invalid_problem" || batch.q.rows() != problem.steps + 1 ||
       !batch.q.allFinite()) {
     return batch;
   }
+  const double batch_s = seconds_since(t0);
+  state_.reset();
+  bool adopted = false;
+  try {
+    adopted = adopt(problem, solution);
+  } catch (const std::exception& e) {
+    spdlog::warn("incremental planner: adopting the batch solution: {}", e.what());
+  }
+  if (adopted) {
+    const double adopted_s = seconds_since(t0);
+    Plan p = batch;
+    stats_ = IncrementalStats();
+    stats_.method = batch.stats.method;
+    stats_.penalty = state_->mu;
+    plan_ = batch;
+    if (!batch.success() || options_.settle_first_plan) {
+      // One replan of the unchanged problem settles the tree at its own optimum (as the
+      // multipliers carried it, within the batch's tolerances). Its plan answers when it
+      // validates and costs no more than the batch plan, or when the batch plan failed.
+      const bool fallback = options_.fallback;
+      options_.fallback = false;
+      const Plan settled = replan(ProblemChange());
+      options_.fallback = fallback;
+      if (settled.success() && (!batch.success() || settled.stats.cost <= batch.stats.cost)) {
+        p = settled;
+        p.stats.method = batch.stats.method;
+        p.stats.iterations = batch.stats.iterations + settled.stats.iterations;
+        p.stats.outer_iterations = batch.stats.outer_iterations + settled.stats.outer_iterations;
+        p.stats.linear_solves = batch.stats.linear_solves + settled.stats.linear_solves;
+      }
+      stats_.method = batch.stats.method;
+    }
+    spdlog::debug(
+        "iDFGP first plan: batch plan {:.2f} ms, carried into the Bayes tree {:.2f} ms, settled "
+        "{:.2f} ms",
+        batch_s * 1e3, (adopted_s - batch_s) * 1e3, (seconds_since(t0) - adopted_s) * 1e3);
+    p.stats.solve_time_s = seconds_since(t0);
+    plan_ = p;
+    return p;
+  }
+  // Not carried (the DFG formulation's graph): re-solve on the incremental graph.
   Plan p = batch_solve(problem, &batch.q, &batch.qd, &batch.qdd, "batch-L", false);
   if (!p.success() && batch.success()) {
     spdlog::debug("incremental planner: the re-solve on the incremental graph did not validate");

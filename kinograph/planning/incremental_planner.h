@@ -10,17 +10,20 @@
 //  - the start (q_0, q̇_0) is a strong linear prior and a joint goal q_N an equality constraint
 //    (StateTargetFactor), not fixed variables, so that changing them is a factor replacement
 //    (ISAM2 cannot change a variable's value or fixed flag); q̇_N = q̈_N = 0 stay fixed (every
-//    goal is at rest). The first plan is solved with them fixed, exactly as BatchPlanner, and
-//    converted (the goal's multipliers from the stationarity of the Lagrangian at q_N);
+//    goal is at rest). The first plan is BatchPlanner's own (with them fixed), carried over
+//    without a second solve: its factors become the incremental graph's, the goal's multipliers
+//    come from the stationarity of the Lagrangian at q_N;
 //  - each obstacle has its own collision factors (one per state and sub-step), so adding,
-//    moving or removing one obstacle touches only its own factors;
-//  - the multipliers carry the constraint forces, and μ is the batch's final μ clamped to
-//    [penalty, max_penalty] = [1e2, 1e4]. Issue 6 warns that Gauss–Newton on a graph with large
-//    penalty weights blows up (measured with GTSAM). Measured here (bench/replanning/README.md,
-//    both caps in one run): with the safeguarded ISAM2 and carried multipliers, keeping the
-//    batch's μ (up to 1e7) does not blow up either — same success — but the moderate cap gives
-//    plans with a lower objective (199 vs 229 on task 1, 1311 vs 1402 on task 2) in less time
-//    (mean 18.6 vs 22.4 ms and 14.7 vs 18.4 ms).
+//    moving or removing one obstacle touches only its own factors; their multipliers are the
+//    batch collision factors' rows of the same (state, sub-step, robot geometry, obstacle);
+//  - the multipliers carry the constraint forces, and μ is a tenth of the batch's final μ
+//    (carried_penalty_fraction) clamped to [penalty, max_penalty] = [1e2, 1e4]; the multipliers
+//    absorb the change of μ (λ + μc is kept), so the batch plan stays stationary. Issue 6 warns
+//    that Gauss–Newton on a graph with large penalty weights blows up (measured with GTSAM).
+//    Measured here (bench/replanning/README.md, both caps in one run): with the safeguarded ISAM2
+//    and carried multipliers, keeping the batch's μ (up to 1e7) does not blow up either — same
+//    success — but the moderate cap gives plans with a lower objective (199 vs 229 on task 1, 1311
+//    vs 1402 on task 2) in less time (mean 18.6 vs 22.4 ms and 14.7 vs 18.4 ms).
 //
 // Stopping rule of a replan. Every ISAM2 update is a safeguarded Gauss–Newton step (LM-damped
 // when the error would rise) that relinearizes every moved variable. At one multiplier estimate
@@ -62,7 +65,13 @@ struct IncrementalPlannerOptions {
   }();
   /// Smallest penalty μ of the constraint rows during incremental updates (see file comment).
   double penalty = 100;
-  /// Largest μ: the batch's final μ is kept up to this, and μ grows (×penalty_growth) up to
+  /// μ of the first plan's Bayes tree, as a fraction of the batch planner's final μ (then
+  /// clamped to [penalty, max_penalty]). Measured: the batch's μ itself (1e4 on the RR reach)
+  /// sends the RR goal change around the ball into a worse optimum (cost 14.3 instead of 6.8);
+  /// a tenth replans the iiwa tasks of bench/replanning as the earlier re-solve on the
+  /// incremental graph did (same successes, no fallback, objectives within 4 %).
+  double carried_penalty_fraction = 0.1;
+  /// Largest μ: the carried μ is kept up to this, and μ grows (×penalty_growth) up to
   /// this when the violation does not shrink between multiplier rounds.
   double max_penalty = 1e4;
   /// Weight w of the start-state prior w·(x_0 − start) on q_0 and q̇_0: a linear soft term
@@ -94,6 +103,10 @@ struct IncrementalPlannerOptions {
   bool stop_when_valid = true;
   double stop_objective_tol = 1e-2;
   double stop_objective_rise = 0.25;
+  /// After the first plan (the batch plan, carried into the Bayes tree), also run one replan of
+  /// the unchanged problem so the tree starts at its own optimum. A first plan that does not
+  /// validate is always settled (the settled plan answers when it validates).
+  bool settle_first_plan = true;
   /// Fall back to a warm-started batch solve when the incremental plan does not validate.
   bool fallback = true;
   /// The Bayes tree is rebuilt (one full elimination) when the ISAM2 graph holds more than this
@@ -128,7 +141,7 @@ struct IncrementalStats {
   double penalty = 0;  ///< μ at the end
 };
 
-/// Plans once (batch, on the incremental graph) and then replans incrementally as the problem
+/// Plans once (batch) and then replans incrementally as the problem
 /// changes. Single-threaded; keep one per robot.
 class IncrementalPlanner {
  public:
@@ -137,9 +150,11 @@ class IncrementalPlanner {
   IncrementalPlanner(const IncrementalPlanner&) = delete;
   IncrementalPlanner& operator=(const IncrementalPlanner&) = delete;
 
-  /// Plans `problem` from a straight line (or `warm`) with the batch augmented-Lagrangian LM loop
-  /// on the incremental graph, then builds the Bayes tree at the result. Problems that cannot be
-  /// planned come back with status "invalid_problem" (and no state is kept).
+  /// Plans `problem` with BatchPlanner (straight line, detours) and builds the Bayes tree at its
+  /// plan from its final graph and multipliers (settle_first_plan: then one replan of the
+  /// unchanged problem). With `warm` (or the DFG formulation, whose graph has other variables)
+  /// the batch augmented-Lagrangian LM loop runs on the incremental graph instead. Problems that
+  /// cannot be planned come back with status "invalid_problem" (and no state is kept).
   Plan plan(const Problem& problem, const Plan* warm = nullptr);
 
   /// Applies `change` to the current problem and replans incrementally (see the file comment).
@@ -166,6 +181,9 @@ class IncrementalPlanner {
 
  private:
   struct State;
+  /// Builds the incremental graph and its Bayes tree from the batch planner's final state
+  /// (factors shared, multipliers carried); false when it cannot (the DFG formulation).
+  bool adopt(const Problem& problem, BatchSolution& solution);
   Plan batch_solve(const Problem& problem, const Eigen::MatrixXd* q, const Eigen::MatrixXd* qd,
                    const Eigen::MatrixXd* qdd, const std::string& method, bool keep_multipliers);
   /// The plan at the current estimate, validated; with_stats adds its cost and worst violation.

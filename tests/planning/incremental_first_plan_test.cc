@@ -1,0 +1,133 @@
+// iDFGP's first plan: the batch planner's plan carried into the incremental graph (its factors,
+// values and multipliers; no second solve), and a Bayes tree that starts at that plan.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "kinograph/dynamics/kinematics.h"
+#include "kinograph/planning/batch_planner.h"
+#include "kinograph/planning/incremental_planner.h"
+#include "kinograph/planning/scene.h"
+
+namespace kinograph::planning {
+namespace {
+
+const std::string kScenes = std::string(KINOGRAPH_SOURCE_DIR) + "/robots/scenes/";
+
+std::string failures(const Plan& p) {
+  std::string s = p.stats.method + " " + p.stats.status + " " + p.stats.reason + ":";
+  for (const auto& f : p.validation.failures) s += " | " + f;
+  return s;
+}
+
+double max_abs(const Eigen::MatrixXd& m) { return m.cwiseAbs().maxCoeff(); }
+
+// The tip's position at joint configuration q as a pose goal.
+Goal tip_goal(const Problem& p, const Eigen::VectorXd& q) {
+  dynamics::Data data(*p.model);
+  dynamics::forward_kinematics(*p.model, data, q);
+  Goal g;
+  g.kind = Goal::Kind::kPose;
+  g.frame = "ee";
+  g.pose = dynamics::frame_pose(*p.model, data, p.model->frame_index("ee"));
+  g.position_only = true;
+  return g;
+}
+
+// The RR reach with its ball, and the same with the goal as the tip's position at the joint goal.
+Problem rr_joint_goal() { return load_scene(kScenes + "rr_reach.yaml").problem; }
+Problem rr_pose_goal() {
+  Problem p = rr_joint_goal();
+  p.goal = tip_goal(p, p.goal.q);
+  return p;
+}
+
+// Without settling, the first plan is the batch planner's plan itself. The carried multipliers
+// hold the Bayes tree at it: a replan of the unchanged problem needs no multiplier round and
+// moves no farther than the batch plan is from the optimum of a tightly converged batch solve
+// (the batch planner stops its last LM solve at a relative decrease of 1e-3), toward it.
+void expect_carried(const Problem& p) {
+  const Plan batch = BatchPlanner().plan(p);
+  ASSERT_TRUE(batch.success()) << failures(batch);
+  BatchPlannerOptions tight_options;
+  tight_options.inner_tolerance_final = 1e-8;
+  tight_options.constraint_tolerance = 1e-6;
+  tight_options.max_outer_iterations = 40;
+  const Plan tight = BatchPlanner(tight_options).plan(p);
+  ASSERT_TRUE(tight.success()) << failures(tight);
+
+  IncrementalPlannerOptions options;
+  options.settle_first_plan = false;
+  options.stop_when_valid = false;  // converge (any multiplier error then shows as a round)
+  IncrementalPlanner planner(options);
+  const Plan first = planner.plan(p);
+  ASSERT_TRUE(first.success()) << failures(first);
+  EXPECT_EQ(first.stats.method, batch.stats.method);
+  EXPECT_EQ(max_abs(first.q - batch.q), 0.0);
+  EXPECT_EQ(max_abs(first.tau - batch.tau), 0.0);
+  EXPECT_EQ(first.stats.cost, batch.stats.cost);
+  EXPECT_EQ(first.stats.iterations, batch.stats.iterations) << "no second solve";
+  ASSERT_TRUE(planner.has_plan());
+
+  const Plan same = planner.replan(ProblemChange());
+  ASSERT_TRUE(same.success()) << failures(same);
+  EXPECT_FALSE(planner.last_stats().fell_back);
+  EXPECT_EQ(planner.last_stats().rounds, 0) << "the carried multipliers needed no update";
+  EXPECT_LE(planner.last_stats().updates, 3);
+  const double gap = max_abs(batch.q - tight.q);
+  EXPECT_LT(max_abs(same.q - batch.q), gap + 1e-3) << "batch plan " << gap << " from the optimum";
+  EXPECT_LT(max_abs(same.q - tight.q), gap + 1e-3);
+  EXPECT_NEAR(same.stats.cost, batch.stats.cost, 0.015 * batch.stats.cost);
+}
+
+TEST(IncrementalFirstPlan, JointGoalIsTheBatchPlan) { expect_carried(rr_joint_goal()); }
+
+TEST(IncrementalFirstPlan, PoseGoalIsTheBatchPlan) { expect_carried(rr_pose_goal()); }
+
+// Settled (the default), the first plan is the tree's own optimum when that validates and costs
+// no more than the batch plan, else the batch plan; either way valid and next to the batch plan.
+TEST(IncrementalFirstPlan, SettledPlanIsAtLeastAsGood) {
+  for (const Problem& p : {rr_joint_goal(), rr_pose_goal()}) {
+    const Plan batch = BatchPlanner().plan(p);
+    ASSERT_TRUE(batch.success()) << failures(batch);
+    IncrementalPlanner planner;
+    ASSERT_TRUE(planner.options().settle_first_plan);
+    const Plan first = planner.plan(p);
+    ASSERT_TRUE(first.success()) << failures(first);
+    EXPECT_EQ(first.stats.method, batch.stats.method);
+    EXPECT_LE(first.stats.cost, batch.stats.cost);
+    EXPECT_LT(max_abs(first.q - batch.q), 2e-2);
+    EXPECT_GE(first.stats.iterations, batch.stats.iterations);
+  }
+}
+
+// The carried graph replans like one built from scratch: a goal change around the ball.
+TEST(IncrementalFirstPlan, PoseGoalChangeReplansIncrementally) {
+  const Problem p = rr_pose_goal();
+  IncrementalPlanner planner;
+  ASSERT_TRUE(planner.plan(p).success());
+  const Plan re = planner.set_goal(tip_goal(p, Eigen::Vector2d(1.0, 0.9)));
+  ASSERT_TRUE(re.success()) << failures(re);
+  EXPECT_EQ(re.stats.method, "incremental");
+  EXPECT_FALSE(planner.last_stats().fell_back);
+  EXPECT_LT(re.validation.goal_error, 1e-3);
+}
+
+// The DFG formulation's graph has other variables: its plan is re-solved on the incremental
+// graph (the path before carrying), and replans still work.
+TEST(IncrementalFirstPlan, DfgFormulationIsResolved) {
+  const Problem p = rr_joint_goal();
+  IncrementalPlannerOptions options;
+  options.batch.formulation = Formulation::kDynamicFactorGraph;
+  IncrementalPlanner planner(options);
+  const Plan first = planner.plan(p);
+  ASSERT_TRUE(first.success()) << failures(first);
+  ASSERT_TRUE(planner.has_plan());
+  Goal g;
+  g.q = Eigen::Vector2d(1.1, 0.2);
+  const Plan re = planner.set_goal(g);
+  EXPECT_TRUE(re.success()) << failures(re);
+}
+
+}  // namespace
+}  // namespace kinograph::planning
