@@ -92,16 +92,22 @@ void CollisionWorld::reserve_output() {
   const size_t max_results = robot_.size() * obstacles_.size() + self_pairs_.size();
   out_.reserve(max_results);
   candidates_.reserve(max_results);
-  if (options_.memo_entries > 0) {
-    const size_t entries = (options_.memo_entries + kMemoWays - 1) / kMemoWays * kMemoWays;
-    const size_t key = kPoseKey * model_.bodies.size() + 2;
-    memo_.assign(entries, MemoEntry{});
-    memo_keys_.assign(entries * key, 0.0);
-    memo_key_.assign(key, 0.0);
-    // Room for the typical few pairs per entry; older entries give way when it wraps.
-    memo_arena_.resize(4 * entries + max_results);
-    memo_write_ = 0;
-  }
+}
+
+void CollisionWorld::memo_reserve() {
+  // Sized on the first query after the obstacles change, so that worlds used only for
+  // closest() (the validator's, the initializations') never pay for it.
+  const size_t max_results = robot_.size() * obstacles_.size() + self_pairs_.size();
+  const size_t entries = (options_.memo_entries + kMemoWays - 1) / kMemoWays * kMemoWays;
+  // Room for the typical few pairs per entry; older entries give way when it wraps.
+  const size_t arena = 4 * entries + max_results;
+  if (memo_.size() == entries && memo_arena_.size() >= arena) return;
+  const size_t key = kPoseKey * model_.bodies.size() + 2;
+  memo_.assign(entries, MemoEntry{});
+  memo_keys_.assign(entries * key, 0.0);
+  memo_key_.assign(key, 0.0);
+  memo_arena_.resize(arena);
+  memo_write_ = 0;
 }
 
 void CollisionWorld::memo_clear() {
@@ -336,7 +342,9 @@ std::span<const Proximity> CollisionWorld::query(const dynamics::Data& data, dou
 
 std::span<const Proximity> CollisionWorld::query(const dynamics::Data& data, double t,
                                                  double query_distance) {
-  if (!memo_.empty()) {
+  const bool memo = options_.memo_entries > 0;
+  if (memo) {
+    memo_reserve();
     if (const MemoEntry* e = memo_find(data, t, query_distance)) {
       // Copied to the output buffer, so every answer lives at the same address.
       const auto first = memo_arena_.begin() + e->begin % memo_arena_.size();
@@ -363,7 +371,7 @@ std::span<const Proximity> CollisionWorld::query(const dynamics::Data& data, dou
     if (options_.cull && beyond(a, b, cull_at)) continue;
     if (robot_robot(a, b, gjk_max, p) && p.distance <= query_distance) out_.push_back(p);
   }
-  if (!memo_.empty()) memo_store();
+  if (memo) memo_store();
   return {out_.data(), out_.size()};
 }
 

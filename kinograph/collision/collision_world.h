@@ -132,6 +132,7 @@ class CollisionWorld {
   // Memo of query(): fills memo_key_ and returns the entry holding that key, or nullptr.
   const MemoEntry* memo_find(const dynamics::Data& data, double t, double query_distance);
   void memo_store();
+  void memo_reserve();
   void memo_clear();
   int find_index(int id) const;
   // Fills `out` with the pair's signed distance if it is at most max_distance.
