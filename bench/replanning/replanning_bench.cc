@@ -177,6 +177,8 @@ int run(int argc, char** argv) {
       io.stop_objective_rise = std::stod(argv[++i]);
     } else if (a == "--polish-objective") {
       io.stop_when_valid = false;
+    } else if (a == "--no-linearize-at-evaluation") {
+      io.isam2.linearize_at_evaluation = false;
     } else if (a == "--no-polish") {
       io.polish = false;
     } else if (a == "--log-level" && i + 1 < argc) {
@@ -186,7 +188,8 @@ int run(int argc, char** argv) {
                    "[--radius 0.2] [--shift 0.05] [--no-stiff] [--json FILE] "
                    "[--log-level warn|info|debug|trace] [--tol 1e-2] [--final-tol 1e-4] "
                    "[--relinearize-threshold X (instead of relinearizing all)] [--no-polish] "
-                   "[--polish-objective] [--max-penalty 1e4] [--stop-rise 0.25]\n";
+                   "[--polish-objective] [--max-penalty 1e4] [--stop-rise 0.25] "
+                   "[--no-linearize-at-evaluation]\n";
       return 1;
     }
   }

@@ -100,4 +100,17 @@ double Factor::error(const Values& values) const {
   return 0.5 * r.squaredNorm();
 }
 
+int compact_nonzero_rows(Eigen::Ref<Eigen::MatrixXd> J, Eigen::Ref<Eigen::VectorXd> r) {
+  int kept = 0;
+  for (Eigen::Index i = 0; i < J.rows(); ++i) {
+    if ((J.row(i).array() == 0).all()) continue;
+    if (kept != i) {
+      J.row(kept) = J.row(i);
+      r[kept] = r[i];
+    }
+    ++kept;
+  }
+  return kept;
+}
+
 }  // namespace kinograph::graph

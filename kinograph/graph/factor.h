@@ -101,4 +101,11 @@ class Factor {
   NoiseModelPtr noise_;
 };
 
+/// Moves the rows of a whitened Jacobian that are not all zero to its top (with their
+/// residuals) and returns how many there are. Inactive inequality rows (a collision hinge far
+/// from its bound) are exactly zero and add nothing to JᵀJ or Jᵀr; a collision factor has a row
+/// per (link, obstacle) pair and usually one or none active, so products over the kept rows
+/// skip most of the work. Order of the kept rows is preserved.
+int compact_nonzero_rows(Eigen::Ref<Eigen::MatrixXd> J, Eigen::Ref<Eigen::VectorXd> r);
+
 }  // namespace kinograph::graph

@@ -65,12 +65,17 @@ void ISAM2::sync_layout() {
   stamp_.resize(n, 0);
 }
 
-bool ISAM2::linearize_factor(int f, std::string* reason) {
+// Up to this many active rows JᵀJ is formed coefficient by coefficient: the blocked product's
+// packing costs more than the product for a collision factor's one or two rows.
+constexpr int kLazyProductRows = 8;
+
+bool ISAM2::evaluate_factor(int f, const Values& at, LinearizedFactor* out, double* error,
+                            std::string* reason) {
   const Factor& factor = *graph_[f];
   const auto& slots = factor_slots_[f];
   const int nk = static_cast<int>(slots.size());
   ptrs_.resize(nk);
-  for (int i = 0; i < nk; ++i) ptrs_[i] = theta_.vector().data() + theta_.offset(slots[i]);
+  for (int i = 0; i < nk; ++i) ptrs_[i] = at.vector().data() + at.offset(slots[i]);
   const int rows = factor.residual_dim();
   const int cols = factor.jacobian_cols();
   if (J_.rows() < rows || J_.cols() < cols) {
@@ -79,51 +84,85 @@ bool ISAM2::linearize_factor(int f, std::string* reason) {
   if (r_.size() < rows) r_.resize(rows);
   auto r = r_.head(rows);
   r.setZero();
+  if (out == nullptr) {
+    factor.whitened(ptrs_.data(), r, nullptr);
+    *error = 0.5 * r.squaredNorm();
+    return true;
+  }
   Eigen::Ref<Eigen::MatrixXd> J = J_.topLeftCorner(rows, cols);
   factor.whitened(ptrs_.data(), r, &J);
+  if (error != nullptr) *error = 0.5 * r.squaredNorm();
   if (!r.allFinite() || !J.allFinite()) {
-    *reason = "factor " + std::to_string(f) + " (" + factor.name() +
-              ") returned a non-finite residual or Jacobian";
+    if (reason != nullptr) {
+      *reason = "factor " + std::to_string(f) + " (" + factor.name() +
+                ") returned a non-finite residual or Jacobian";
+    }
     return false;
   }
-  LinearizedFactor& lf = linearized_[f];
+  LinearizedFactor& lf = *out;
+  lf.error = 0.5 * r.squaredNorm();
+  const int active = compact_nonzero_rows(J, r);
   lf.vars.clear();
   lf.offsets.clear();
-  std::vector<int> free_cols;
+  free_cols_.clear();
   int off = 0;
   for (int i = 0; i < nk; ++i) {
-    if (theta_.is_fixed_slot(slots[i])) continue;
+    if (at.is_fixed_slot(slots[i])) continue;
     lf.vars.push_back(slots[i]);
     lf.offsets.push_back(off);
-    for (int c = 0; c < factor.dims()[i]; ++c) free_cols.push_back(factor.block_offsets()[i] + c);
+    for (int c = 0; c < factor.dims()[i]; ++c) free_cols_.push_back(factor.block_offsets()[i] + c);
     off += factor.dims()[i];
   }
-  if (off == cols) {
-    lf.H.noalias() = J.transpose() * J;
-    lf.g.noalias() = J.transpose() * r;
+  const auto Ja = J.topRows(active);
+  const auto ra = r.head(active);
+  if (active == 0) {
+    lf.H.setZero(off, off);
+    lf.g.setZero(off);
+  } else if (off == cols && active <= kLazyProductRows) {
+    lf.H.noalias() = Ja.transpose().lazyProduct(Ja);
+    lf.g.noalias() = Ja.transpose() * ra;
+  } else if (off == cols) {
+    lf.H.noalias() = Ja.transpose() * Ja;
+    lf.g.noalias() = Ja.transpose() * ra;
   } else {
-    Eigen::MatrixXd Jf(rows, off);
-    for (int c = 0; c < off; ++c) Jf.col(c) = J.col(free_cols[c]);
+    Eigen::MatrixXd Jf(active, off);
+    for (int c = 0; c < off; ++c) Jf.col(c) = Ja.col(free_cols_[c]);
     lf.H.noalias() = Jf.transpose() * Jf;
-    lf.g.noalias() = Jf.transpose() * r;
+    lf.g.noalias() = Jf.transpose() * ra;
   }
-  lf.error = 0.5 * r.squaredNorm();
   lf.active = true;
   return true;
 }
 
-double ISAM2::factor_error_at_estimate(int f) {
-  const Factor& factor = *graph_[f];
-  const auto& slots = factor_slots_[f];
-  ptrs_.resize(slots.size());
-  for (size_t i = 0; i < slots.size(); ++i) {
-    ptrs_[i] = estimate_.vector().data() + estimate_.offset(slots[i]);
+bool ISAM2::linearize_factor(int f, std::string* reason) {
+  // Reuse the linearization made when the error was evaluated at the estimate, if the factor's
+  // variables have since been relinearized exactly there (θ = estimate: their δ is zero).
+  if (at_estimate_ok_[f]) {
+    bool at_estimate = true;
+    for (int s : factor_slots_[f]) {
+      if (!(delta_.segment(theta_.offset(s), theta_.dim(s)).array() == 0).all()) {
+        at_estimate = false;
+        break;
+      }
+    }
+    if (at_estimate) {
+      std::swap(linearized_[f], at_estimate_[f]);
+      at_estimate_ok_[f] = 0;
+      ++factors_reused_;
+      return true;
+    }
   }
-  if (r_.size() < factor.residual_dim()) r_.resize(factor.residual_dim());
-  auto r = r_.head(factor.residual_dim());
-  r.setZero();
-  factor.whitened(ptrs_.data(), r, nullptr);
-  return 0.5 * r.squaredNorm();
+  return evaluate_factor(f, theta_, &linearized_[f], nullptr, reason);
+}
+
+double ISAM2::factor_error_at_estimate(int f) {
+  double error = 0;
+  if (!options_.linearize_at_evaluation) {
+    evaluate_factor(f, estimate_, nullptr, &error, nullptr);
+    return error;
+  }
+  at_estimate_ok_[f] = evaluate_factor(f, estimate_, &at_estimate_[f], &error, nullptr) ? 1 : 0;
+  return error;
 }
 
 void ISAM2::refresh_estimate(const std::vector<int>& changed_vars) {
@@ -229,6 +268,8 @@ ISAM2Result ISAM2::update(const std::vector<FactorPtr>& new_factors,
       list.erase(std::remove(list.begin(), list.end(), static_cast<int>(idx)), list.end());
     }
     linearized_[idx] = LinearizedFactor();
+    at_estimate_[idx] = LinearizedFactor();
+    at_estimate_ok_[idx] = 0;
     factor_error_[idx] = 0;
     factor_slots_[idx].clear();
     graph_.remove(idx);
@@ -238,6 +279,8 @@ ISAM2Result ISAM2::update(const std::vector<FactorPtr>& new_factors,
     const int idx = static_cast<int>(graph_.add(f));
     res.new_factor_indices.push_back(idx);
     linearized_.resize(graph_.size());
+    at_estimate_.resize(graph_.size());
+    at_estimate_ok_.resize(graph_.size(), 0);
     factor_slots_.resize(graph_.size());
     factor_error_.resize(graph_.size(), 0);
     factor_stamp_.resize(graph_.size(), 0);
@@ -331,6 +374,7 @@ ISAM2Result ISAM2::update(const std::vector<FactorPtr>& new_factors,
   }
   res.full_reelimination = full;
 
+  const int reused_before = factors_reused_;
   for (int f : to_linearize) {
     std::string reason;
     if (!linearize_factor(f, &reason)) {
@@ -343,6 +387,7 @@ ISAM2Result ISAM2::update(const std::vector<FactorPtr>& new_factors,
     }
   }
   res.factors_linearized = static_cast<int>(to_linearize.size());
+  res.factors_reused = factors_reused_ - reused_before;
   std::vector<int> factors;
   if (full) {
     for (size_t f = 0; f < graph_.size(); ++f) {

@@ -44,6 +44,12 @@ struct ISAM2Options {
   double constrain_touched_fraction = 0.3;
   ISAM2Step step = ISAM2Step::kGaussNewton;
 
+  /// While the safeguard (or Dogleg) evaluates the error at a new estimate, also linearize
+  /// there: a variable that is then relinearized at that estimate reuses it instead of
+  /// evaluating its factors a second time. The Jacobians cost little beside the residuals of
+  /// collision and kinematic factors; a rejected step wastes them.
+  bool linearize_at_evaluation = true;
+
   /// Safeguard: evaluate the nonlinear error after each update (incrementally: only factors on
   /// variables that moved); with Gauss–Newton, if it rose, re-eliminate the affected top with
   /// Marquardt damping λ·diag(H) (λ grows by lambda_factor) until it no longer rises. A damped
@@ -100,6 +106,7 @@ struct ISAM2Result {
   int cliques_reeliminated = 0;  ///< cliques built by this update
   int variables_relinearized = 0;
   int factors_linearized = 0;  ///< new factors plus those touching relinearized variables
+  int factors_reused = 0;      ///< of those, linearizations kept from the error evaluation
   int cliques_solved = 0;      ///< cliques back-substituted (last trial)
   int trials = 0;              ///< numeric eliminations (GN) or dogleg steps tried
   double lambda = 0;           ///< damping of the accepted GN trial
@@ -145,6 +152,10 @@ class ISAM2 {
 
  private:
   struct Linearization;
+  /// Error of factor f at `at` and, with `out`, its linearization there (false when the
+  /// residual or Jacobian is not finite).
+  bool evaluate_factor(int f, const Values& at, LinearizedFactor* out, double* error,
+                       std::string* reason);
   bool linearize_factor(int f, std::string* reason);
   double factor_error_at_estimate(int f);
   void refresh_estimate(const std::vector<int>& changed_vars);
@@ -160,6 +171,9 @@ class ISAM2 {
   Eigen::VectorXd delta_gn_;  // Bayes tree solution (equals delta_ with Gauss–Newton)
   BayesTree tree_;
   std::vector<LinearizedFactor> linearized_;    // per factor index
+  std::vector<LinearizedFactor> at_estimate_;   // per factor: linearized at the estimate
+  std::vector<char> at_estimate_ok_;            // per factor: at_estimate_ is current
+  int factors_reused_ = 0;                      // linearizations taken from at_estimate_
   std::vector<std::vector<int>> factor_slots_;  // per factor: Values slot per key
   std::vector<double> factor_error_;            // per factor: error at the estimate
   std::vector<std::vector<int>> var_factors_;   // per slot: factor indices touching it
@@ -177,6 +191,7 @@ class ISAM2 {
   Eigen::VectorXd r_;
   Eigen::MatrixXd J_;
   std::vector<const double*> ptrs_;
+  std::vector<int> free_cols_;
 };
 
 }  // namespace kinograph::graph

@@ -26,6 +26,7 @@ LevenbergMarquardt& LevenbergMarquardt::operator=(LevenbergMarquardt&&) noexcept
 void LevenbergMarquardt::set_options(const LevenbergMarquardtOptions& options) {
   if (options.ordering != options_.ordering || options.factorization != options_.factorization) {
     equations_.reset();
+    candidate_.reset();
     cholesky_.reset();
   }
   options_ = options;
@@ -43,6 +44,9 @@ OptimizationResult LevenbergMarquardt::optimize(const FactorGraph& graph, Values
                                                    equations_->row_idx(), o.factorization);
     }
     result.symbolic_s = seconds_since(t_start);
+  }
+  if (o.linearize_at_evaluation && (!candidate_ || !candidate_->matches(graph, values))) {
+    candidate_ = std::make_unique<NormalEquations>(*equations_);
   }
   NormalEquations& eq = *equations_;
   const int n = eq.dim();
@@ -107,6 +111,7 @@ OptimizationResult LevenbergMarquardt::optimize(const FactorGraph& graph, Values
     result.factorize_s += stats.factorize_s;
     bool accepted = false;
     bool converged = false;
+    bool candidate_ready = false;
     if (factored) {
       t = Clock::now();
       rhs = -eq.gradient();
@@ -130,7 +135,12 @@ OptimizationResult LevenbergMarquardt::optimize(const FactorGraph& graph, Values
         x_backup = values.vector();
         eq.add_step(step, values.vector());
         double new_error = 0;
-        const bool finite = eq.evaluate_error(graph, values, &new_error, nullptr);
+        candidate_ready =
+            o.linearize_at_evaluation && candidate_->linearize(graph, values, &new_error, nullptr);
+        // Without the candidate (or when its Jacobian is not finite) the error alone decides,
+        // and a non-finite Jacobian is reported by the linearization after acceptance.
+        const bool finite =
+            candidate_ready || eq.evaluate_error(graph, values, &new_error, nullptr);
         stats.evaluate_s = seconds_since(t);
         result.evaluate_s += stats.evaluate_s;
         stats.error = finite ? new_error : std::numeric_limits<double>::infinity();
@@ -173,7 +183,9 @@ OptimizationResult LevenbergMarquardt::optimize(const FactorGraph& graph, Values
                       "reached " + std::to_string(o.max_iterations) + " iterations");
       }
       t = Clock::now();
-      if (!eq.linearize(graph, values, &error, &reason)) {
+      if (candidate_ready) {
+        std::swap(eq, *candidate_);  // linearized at the accepted point already
+      } else if (!eq.linearize(graph, values, &error, &reason)) {
         return finish(SolverStatus::kNonFinite, reason);
       }
       linearize_s = seconds_since(t);

@@ -33,6 +33,10 @@ struct LevenbergMarquardtOptions {
   double step_tol = 1e-14;           ///< converged when ‖δ‖ ≤ step_tol·(‖x‖ + step_tol)
   OrderingMethod ordering = OrderingMethod::kAmd;
   Factorization factorization = Factorization::kAuto;
+  /// Evaluate a trial step's error together with its Jacobians (into a second set of normal
+  /// equations): an accepted step is then not evaluated again to linearize there. A rejected
+  /// step wastes the Jacobians.
+  bool linearize_at_evaluation = true;
   bool record_history = true;   ///< fill OptimizationResult::history
   bool log_iterations = false;  ///< spdlog debug line per trial
 };
@@ -63,6 +67,7 @@ class LevenbergMarquardt {
  private:
   LevenbergMarquardtOptions options_;
   std::unique_ptr<NormalEquations> equations_;
+  std::unique_ptr<NormalEquations> candidate_;  // linearized at the trial step
   std::unique_ptr<SparseCholesky> cholesky_;
 };
 

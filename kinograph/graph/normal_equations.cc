@@ -191,17 +191,20 @@ bool NormalEquations::run(const FactorGraph& graph, const Values& values, double
       }
       total += 0.5 * r.squaredNorm();
       if (info.num_pairs == 0) continue;
+      const int active = compact_nonzero_rows(J, r);
+      if (active == 0) continue;  // e.g. a collision factor with every pair clear
+      const auto Ja = J.topRows(active);
       auto JtJ = JtJ_.topLeftCorner(nc, nc);
       if (nc >= kRankUpdateColumns) {
         // Large factors (e.g. the GP prior): a symmetric rank update fills the upper triangle
         // with half the flops of the full product.
         JtJ.triangularView<Eigen::Upper>().setZero();
-        JtJ.selfadjointView<Eigen::Upper>().rankUpdate(J.transpose());
+        JtJ.selfadjointView<Eigen::Upper>().rankUpdate(Ja.transpose());
       } else {
-        JtJ.noalias() = J.transpose() * J;
+        JtJ.noalias() = Ja.transpose() * Ja;
       }
       auto Jtr = Jtr_.head(nc);
-      Jtr.noalias() = J.transpose() * r;
+      Jtr.noalias() = Ja.transpose() * r.head(active);
       const auto& offsets = f.block_offsets();
       const auto& dims = f.dims();
       for (int k = 0; k < nk; ++k) {

@@ -146,5 +146,52 @@ TEST(Solver, StatisticsAreConsistent) {
   EXPECT_GE(r.total_s, r.linearize_s + r.factorize_s + r.solve_s);
 }
 
+TEST(Solver, LinearizingTrialStepsChangesNothingButTheWork) {
+  // A trial step evaluated with its Jacobians (kept for the next iteration when accepted) gives
+  // the same iterates as evaluating the error alone and linearizing after acceptance. The
+  // curve fit from (0, 0) rejects steps, so both branches run.
+  for (const problems::Problem& p : {problems::chain(40), problems::curve_fit()}) {
+    LevenbergMarquardtOptions reuse_options, fresh_options;
+    fresh_options.linearize_at_evaluation = false;
+    Values a = p.start, b = p.start;
+    const OptimizationResult ra = LevenbergMarquardt(reuse_options).optimize(p.graph, a);
+    const OptimizationResult rb = LevenbergMarquardt(fresh_options).optimize(p.graph, b);
+    EXPECT_EQ(ra.status, rb.status);
+    EXPECT_EQ(ra.iterations, rb.iterations);
+    EXPECT_EQ(ra.trials, rb.trials);
+    EXPECT_EQ(ra.final_error, rb.final_error);
+    EXPECT_EQ(a.vector(), b.vector());
+  }
+  Values v = problems::curve_fit().start;
+  const OptimizationResult r = LevenbergMarquardt().optimize(problems::curve_fit().graph, v);
+  EXPECT_GT(r.trials, r.iterations);  // some steps were rejected
+}
+
+TEST(Solver, CompactNonzeroRowsKeepsTheInformation) {
+  // Zero rows (inactive hinges) are dropped, the others keep their order and residuals, and
+  // JᵀJ and Jᵀr are unchanged.
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(6, 4);
+  Eigen::VectorXd r(6);
+  r << 1, 0, 2, 5, 0, 3;  // row 3 has a residual but no Jacobian: no information either
+  J.row(0) << 1, 2, 3, 4;
+  J.row(2) << 0, 0, -1, 0;
+  J.row(5) << 0.5, 0, 0, 7;
+  const Eigen::MatrixXd JtJ = J.transpose() * J;
+  const Eigen::VectorXd Jtr = J.transpose() * r;
+  Eigen::MatrixXd Jc = J;
+  Eigen::VectorXd rc = r;
+  const int kept = compact_nonzero_rows(Jc, rc);
+  ASSERT_EQ(kept, 3);
+  EXPECT_EQ(Jc.row(0), J.row(0));
+  EXPECT_EQ(Jc.row(1), J.row(2));
+  EXPECT_EQ(Jc.row(2), J.row(5));
+  EXPECT_EQ(rc.head(3), Eigen::Vector3d(1, 2, 3));
+  EXPECT_EQ(Jc.topRows(kept).transpose() * Jc.topRows(kept), JtJ);
+  EXPECT_EQ(Jc.topRows(kept).transpose() * rc.head(kept), Jtr);
+  Eigen::MatrixXd zero = Eigen::MatrixXd::Zero(3, 2);
+  Eigen::VectorXd rz = Eigen::VectorXd::Ones(3);
+  EXPECT_EQ(compact_nonzero_rows(zero, rz), 0);
+}
+
 }  // namespace
 }  // namespace kinograph::graph
