@@ -18,7 +18,8 @@ inline void rotate_columns(const Eigen::Matrix3d& P, int i, int j, double c, dou
 
 /// T_parent,body(q) = parent_to_joint · exp([A] q) for a unit revolute or prismatic screw A.
 /// Revolute joints about a coordinate axis (every joint of the iiwa, most URDFs) skip the
-/// general axis-angle matrix and its 3 × 3 product: two columns of parent_to_joint mix.
+/// general axis-angle matrix and its 3 × 3 product: two columns of parent_to_joint mix, with
+/// the same roundings as the general form (the dropped terms are exact zeros).
 inline void joint_transform(const Body& b, double q, Eigen::Isometry3d& out) {
   if (b.joint_type == JointType::kRevolute) {
     const Eigen::Vector3d axis = b.screw_axis.head<3>();
@@ -29,7 +30,9 @@ inline void joint_transform(const Body& b, double q, Eigen::Isometry3d& out) {
       if (axis[i] != 0 || axis[j] != 0 || std::abs(axis[k]) != 1) continue;
       const double c = std::cos(q), s = axis[k] * std::sin(q);
       Eigen::Matrix3d R;
-      R.col(k) = P.col(k);
+      // (1 − c) + c is the axis-angle formula's diagonal entry for the axis, which rounds off 1
+      // by an ulp for some angles: kept so that poses are bitwise those of the general form.
+      R.col(k) = P.col(k) * ((1 - c) + c);
       rotate_columns(P, i, j, c, s, R);
       out.linear() = R;
       return;

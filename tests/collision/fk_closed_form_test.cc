@@ -1,6 +1,6 @@
 // Forward kinematics feeds every collision query. Revolute joints about a coordinate axis take a
-// closed form (two columns of the joint's fixed rotation mix); it must agree with the general
-// axis-angle rotation to rounding, for ±x, ±y, ±z and for an oblique axis that keeps the
+// closed form (two columns of the joint's fixed rotation mix); it must agree bit for bit with
+// the general axis-angle rotation, for ±x, ±y, ±z and for an oblique axis that keeps the
 // general path.
 #include <gtest/gtest.h>
 
@@ -46,15 +46,26 @@ TEST(ForwardKinematicsClosedForm, MatchesAxisAngleChainOnEveryAxis) {
     for (int i = 0; i < model.nq(); ++i) {
       const Body& b = model.bodies[i];
       ASSERT_EQ(b.parent, i - 1);
-      Eigen::Isometry3d J = Eigen::Isometry3d::Identity();
+      // The general form, as forward kinematics composes it: P · R(axis, q), then parent · that.
+      Eigen::Isometry3d J = b.parent_to_joint;
       if (b.joint_type == JointType::kRevolute) {
-        J.linear() = Eigen::AngleAxisd(q[i], b.screw_axis.head<3>()).toRotationMatrix();
+        J.linear().noalias() = b.parent_to_joint.linear() *
+                               Eigen::AngleAxisd(q[i], b.screw_axis.head<3>()).toRotationMatrix();
       } else {
-        J.translation() = b.screw_axis.tail<3>() * q[i];
+        J.translation() += b.parent_to_joint.linear() * (b.screw_axis.tail<3>() * q[i]);
       }
-      T = T * b.parent_to_joint * J;
-      EXPECT_LT((data.body_pose[i].matrix() - T.matrix()).cwiseAbs().maxCoeff(), 1e-14)
-          << "trial " << trial << " body " << i;
+      if (i == 0) {
+        T = J;
+      } else {
+        const Eigen::Matrix3d R = T.linear() * J.linear();
+        T.translation() = T.translation() + T.linear() * J.translation();
+        T.linear() = R;
+      }
+      SCOPED_TRACE("trial " + std::to_string(trial) + " body " + std::to_string(i));
+      EXPECT_LT((data.body_pose[i].matrix() - T.matrix()).cwiseAbs().maxCoeff(), 1e-14);
+      // Bit for bit, so that plans do not move when the closed form is taken.
+      EXPECT_EQ(data.body_pose[i].linear(), T.linear());
+      EXPECT_EQ(data.body_pose[i].translation(), T.translation());
     }
   }
 }
