@@ -110,8 +110,11 @@ void CollisionWorld::memo_reserve() {
   memo_write_ = 0;
 }
 
-void CollisionWorld::memo_clear() {
+void CollisionWorld::obstacles_changed() {
   for (MemoEntry& e : memo_) e.valid = false;
+  moving_ = static_cast<int>(
+      std::count_if(obstacles_.begin(), obstacles_.end(),
+                    [](const ObstacleEntry& o) { return o.obstacle.is_moving(); }));
 }
 
 const CollisionWorld::MemoEntry* CollisionWorld::memo_find(const dynamics::Data& data, double t,
@@ -197,7 +200,7 @@ Status CollisionWorld::add_obstacle(const Obstacle& obstacle) {
   entry.place(obstacle.pose_at(0));
   obstacles_.push_back(std::move(entry));
   reserve_output();
-  memo_clear();
+  obstacles_changed();
   return Status::success();
 }
 
@@ -208,7 +211,7 @@ Status CollisionWorld::move_obstacle(int id, const Eigen::Isometry3d& pose) {
   o.obstacle.pose = pose;
   o.obstacle.trajectory = PoseTrajectory();
   o.place(pose);
-  memo_clear();
+  obstacles_changed();
   return Status::success();
 }
 
@@ -218,7 +221,7 @@ Status CollisionWorld::set_obstacle_trajectory(int id, PoseTrajectory trajectory
   ObstacleEntry& o = obstacles_[i];
   o.obstacle.trajectory = std::move(trajectory);
   o.place(o.obstacle.pose_at(0));
-  memo_clear();
+  obstacles_changed();
   return Status::success();
 }
 
@@ -226,23 +229,18 @@ Status CollisionWorld::remove_obstacle(int id) {
   const int i = find_index(id);
   if (i < 0) return Status::failure("no obstacle with id " + std::to_string(id));
   obstacles_.erase(obstacles_.begin() + i);
-  memo_clear();
+  obstacles_changed();
   return Status::success();
 }
 
 void CollisionWorld::clear_obstacles() {
   obstacles_.clear();
-  memo_clear();
+  obstacles_changed();
 }
 
 const Obstacle* CollisionWorld::find_obstacle(int id) const {
   const int i = find_index(id);
   return i < 0 ? nullptr : &obstacles_[i].obstacle;
-}
-
-bool CollisionWorld::has_moving_obstacles() const {
-  return std::any_of(obstacles_.begin(), obstacles_.end(),
-                     [](const ObstacleEntry& o) { return o.obstacle.is_moving(); });
 }
 
 void CollisionWorld::update_poses(const dynamics::Data& data, double t) {
@@ -251,6 +249,7 @@ void CollisionWorld::update_poses(const dynamics::Data& data, double t) {
     if (g.body >= 0) g.centre = data.body_pose[g.body] * g.local_centre;
   }
   data_ = &data;
+  if (moving_ == 0) return;
   for (ObstacleEntry& o : obstacles_) {
     if (!o.obstacle.is_moving()) continue;  // fixed poses are set on add and move
     o.place(o.obstacle.trajectory.at(t));

@@ -67,7 +67,7 @@ class CollisionWorld {
   // Number of obstacles.
   int num_obstacles() const { return static_cast<int>(obstacles_.size()); }
   // True when some obstacle follows a trajectory.
-  bool has_moving_obstacles() const;
+  bool has_moving_obstacles() const { return moving_ > 0; }
   // The robot's collision geometry as Bullet shapes, one per Model::collision entry.
   const ConvexShape& robot_shape(int geom) const { return robot_[geom].shape; }
   // The options the world was built with.
@@ -133,7 +133,8 @@ class CollisionWorld {
   const MemoEntry* memo_find(const dynamics::Data& data, double t, double query_distance);
   void memo_store();
   void memo_reserve();
-  void memo_clear();
+  // After any change of the obstacles: forgets the memo, recounts moving obstacles.
+  void obstacles_changed();
   int find_index(int id) const;
   // Fills `out` with the pair's signed distance if it is at most max_distance.
   bool robot_obstacle(int g, const ObstacleEntry& o, double max_distance, Proximity& out);
@@ -149,6 +150,7 @@ class CollisionWorld {
   std::vector<RobotGeom> robot_;
   std::vector<std::pair<int, int>> self_pairs_;  // robot geometry index pairs
   std::vector<ObstacleEntry> obstacles_;
+  int moving_ = 0;  // obstacles with a trajectory
   std::vector<Proximity> out_;
   std::vector<Candidate> candidates_;
   uint64_t pose_stamp_ = 0;
