@@ -102,10 +102,9 @@ void CollisionWorld::memo_reserve() {
   // Room for the typical few pairs per entry; older entries give way when it wraps.
   const size_t arena = 4 * entries + max_results;
   if (memo_.size() == entries && memo_arena_.size() >= arena) return;
-  const size_t key = kPoseKey * model_.bodies.size() + 2;
+  memo_key_size_ = kPoseKey * model_.bodies.size() + 2;
   memo_.assign(entries, MemoEntry{});
-  memo_keys_.assign(entries * key, 0.0);
-  memo_key_.assign(key, 0.0);
+  memo_keys_.assign(entries * memo_key_size_, 0.0);
   memo_arena_.resize(arena);
   memo_write_ = 0;
 }
@@ -119,15 +118,10 @@ void CollisionWorld::obstacles_changed() {
 
 const CollisionWorld::MemoEntry* CollisionWorld::memo_find(const dynamics::Data& data, double t,
                                                            double query_distance) {
-  double* k = memo_key_.data();
-  for (const Eigen::Isometry3d& T : data.body_pose) {
-    std::memcpy(k, T.data(), kPoseKey * sizeof(double));
-    k += kPoseKey;
-  }
-  k[0] = query_distance;
-  k[1] = has_moving_obstacles() ? t : 0.0;  // fixed obstacles do not depend on t
+  memo_tail_[0] = query_distance;
+  memo_tail_[1] = has_moving_obstacles() ? t : 0.0;  // fixed obstacles do not depend on t
   // The hash reads each pose's first rotation column and translation (every joint moves one of
-  // them) and the last two entries; the full key is compared on a hit.
+  // them) and the tail; the full key is compared, straight from the poses, on a hit.
   uint64_t h = 0;
   auto add = [&h](const double* v, int n) {
     for (int i = 0; i < n; ++i) {
@@ -136,14 +130,13 @@ const CollisionWorld::MemoEntry* CollisionWorld::memo_find(const dynamics::Data&
       h = mix(h, bits);
     }
   };
-  const double* key_begin = memo_key_.data();
-  for (; key_begin != k; key_begin += kPoseKey) {
-    add(key_begin, 3);       // rotation column 0
-    add(key_begin + 12, 3);  // translation
+  for (const Eigen::Isometry3d& T : data.body_pose) {
+    add(T.data(), 3);       // rotation column 0
+    add(T.data() + 12, 3);  // translation
   }
-  add(k, 2);
+  add(memo_tail_, 2);
   memo_hash_ = h;
-  const size_t key = memo_key_.size();
+  const size_t nb = data.body_pose.size();
   const size_t set = (h >> 17) % (memo_.size() / kMemoWays) * kMemoWays;
   for (size_t w = set; w < set + kMemoWays; ++w) {
     MemoEntry& e = memo_[w];
@@ -152,15 +145,20 @@ const CollisionWorld::MemoEntry* CollisionWorld::memo_find(const dynamics::Data&
       e.valid = false;
       continue;
     }
-    if (std::memcmp(&memo_keys_[w * key], memo_key_.data(), key * sizeof(double)) != 0) continue;
+    const double* stored = &memo_keys_[w * memo_key_size_];
+    bool same = std::memcmp(stored + nb * kPoseKey, memo_tail_, sizeof memo_tail_) == 0;
+    for (size_t b = 0; same && b < nb; ++b) {
+      same = std::memcmp(stored + b * kPoseKey, data.body_pose[b].data(),
+                         kPoseKey * sizeof(double)) == 0;
+    }
+    if (!same) continue;
     e.used = ++memo_tick_;
     return &e;
   }
   return nullptr;
 }
 
-void CollisionWorld::memo_store() {
-  const size_t key = memo_key_.size();
+void CollisionWorld::memo_store(const dynamics::Data& data) {
   const size_t set = (memo_hash_ >> 17) % (memo_.size() / kMemoWays) * kMemoWays;
   size_t victim = set;
   for (size_t w = set; w < set + kMemoWays; ++w) {
@@ -173,7 +171,12 @@ void CollisionWorld::memo_store() {
   const size_t n = out_.size(), size = memo_arena_.size();
   if (memo_write_ % size + n > size) memo_write_ += size - memo_write_ % size;  // keep it whole
   std::copy(out_.begin(), out_.end(), memo_arena_.begin() + memo_write_ % size);
-  std::copy(memo_key_.begin(), memo_key_.end(), memo_keys_.begin() + victim * key);
+  double* stored = &memo_keys_[victim * memo_key_size_];
+  for (const Eigen::Isometry3d& T : data.body_pose) {
+    std::memcpy(stored, T.data(), kPoseKey * sizeof(double));
+    stored += kPoseKey;
+  }
+  std::memcpy(stored, memo_tail_, sizeof memo_tail_);
   memo_[victim] = MemoEntry{true, memo_hash_, ++memo_tick_, memo_write_, static_cast<int>(n)};
   memo_write_ += n;
 }
@@ -370,7 +373,7 @@ std::span<const Proximity> CollisionWorld::query(const dynamics::Data& data, dou
     if (options_.cull && beyond(a, b, cull_at)) continue;
     if (robot_robot(a, b, gjk_max, p) && p.distance <= query_distance) out_.push_back(p);
   }
-  if (memo) memo_store();
+  if (memo) memo_store(data);
   return {out_.data(), out_.size()};
 }
 

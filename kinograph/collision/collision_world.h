@@ -129,9 +129,10 @@ class CollisionWorld {
   // when threshold + radii >= 0).
   bool beyond(int g, const ObstacleEntry& o, double threshold) const;
   bool beyond(int a, int b, double threshold) const;
-  // Memo of query(): fills memo_key_ and returns the entry holding that key, or nullptr.
+  // Memo of query(): the entry whose key is these body poses, query distance and time, or
+  // nullptr; memo_store files out_ under that key.
   const MemoEntry* memo_find(const dynamics::Data& data, double t, double query_distance);
-  void memo_store();
+  void memo_store(const dynamics::Data& data);
   void memo_reserve();
   // After any change of the obstacles: forgets the memo, recounts moving obstacles.
   void obstacles_changed();
@@ -155,11 +156,12 @@ class CollisionWorld {
   std::vector<Candidate> candidates_;
   uint64_t pose_stamp_ = 0;
   const dynamics::Data* data_ = nullptr;  // of the current query, for geom_world
-  // query() memo: memo_entries_ slots in sets of kMemoWays, the key of each slot (body poses,
+  // query() memo: memo_entries slots in sets of kMemoWays, the key of each slot (body poses,
   // query distance, time) in memo_keys_, results in a ring arena.
   std::vector<MemoEntry> memo_;
   std::vector<double> memo_keys_;
-  std::vector<double> memo_key_;  // key of the current query
+  size_t memo_key_size_ = 0;
+  double memo_tail_[2] = {0, 0};  // query distance and time of the current query
   uint64_t memo_hash_ = 0;
   std::vector<Proximity> memo_arena_;
   uint64_t memo_write_ = 0, memo_tick_ = 0;
