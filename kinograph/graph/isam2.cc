@@ -39,8 +39,9 @@ ISAM2::ISAM2(ISAM2Options options)
   if (options_.relinearize_threshold < 0 || options_.wildfire_threshold < 0) {
     throw std::invalid_argument("ISAM2Options: thresholds must be non-negative");
   }
-  if (options_.lambda_initial <= 0 || options_.lambda_factor <= 1) {
-    throw std::invalid_argument("ISAM2Options: need lambda_initial > 0 and lambda_factor > 1");
+  if (options_.lambda_initial <= 0 || options_.lambda_factor <= 1 || options_.lambda_decrease < 1) {
+    throw std::invalid_argument(
+        "ISAM2Options: need lambda_initial > 0, lambda_factor > 1 and lambda_decrease >= 1");
   }
   if (options_.trust_radius_initial <= 0) {
     throw std::invalid_argument("ISAM2Options: trust_radius_initial must be positive");
@@ -516,7 +517,7 @@ ISAM2Result ISAM2::update(const std::vector<FactorPtr>& new_factors,
   if (gauss_newton) {
     res.lambda = lambda;
     if (accepted) {
-      lambda_ = lambda / options_.lambda_factor;
+      lambda_ = lambda / options_.lambda_decrease;
       if (lambda_ < options_.lambda_min) lambda_ = 0;
     } else {
       lambda_ = lambda;

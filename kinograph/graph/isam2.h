@@ -58,10 +58,16 @@ struct ISAM2Options {
   /// evaluated (error_evaluated is false).
   bool safeguard = true;
   double lambda_initial = 1e-2;  ///< first damping after a rejected step (paper's λ₀)
-  double lambda_factor = 10;     ///< λ grows by this after a rejection, shrinks after acceptance
-  double lambda_min = 1e-7;      ///< below this λ drops to 0 (plain Gauss–Newton again)
-  double lambda_max = 1e12;      ///< give up (flag the increase) beyond this
-  double min_diagonal = 1e-6;    ///< clamp of diag(H) in the damping (keeps it positive)
+  double lambda_factor = 10;     ///< λ grows by this after a rejection
+  /// λ shrinks by this after an accepted update. Marquardt damping λ·diag(H) suppresses the
+  /// smooth, low-curvature modes of a trajectory chain, so while λ lingers each update bends
+  /// only part of the trajectory: measured on the iiwa goal changes (bench/replanning), 100
+  /// takes a median of 3 updates where 10 took 6, with a lower objective; 1e6 (back to plain
+  /// Gauss–Newton at once) overshoots into newly active constraints and takes up to 40.
+  double lambda_decrease = 100;
+  double lambda_min = 1e-7;    ///< below this λ drops to 0 (plain Gauss–Newton again)
+  double lambda_max = 1e12;    ///< give up (flag the increase) beyond this
+  double min_diagonal = 1e-6;  ///< clamp of diag(H) in the damping (keeps it positive)
   /// Relative slack before a rise counts (rounding, wildfire approximation).
   double error_rise_tolerance = 1e-9;
 
