@@ -4,14 +4,12 @@
 // pair. Random configurations within the joint limits (seeded). Each configuration is timed
 // `repeats` times and keeps its median (the machine is shared, so single runs see
 // preemption); the table gives the median, p10 and p90 of those over configurations, in µs
-// per configuration. These cases run with the query memo off, so repeats measure fresh
-// queries. Two cases follow the planners: the desk scene of robots/scenes/iiwa_desk.yaml as one
-// world per obstacle (the incremental planner's CollisionContexts), and the optimizer's pattern
-// of an error pass then a linearization pass (with gradients) over a block of 64 configurations
-// with the memo at its default, timed per block (one block per `repeats`-th of the
-// configurations, each seen once). Heap allocations inside the timed loops are counted too (the
-// queries promise none after warm-up). The source also builds against a CollisionWorld
-// without the memo option (for before/after figures).
+// per configuration. Two cases follow the planners: the desk scene of
+// robots/scenes/iiwa_desk.yaml as one world per obstacle (the incremental planner's
+// CollisionContexts), and the optimizer's pattern of an error pass then a linearization pass
+// (with gradients) over a block of 64 configurations, timed per block (each configuration seen
+// once, so no case is helped by a warm cache). Heap allocations inside the timed loops are
+// counted too (the queries promise none after warm-up).
 //
 //   bench_collision [--configs N] [--repeats R]   → JSON on stdout, then a Markdown table
 // Replacing the global operator new/delete pair confuses GCC's mismatch analysis of inlined
@@ -49,13 +47,6 @@ void operator delete(void* p) noexcept { std::free(p); }
 void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 
 namespace {
-
-// Sets the query memo's size where the library has one (the same source builds against older
-// versions of CollisionWorld for before/after figures).
-template <typename Options>
-void set_memo(Options& o, int entries) {
-  if constexpr (requires { o.memo_entries; }) o.memo_entries = entries;
-}
 
 using kinograph::collision::CollisionWorld;
 using kinograph::collision::CollisionWorldOptions;
@@ -104,7 +95,6 @@ int main(int argc, char** argv) {
       obstacle(3, Shape::cylinder(0.06, 0.6), -0.3, -0.5, 0.5),
       obstacle(4, Shape::capsule(0.05, 0.5), 0.2, -0.6, 1.0, 0.7)};
   CollisionWorldOptions culled_opts;  // defaults: query distance 0.3 m, culling on
-  set_memo(culled_opts, 0);
   CollisionWorldOptions all_opts = culled_opts;
   all_opts.cull = false;
   all_opts.query_distance = INFINITY;
@@ -119,13 +109,10 @@ int main(int argc, char** argv) {
                                       obstacle(2, Shape::box(0.04, 0.04, 0.62), 0.52, -0.48, 0.31),
                                       obstacle(3, Shape::box(0.04, 0.04, 0.62), 0.98, 0.48, 0.31),
                                       obstacle(4, Shape::box(0.04, 0.04, 0.62), 0.98, -0.48, 0.31)};
-  std::vector<std::unique_ptr<CollisionWorld>> desk_worlds, desk_memo_worlds;
-  CollisionWorldOptions memo_opts;  // the planners' defaults, memo included
+  std::vector<std::unique_ptr<CollisionWorld>> desk_worlds;
   for (const Obstacle& o : desk) {
     desk_worlds.push_back(std::make_unique<CollisionWorld>(model, culled_opts));
     desk_worlds.back()->add_obstacle(o);
-    desk_memo_worlds.push_back(std::make_unique<CollisionWorld>(model, memo_opts));
-    desk_memo_worlds.back()->add_obstacle(o);
   }
   DistanceGradientWorkspace ws(model);
   Eigen::VectorXd grad(model.nq());
@@ -224,7 +211,7 @@ int main(int argc, char** argv) {
     auto pass = [&](int b, bool gradients) {
       for (int i = b * kBlock; i < std::min(configs, (b + 1) * kBlock); ++i) {
         dyn::forward_kinematics(model, data, qs[i]);
-        for (auto& w : desk_memo_worlds) {
+        for (auto& w : desk_worlds) {
           for (const Proximity& p : w->query(data)) {
             sink += p.distance;
             ++pairs_total;

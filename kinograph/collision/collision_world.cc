@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -20,15 +19,6 @@ constexpr double kInfinity = std::numeric_limits<double>::infinity();
 // a hair above an exact distance (sphere against sphere or box face) cannot drop a pair at the
 // cut-off. GJK decides those pairs.
 constexpr double kCullSlack = 1e-9;
-constexpr int kMemoWays = 4;
-// Doubles of the memo key per body pose (the Isometry's 4 × 4 matrix), plus two for the query
-// distance and time.
-constexpr int kPoseKey = 16;
-
-uint64_t mix(uint64_t h, uint64_t v) {
-  h = (h ^ v) * 0x9E3779B97F4A7C15ull;
-  return h ^ (h >> 31);
-}
 
 ConvexShape make_robot_shape(const dynamics::Geometry& g, size_t index) {
   try {
@@ -94,91 +84,10 @@ void CollisionWorld::reserve_output() {
   candidates_.reserve(max_results);
 }
 
-void CollisionWorld::memo_reserve() {
-  // Sized on the first query after the obstacles change, so that worlds used only for
-  // closest() (the validator's, the initializations') never pay for it.
-  const size_t max_results = robot_.size() * obstacles_.size() + self_pairs_.size();
-  const size_t entries = (options_.memo_entries + kMemoWays - 1) / kMemoWays * kMemoWays;
-  // Room for the typical few pairs per entry; older entries give way when it wraps.
-  const size_t arena = 4 * entries + max_results;
-  if (memo_.size() == entries && memo_arena_.size() >= arena) return;
-  memo_key_size_ = kPoseKey * model_.bodies.size() + 2;
-  memo_.assign(entries, MemoEntry{});
-  memo_keys_.assign(entries * memo_key_size_, 0.0);
-  memo_arena_.resize(arena);
-  memo_write_ = 0;
-}
-
 void CollisionWorld::obstacles_changed() {
-  for (MemoEntry& e : memo_) e.valid = false;
   moving_ = static_cast<int>(
       std::count_if(obstacles_.begin(), obstacles_.end(),
                     [](const ObstacleEntry& o) { return o.obstacle.is_moving(); }));
-}
-
-const CollisionWorld::MemoEntry* CollisionWorld::memo_find(const dynamics::Data& data, double t,
-                                                           double query_distance) {
-  memo_tail_[0] = query_distance;
-  memo_tail_[1] = has_moving_obstacles() ? t : 0.0;  // fixed obstacles do not depend on t
-  // The hash reads each pose's first rotation column and translation (every joint moves one of
-  // them) and the tail; the full key is compared, straight from the poses, on a hit.
-  uint64_t h = 0;
-  auto add = [&h](const double* v, int n) {
-    for (int i = 0; i < n; ++i) {
-      uint64_t bits;
-      std::memcpy(&bits, v + i, sizeof bits);
-      h = mix(h, bits);
-    }
-  };
-  for (const Eigen::Isometry3d& T : data.body_pose) {
-    add(T.data(), 3);       // rotation column 0
-    add(T.data() + 12, 3);  // translation
-  }
-  add(memo_tail_, 2);
-  memo_hash_ = h;
-  const size_t nb = data.body_pose.size();
-  const size_t set = (h >> 17) % (memo_.size() / kMemoWays) * kMemoWays;
-  for (size_t w = set; w < set + kMemoWays; ++w) {
-    MemoEntry& e = memo_[w];
-    if (!e.valid || e.hash != h) continue;
-    if (memo_write_ > e.begin + memo_arena_.size()) {  // its results were overwritten
-      e.valid = false;
-      continue;
-    }
-    const double* stored = &memo_keys_[w * memo_key_size_];
-    bool same = std::memcmp(stored + nb * kPoseKey, memo_tail_, sizeof memo_tail_) == 0;
-    for (size_t b = 0; same && b < nb; ++b) {
-      same = std::memcmp(stored + b * kPoseKey, data.body_pose[b].data(),
-                         kPoseKey * sizeof(double)) == 0;
-    }
-    if (!same) continue;
-    e.used = ++memo_tick_;
-    return &e;
-  }
-  return nullptr;
-}
-
-void CollisionWorld::memo_store(const dynamics::Data& data) {
-  const size_t set = (memo_hash_ >> 17) % (memo_.size() / kMemoWays) * kMemoWays;
-  size_t victim = set;
-  for (size_t w = set; w < set + kMemoWays; ++w) {
-    if (!memo_[w].valid) {
-      victim = w;
-      break;
-    }
-    if (memo_[w].used < memo_[victim].used) victim = w;
-  }
-  const size_t n = out_.size(), size = memo_arena_.size();
-  if (memo_write_ % size + n > size) memo_write_ += size - memo_write_ % size;  // keep it whole
-  std::copy(out_.begin(), out_.end(), memo_arena_.begin() + memo_write_ % size);
-  double* stored = &memo_keys_[victim * memo_key_size_];
-  for (const Eigen::Isometry3d& T : data.body_pose) {
-    std::memcpy(stored, T.data(), kPoseKey * sizeof(double));
-    stored += kPoseKey;
-  }
-  std::memcpy(stored, memo_tail_, sizeof memo_tail_);
-  memo_[victim] = MemoEntry{true, memo_hash_, ++memo_tick_, memo_write_, static_cast<int>(n)};
-  memo_write_ += n;
 }
 
 int CollisionWorld::find_index(int id) const {
@@ -344,16 +253,6 @@ std::span<const Proximity> CollisionWorld::query(const dynamics::Data& data, dou
 
 std::span<const Proximity> CollisionWorld::query(const dynamics::Data& data, double t,
                                                  double query_distance) {
-  const bool memo = options_.memo_entries > 0;
-  if (memo) {
-    memo_reserve();
-    if (const MemoEntry* e = memo_find(data, t, query_distance)) {
-      // Copied to the output buffer, so every answer lives at the same address.
-      const auto first = memo_arena_.begin() + e->begin % memo_arena_.size();
-      out_.assign(first, first + e->count);
-      return {out_.data(), out_.size()};
-    }
-  }
   update_poses(data, t);
   out_.clear();
   // Without culling every pair goes through GJK to the end: the brute-force reference. GJK's
@@ -373,7 +272,6 @@ std::span<const Proximity> CollisionWorld::query(const dynamics::Data& data, dou
     if (options_.cull && beyond(a, b, cull_at)) continue;
     if (robot_robot(a, b, gjk_max, p) && p.distance <= query_distance) out_.push_back(p);
   }
-  if (memo) memo_store(data);
   return {out_.data(), out_.size()};
 }
 

@@ -33,12 +33,6 @@ struct CollisionWorldOptions {
   // Include geometry fixed to the base (body -1) in robot-versus-obstacle pairs. Default off:
   // the base cannot move, so such a distance has no gradient and belongs to scene checks.
   bool base_vs_obstacles = false;
-  // query() remembers this many recent results, keyed by the exact body poses, query distance
-  // and (with moving obstacles) time, and answers a repeated query from memory: the optimizers
-  // evaluate a factor's error at a trial point and then linearize it at the same point, so about
-  // half of the planner's queries repeat. Answers are bitwise those of a fresh query. 0 = off.
-  // Default 256 (the planners' working set per world is about 100–200 configurations).
-  int memo_entries = 256;
 };
 
 // The collision scene of one robot: its collision geometry (from the Model, Bullet shapes made
@@ -96,15 +90,6 @@ class CollisionWorld {
     Eigen::Vector3d centre;        // bounding sphere centre, world (after update_poses)
     uint64_t posed = 0;
   };
-  // One remembered query: its result lives in memo_arena_ at monotonic positions
-  // [begin, begin + count) and is intact while memo_write_ <= begin + arena size.
-  struct MemoEntry {
-    bool valid = false;
-    uint64_t hash = 0;
-    uint64_t used = 0;  // LRU tick
-    uint64_t begin = 0;
-    int count = 0;
-  };
   // A pair that survived culling in closest(), ordered by its lower bound.
   struct Candidate {
     double bound;
@@ -129,12 +114,7 @@ class CollisionWorld {
   // when threshold + radii >= 0).
   bool beyond(int g, const ObstacleEntry& o, double threshold) const;
   bool beyond(int a, int b, double threshold) const;
-  // Memo of query(): the entry whose key is these body poses, query distance and time, or
-  // nullptr; memo_store files out_ under that key.
-  const MemoEntry* memo_find(const dynamics::Data& data, double t, double query_distance);
-  void memo_store(const dynamics::Data& data);
-  void memo_reserve();
-  // After any change of the obstacles: forgets the memo, recounts moving obstacles.
+  // After any change of the obstacles: recounts the moving ones.
   void obstacles_changed();
   int find_index(int id) const;
   // Fills `out` with the pair's signed distance if it is at most max_distance.
@@ -156,15 +136,6 @@ class CollisionWorld {
   std::vector<Candidate> candidates_;
   uint64_t pose_stamp_ = 0;
   const dynamics::Data* data_ = nullptr;  // of the current query, for geom_world
-  // query() memo: memo_entries slots in sets of kMemoWays, the key of each slot (body poses,
-  // query distance, time) in memo_keys_, results in a ring arena.
-  std::vector<MemoEntry> memo_;
-  std::vector<double> memo_keys_;
-  size_t memo_key_size_ = 0;
-  double memo_tail_[2] = {0, 0};  // query distance and time of the current query
-  uint64_t memo_hash_ = 0;
-  std::vector<Proximity> memo_arena_;
-  uint64_t memo_write_ = 0, memo_tick_ = 0;
 };
 
 }  // namespace kinograph::collision

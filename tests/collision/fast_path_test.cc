@@ -1,8 +1,8 @@
 // The fast paths of CollisionWorld (culling without square roots, geometry poses made only for
-// pairs that survive culling, the query memo, closest() in order of lower bounds) against a
-// plain reference: every (robot geometry, obstacle) pair through pair_distance at poses made
-// here from the forward kinematics. Answers must agree bit for bit, including pairs exactly at
-// the query-distance cut-off and penetrating pairs.
+// pairs that survive culling, closest() in order of lower bounds) against a plain reference: every
+// (robot geometry, obstacle) pair through pair_distance at poses made here from the forward
+// kinematics. Answers must agree bit for bit, including pairs exactly at the query-distance cut-off
+// and penetrating pairs.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -106,30 +106,26 @@ void expect_same(std::span<const Proximity> a, const std::vector<Proximity>& b,
 }
 
 // One world with the whole desk (batch planner) and one world per desk part (incremental
-// planner), with and without the memo, against the reference on random configurations.
+// planner) against the reference on random configurations.
 TEST_F(IiwaDesk, QueriesMatchPairwiseReferenceBitForBit) {
-  CollisionWorldOptions memo_opts;  // defaults: query distance 0.3 m, culling, memo
-  CollisionWorldOptions plain_opts = memo_opts;
-  plain_opts.memo_entries = 0;
-  CollisionWorld all_memo(model, memo_opts), all_plain(model, plain_opts);
+  CollisionWorldOptions opts;  // defaults: query distance 0.3 m, culling
+  CollisionWorld all(model, opts);
   std::vector<std::unique_ptr<CollisionWorld>> single;
   for (const Obstacle& o : obstacles) {
-    ASSERT_TRUE(all_memo.add_obstacle(o));
-    ASSERT_TRUE(all_plain.add_obstacle(o));
-    single.push_back(std::make_unique<CollisionWorld>(model, memo_opts));
+    ASSERT_TRUE(all.add_obstacle(o));
+    single.push_back(std::make_unique<CollisionWorld>(model, opts));
     ASSERT_TRUE(single.back()->add_obstacle(o));
   }
   std::mt19937 rng(7);
   int reported = 0, penetrating = 0;
   for (int trial = 0; trial < 400; ++trial) {
     dynamics::forward_kinematics(model, data, random_q(rng));
-    const std::vector<Proximity> ref = reference(all_plain, 0.3);
+    const std::vector<Proximity> ref = reference(all, 0.3);
     const std::string what = "trial " + std::to_string(trial);
-    expect_same(all_plain.query(data), ref, what + " plain");
-    expect_same(all_memo.query(data), ref, what + " memo");
-    expect_same(all_memo.query(data), ref, what + " memo repeat");
+    expect_same(all.query(data), ref, what);
+    expect_same(all.query(data), ref, what + " repeated");
     for (size_t o = 0; o < single.size(); ++o) {
-      expect_same(single[o]->query(data), reference(all_plain, 0.3, static_cast<int>(o)),
+      expect_same(single[o]->query(data), reference(all, 0.3, static_cast<int>(o)),
                   what + " single world " + std::to_string(o));
     }
     reported += static_cast<int>(ref.size());
@@ -191,19 +187,13 @@ TEST_F(IiwaDesk, ClosestMatchesBruteForce) {
   EXPECT_GT(penetrating, 5);
 }
 
-// The memo answers repeats (interleaved, as the optimizers evaluate many factors between an
-// error and a linearization at the same point) exactly as a fresh query, keys moving obstacles
-// by time, and forgets everything when an obstacle changes.
-TEST_F(IiwaDesk, MemoAnswersAsAFreshQuery) {
-  CollisionWorldOptions memo_opts;
-  memo_opts.memo_entries = 8;  // small, so entries are also evicted and overwritten
-  CollisionWorldOptions plain_opts = memo_opts;
-  plain_opts.memo_entries = 0;
-  CollisionWorld memo(model, memo_opts), plain(model, plain_opts);
-  for (const Obstacle& o : obstacles) {
-    ASSERT_TRUE(memo.add_obstacle(o));
-    ASSERT_TRUE(plain.add_obstacle(o));
-  }
+// A world that has lived through obstacle changes and interleaved queries at changing times
+// (geometry poses are made lazily, stamped per query) answers as a world built afresh.
+TEST_F(IiwaDesk, LongLivedWorldAnswersAsAFreshOne) {
+  CollisionWorldOptions opts;
+  CollisionWorld live(model, opts);
+  std::vector<Obstacle> current = obstacles;
+  for (const Obstacle& o : current) ASSERT_TRUE(live.add_obstacle(o));
   // A ball sweeping through the workspace, so the answer depends on time.
   Obstacle ball;
   ball.id = 9;
@@ -212,8 +202,8 @@ TEST_F(IiwaDesk, MemoAnswersAsAFreshQuery) {
   a.translation() = Eigen::Vector3d(0.4, -0.4, 0.6);
   b.translation() = Eigen::Vector3d(0.4, 0.4, 0.9);
   ball.trajectory = PoseTrajectory({0.0, 1.0}, {a, b});
-  ASSERT_TRUE(memo.add_obstacle(ball));
-  ASSERT_TRUE(plain.add_obstacle(ball));
+  ASSERT_TRUE(live.add_obstacle(ball));
+  current.push_back(ball);
 
   std::mt19937 rng(3);
   std::vector<Eigen::VectorXd> qs;
@@ -224,9 +214,11 @@ TEST_F(IiwaDesk, MemoAnswersAsAFreshQuery) {
       for (size_t i = 0; i < qs.size(); ++i) {
         dynamics::forward_kinematics(model, data, qs[i]);
         const double t = 0.1 * static_cast<double>(i % 4) + 0.05 * (pass == 2);
-        const std::vector<Proximity> fresh(plain.query(data, t).begin(),
-                                           plain.query(data, t).end());
-        expect_same(memo.query(data, t), fresh,
+        CollisionWorld fresh_world(model, opts);
+        for (const Obstacle& o : current) EXPECT_TRUE(fresh_world.add_obstacle(o));
+        const auto answer = fresh_world.query(data, t);
+        const std::vector<Proximity> fresh(answer.begin(), answer.end());
+        expect_same(live.query(data, t), fresh,
                     what + " pass " + std::to_string(pass) + " config " + std::to_string(i));
         reported += static_cast<int>(fresh.size());
       }
@@ -235,11 +227,11 @@ TEST_F(IiwaDesk, MemoAnswersAsAFreshQuery) {
   compare("initial");
   Eigen::Isometry3d raised = obstacles[0].pose;
   raised.translation().z() += 0.05;
-  ASSERT_TRUE(memo.move_obstacle(0, raised));
-  ASSERT_TRUE(plain.move_obstacle(0, raised));
+  ASSERT_TRUE(live.move_obstacle(0, raised));
+  current[0].pose = raised;
   compare("tabletop moved");
-  ASSERT_TRUE(memo.remove_obstacle(9));
-  ASSERT_TRUE(plain.remove_obstacle(9));
+  ASSERT_TRUE(live.remove_obstacle(9));
+  current.pop_back();
   compare("ball removed");
   EXPECT_GT(reported, 100);
 }
