@@ -181,6 +181,8 @@ int run(int argc, char** argv) {
       io.isam2.linearize_at_evaluation = false;
     } else if (a == "--stop-tol" && i + 1 < argc) {
       io.stop_objective_tol = std::stod(argv[++i]);
+    } else if (a == "--lambda-initial" && i + 1 < argc) {
+      io.isam2.lambda_initial = std::stod(argv[++i]);
     } else if (a == "--lambda-decrease" && i + 1 < argc) {
       io.isam2.lambda_decrease = std::stod(argv[++i]);
     } else if (a == "--no-polish") {
@@ -193,7 +195,8 @@ int run(int argc, char** argv) {
                    "[--log-level warn|info|debug|trace] [--tol 1e-2] [--final-tol 1e-4] "
                    "[--relinearize-threshold X (instead of relinearizing all)] [--no-polish] "
                    "[--polish-objective] [--max-penalty 1e4] [--stop-rise 0.25] "
-                   "[--no-linearize-at-evaluation] [--stop-tol 1e-2] [--lambda-decrease 100]\n";
+                   "[--no-linearize-at-evaluation] [--stop-tol 1e-2] [--lambda-initial 1e-2] "
+                   "[--lambda-decrease 100]\n";
       return 1;
     }
   }
