@@ -38,9 +38,9 @@ std::vector<Obstacle> desk_scene() {
           box_at(4, 0.04, 0.04, 0.62, 0.98, -0.48, 0.31)};
 }
 
-class IiwaDesk : public testing::Test {
+class CollisionFastPath : public testing::Test {
  protected:
-  IiwaDesk()
+  CollisionFastPath()
       : model(dynamics::Model::from_urdf_file(std::string(KINOGRAPH_SOURCE_DIR) +
                                               "/robots/iiwa14/iiwa14.urdf")),
         data(model),
@@ -107,7 +107,7 @@ void expect_same(std::span<const Proximity> a, const std::vector<Proximity>& b,
 
 // One world with the whole desk (batch planner) and one world per desk part (incremental
 // planner) against the reference on random configurations.
-TEST_F(IiwaDesk, QueriesMatchPairwiseReferenceBitForBit) {
+TEST_F(CollisionFastPath, QueriesMatchPairwiseReferenceBitForBit) {
   CollisionWorldOptions opts;  // defaults: query distance 0.3 m, culling
   CollisionWorld all(model, opts);
   std::vector<std::unique_ptr<CollisionWorld>> single;
@@ -136,7 +136,7 @@ TEST_F(IiwaDesk, QueriesMatchPairwiseReferenceBitForBit) {
 }
 
 // A query distance equal to a pair's distance reports it; the next smaller double does not.
-TEST_F(IiwaDesk, PairsExactlyAtTheCutOff) {
+TEST_F(CollisionFastPath, PairsExactlyAtTheCutOff) {
   CollisionWorldOptions opts;
   CollisionWorld world(model, opts);
   for (const Obstacle& o : obstacles) ASSERT_TRUE(world.add_obstacle(o));
@@ -160,7 +160,7 @@ TEST_F(IiwaDesk, PairsExactlyAtTheCutOff) {
 
 // closest() visits pairs in order of their bounds; it must give the brute-force minimum and,
 // among equals, the same pair as the brute-force order.
-TEST_F(IiwaDesk, ClosestMatchesBruteForce) {
+TEST_F(CollisionFastPath, ClosestMatchesBruteForce) {
   CollisionWorldOptions opts;
   opts.self_collision = true;
   CollisionWorldOptions brute_opts = opts;
@@ -189,7 +189,7 @@ TEST_F(IiwaDesk, ClosestMatchesBruteForce) {
 
 // A world that has lived through obstacle changes and interleaved queries at changing times
 // (geometry poses are made lazily, stamped per query) answers as a world built afresh.
-TEST_F(IiwaDesk, LongLivedWorldAnswersAsAFreshOne) {
+TEST_F(CollisionFastPath, LongLivedWorldAnswersAsAFreshOne) {
   CollisionWorldOptions opts;
   CollisionWorld live(model, opts);
   std::vector<Obstacle> current = obstacles;
