@@ -90,7 +90,7 @@ class CollisionWorld {
     Eigen::Vector3d centre;        // bounding sphere centre, world (after update_poses)
     uint64_t posed = 0;
   };
-  // A pair that survived culling in closest(), ordered by its lower bound.
+  // A pair closest() may check, with its lower bound; checked in order of the bound.
   struct Candidate {
     double bound;
     int order;  // position in the brute-force visiting order (ties keep the earlier pair)
