@@ -261,9 +261,11 @@ planning::Plan PlannerNode::plan_from_scratch(const planning::Problem& problem,
   planning::Plan plan = incremental_.plan(problem);
   incremental_ready_ = plan.success();
   if (!plan.success() && plan.stats.status != "invalid_problem") {
-    // iDFGP's first plan re-solves the batch planner's plan on its own graph and settles it;
-    // when that does not validate, the batch plan itself still may (seen once in 18 medium goal
-    // changes of bench/daemon). Answer with it; the next change then plans from scratch again.
+    // iDFGP's first plan carries the batch planner's solution into its tree and settles it
+    // (re-solving on its own graph only when neither validates); when that still does not
+    // validate, a batch plan from scratch may (seen once in 18 medium goal changes of
+    // bench/daemon, with the earlier re-solving first plan). Answer with it; the next change then
+    // plans from scratch again.
     planning::Plan batch = planner_.plan(problem);
     if (batch.success()) {
       spdlog::info("iDFGP's first plan did not validate ({}); answering with the batch plan",
@@ -285,11 +287,13 @@ planning::Plan PlannerNode::solve_incremental(const planning::Problem& problem, 
   // validated 18/18 (13 directly, 4 after the planner's warm batch fallback, 1 from scratch after
   // an earlier failure), median 97 ms end to end; the batch path (BatchPlanner from the straight
   // line) 18/18, median 98 ms. A fallback costs about 0.5 s, but planning far goals from scratch
-  // here would cost IncrementalPlanner::plan's median 236 ms every time (a batch solve, its
-  // re-solve on the incremental graph, and settling). Goals within 1.3 rad replanned at 23–47 ms
-  // median against 134–156 ms for the batch path. So every goal replans incrementally by default
+  // here cost IncrementalPlanner::plan's median 236 ms every time when its first plan re-solved
+  // the batch plan on the incremental graph. Goals within 1.3 rad replanned at 23–47 ms median
+  // against 134–156 ms for the batch path. So every goal replans incrementally by default
   // (max_incremental_goal_change = ∞); the option remains for robots where far goals fall back
-  // more often.
+  // more often. The first plan now carries the batch solution instead (about the batch plan's
+  // time plus 10 ms, bench/daemon/README.md), so planning far goals from scratch costs about what
+  // the batch path does; this default has not been re-measured since.
   if (!from_scratch && new_goal) {
     const double change = joint_goal_change(incremental_.problem().goal, problem.goal);
     // Pose goals have no joint distance (infinity here): they always replan incrementally.
