@@ -23,6 +23,7 @@
 #include <fstream>
 #include <iostream>
 #include <lcm/lcm-cpp.hpp>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -156,6 +157,10 @@ int main(int argc, char** argv) {
   app.add_option("--only", only, "run only this problem (index from 0; to look at one case)");
   app.add_flag("--samples", samples, "list every request in the JSON (goal change, outcome)");
   app.add_option("--log-level", level, "the node's log level (info shows every plan)");
+  double max_goal_change = std::numeric_limits<double>::infinity();
+  app.add_option("--max-goal-change", max_goal_change,
+                 "incremental node: goals farther than this (rad, largest joint change) are "
+                 "planned from scratch (PlannerNodeOptions::max_incremental_goal_change)");
   CLI11_PARSE(app, argc, argv);
   spdlog::set_level(spdlog::level::from_str(level));
 
@@ -192,6 +197,7 @@ int main(int argc, char** argv) {
       options.channel_prefix = "IIWA";
       options.status_period_s = 10;
       options.incremental = mode == "incremental";
+      options.max_incremental_goal_change = max_goal_change;
       daemon::PlannerNode node(scene, options, &lcm);
       Client client(lcm);
       std::atomic<bool> stop{false};
