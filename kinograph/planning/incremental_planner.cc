@@ -151,6 +151,7 @@ struct IncrementalPlanner::State {
   }
   // A fresh tree at the snapshot (one full elimination); false when it cannot be built.
   bool restore(const Snapshot& s, const graph::ISAM2Options& options) {
+    spdlog::debug("iDFGP: the settled tree does not validate; rebuilt at the answered plan");
     for (size_t i = 0; i < entries.size() && i < s.penalty.size(); ++i) {
       if (!entries[i].constrained) continue;
       entries[i].constrained->set_multipliers(s.lower[i], s.upper[i]);
