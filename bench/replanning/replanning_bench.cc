@@ -151,6 +151,7 @@ int run(int argc, char** argv) {
   double radius = 0.2, shift = 0.05;
   bool stiff = true;
   double limit_epsilon = -1;  // < 0: the scenes' own
+  int only = -1;              // >= 0: replan only this problem of each row (debugging)
   std::string json_path;
   spdlog::level::level_enum log_level = spdlog::level::warn;
   planning::IncrementalPlannerOptions io;
@@ -191,6 +192,8 @@ int run(int argc, char** argv) {
       io.isam2.lambda_decrease = std::stod(argv[++i]);
     } else if (a == "--limit-epsilon" && i + 1 < argc) {
       limit_epsilon = std::stod(argv[++i]);
+    } else if (a == "--only" && i + 1 < argc) {
+      only = std::stoi(argv[++i]);
     } else if (a == "--no-polish") {
       io.polish = false;
     } else if (a == "--log-level" && i + 1 < argc) {
@@ -202,7 +205,7 @@ int run(int argc, char** argv) {
                    "[--relinearize-threshold X (instead of relinearizing all)] [--no-polish] "
                    "[--polish-objective] [--max-penalty 1e4] [--stop-rise 0.25] "
                    "[--no-linearize-at-evaluation] [--stop-tol 1e-2] [--lambda-initial 1e-2] "
-                   "[--lambda-decrease 100] [--limit-epsilon X]\n";
+                   "[--lambda-decrease 100] [--limit-epsilon X] [--only I]\n";
       return 1;
     }
   }
@@ -219,6 +222,7 @@ int run(int argc, char** argv) {
     const std::vector<Eigen::VectorXd> goals = sampler.sample(problems);
     Row& row = rows[t];
     for (size_t i = 0; i < goals.size(); ++i) {
+      if (only >= 0 && static_cast<int>(i) != only) continue;
       Problem first = scene.problem;
       first.goal.q = goals[i];
       const auto next = nearby_goal(sampler, goals[i], radius, 1000 * (t + 1) + i);
@@ -247,6 +251,7 @@ int run(int argc, char** argv) {
     const std::vector<Eigen::VectorXd> goals = sampler.sample(obstacle_problems);
     const int top = 0;  // desk_top, the scene's first obstacle
     for (size_t i = 0; i < goals.size(); ++i) {
+      if (only >= 0 && static_cast<int>(i) != only) continue;
       Problem first = scene.problem;
       first.goal.q = goals[i];
       std::mt19937_64 rng(5000 + i);
