@@ -996,7 +996,7 @@ Plan IncrementalPlanner::replan(const ProblemChange& change) {
     round_tol = std::max(options_.final_relative_error_tol, 0.1 * round_tol);
     // Penalty growth (every factor re-added) or a selective multiplier update.
     const bool grow = st.last_violation >= 0 && worst > alo.required_decrease * st.last_violation &&
-                      st.mu < options_.max_penalty;
+                      st.mu < options_.max_grown_penalty;
     st.last_violation = worst;
     for (size_t i = 0; i < st.entries.size(); ++i) {
       Entry& en = st.entries[i];
@@ -1017,12 +1017,13 @@ Plan IncrementalPlanner::replan(const ProblemChange& change) {
         continue;
       }
       if (grow) {
-        en.constrained->set_penalty(std::min(options_.max_penalty, st.mu * alo.penalty_growth));
+        en.constrained->set_penalty(
+            std::min(options_.max_grown_penalty, st.mu * alo.penalty_growth));
       }
       st.pending_remove.push_back(en.index);
       st.pending_add.push_back(i);
     }
-    if (grow) st.mu = std::min(options_.max_penalty, st.mu * alo.penalty_growth);
+    if (grow) st.mu = std::min(options_.max_grown_penalty, st.mu * alo.penalty_growth);
     stats_.factors_readded += static_cast<int>(st.pending_add.size());
   }
   stats_.penalty = st.mu;
