@@ -188,6 +188,8 @@ int run(int argc, char** argv) {
       io.stop_objective_tol = std::stod(argv[++i]);
     } else if (a == "--lambda-initial" && i + 1 < argc) {
       io.isam2.lambda_initial = std::stod(argv[++i]);
+    } else if (a == "--lambda-min" && i + 1 < argc) {
+      io.isam2.lambda_min = std::stod(argv[++i]);
     } else if (a == "--lambda-decrease" && i + 1 < argc) {
       io.isam2.lambda_decrease = std::stod(argv[++i]);
     } else if (a == "--limit-epsilon" && i + 1 < argc) {
@@ -205,7 +207,7 @@ int run(int argc, char** argv) {
                    "[--relinearize-threshold X (instead of relinearizing all)] [--no-polish] "
                    "[--polish-objective] [--max-penalty 1e4] [--stop-rise 0.25] "
                    "[--no-linearize-at-evaluation] [--stop-tol 1e-2] [--lambda-initial 1e-2] "
-                   "[--lambda-decrease 100] [--limit-epsilon X] [--only I]\n";
+                   "[--lambda-decrease 100] [--lambda-min 1e-7] [--limit-epsilon X] [--only I]\n";
       return 1;
     }
   }
