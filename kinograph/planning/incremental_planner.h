@@ -32,8 +32,8 @@
 // `final_relative_error_tol`). Then: if some constraint row's scaled violation exceeds the batch
 // planner's constraint_tolerance, a multiplier round λ ← λ + μc runs on the rows that are
 // violated or hold a bound multiplier, the factors whose multipliers changed by more than half
-// the tolerance (scaled) are re-added, and μ grows (×penalty_growth, up to max_grown_penalty) when the
-// violation did not shrink enough since the last round; if the constraints hold but the
+// the tolerance (scaled) are re-added, and μ grows (×penalty_growth, up to max_grown_penalty) when
+// the violation did not shrink enough since the last round; if the constraints hold but the
 // tolerance is not yet the final one, sweeping continues at the final tolerance; otherwise one
 // polish update ends the replan. At most `max_updates` updates and `max_rounds` rounds.
 #include <Eigen/Core>
