@@ -113,4 +113,16 @@ int compact_nonzero_rows(Eigen::Ref<Eigen::MatrixXd> J, Eigen::Ref<Eigen::Vector
   return kept;
 }
 
+void jacobian_gram(const Eigen::Ref<const Eigen::MatrixXd>& J, Eigen::Ref<Eigen::MatrixXd> H,
+                   bool upper_only) {
+  constexpr Eigen::Index kRankUpdateColumns = 16;
+  if (J.cols() < kRankUpdateColumns) {
+    H.noalias() = J.transpose() * J;
+    return;
+  }
+  H.triangularView<Eigen::Upper>().setZero();
+  H.selfadjointView<Eigen::Upper>().rankUpdate(J.transpose());
+  if (!upper_only) H.triangularView<Eigen::StrictlyLower>() = H.transpose();
+}
+
 }  // namespace kinograph::graph

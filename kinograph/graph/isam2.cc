@@ -123,12 +123,14 @@ bool ISAM2::evaluate_factor(int f, const Values& at, LinearizedFactor* out, doub
     lf.H.noalias() = Ja.transpose().lazyProduct(Ja);
     lf.g.noalias() = Ja.transpose() * ra;
   } else if (off == cols) {
-    lf.H.noalias() = Ja.transpose() * Ja;
+    lf.H.resize(off, off);
+    jacobian_gram(Ja, lf.H, /*upper_only=*/false);
     lf.g.noalias() = Ja.transpose() * ra;
   } else {
     Eigen::MatrixXd Jf(active, off);
     for (int c = 0; c < off; ++c) Jf.col(c) = Ja.col(free_cols_[c]);
-    lf.H.noalias() = Jf.transpose() * Jf;
+    lf.H.resize(off, off);
+    jacobian_gram(Jf, lf.H, /*upper_only=*/false);
     lf.g.noalias() = Jf.transpose() * ra;
   }
   lf.active = true;

@@ -6,12 +6,6 @@
 
 namespace kinograph::graph {
 
-namespace {
-// From this many Jacobian columns on, JᵀJ is formed by a symmetric rank update (upper triangle
-// only); below it the plain small product is cheaper.
-constexpr int kRankUpdateColumns = 16;
-}  // namespace
-
 NormalEquations::NormalEquations(const FactorGraph& graph, const Values& values,
                                  OrderingMethod ordering)
     : graph_id_(graph.structure_id()), layout_id_(values.layout_id()) {
@@ -195,14 +189,7 @@ bool NormalEquations::run(const FactorGraph& graph, const Values& values, double
       if (active == 0) continue;  // e.g. a collision factor with every pair clear
       const auto Ja = J.topRows(active);
       auto JtJ = JtJ_.topLeftCorner(nc, nc);
-      if (nc >= kRankUpdateColumns) {
-        // Large factors (e.g. the GP prior): a symmetric rank update fills the upper triangle
-        // with half the flops of the full product.
-        JtJ.triangularView<Eigen::Upper>().setZero();
-        JtJ.selfadjointView<Eigen::Upper>().rankUpdate(Ja.transpose());
-      } else {
-        JtJ.noalias() = Ja.transpose() * Ja;
-      }
+      jacobian_gram(Ja, JtJ, /*upper_only=*/true);  // only upper blocks are scattered
       auto Jtr = Jtr_.head(nc);
       Jtr.noalias() = Ja.transpose() * r.head(active);
       const auto& offsets = f.block_offsets();

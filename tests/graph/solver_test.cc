@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <numeric>
+#include <random>
 
 #include "kinograph/graph/levenberg_marquardt.h"
 #include "kinograph/graph/ordering.h"
@@ -191,6 +192,30 @@ TEST(Solver, CompactNonzeroRowsKeepsTheInformation) {
   Eigen::MatrixXd zero = Eigen::MatrixXd::Zero(3, 2);
   Eigen::VectorXd rz = Eigen::VectorXd::Ones(3);
   EXPECT_EQ(compact_nonzero_rows(zero, rz), 0);
+}
+
+TEST(Solver, JacobianGramIsJtJOnBothPaths) {
+  // Below 16 columns the plain product, from 16 on the symmetric rank update (GP prior and
+  // collocation shapes); the full matrix is symmetric, the upper-only one agrees above the
+  // diagonal.
+  std::mt19937 rng(5);
+  std::normal_distribution<double> n01;
+  for (const auto& [rows, cols] : {std::pair{7, 21}, std::pair{21, 42}, std::pair{2, 7},
+                                   std::pair{14, 42}, std::pair{3, 16}}) {
+    Eigen::MatrixXd J(rows, cols);
+    for (int i = 0; i < J.size(); ++i) J.data()[i] = n01(rng);
+    const Eigen::MatrixXd expected = J.transpose() * J;
+    Eigen::MatrixXd full = Eigen::MatrixXd::Constant(cols, cols, 99.0);
+    jacobian_gram(J, full, /*upper_only=*/false);
+    EXPECT_LT((full - expected).cwiseAbs().maxCoeff(), 1e-12 * expected.cwiseAbs().maxCoeff())
+        << rows << "x" << cols;
+    EXPECT_EQ(full, full.transpose());
+    Eigen::MatrixXd upper = Eigen::MatrixXd::Constant(cols, cols, 99.0);
+    jacobian_gram(J, upper, /*upper_only=*/true);
+    const Eigen::MatrixXd diff = Eigen::MatrixXd(upper.triangularView<Eigen::Upper>()) -
+                                 Eigen::MatrixXd(expected.triangularView<Eigen::Upper>());
+    EXPECT_LT(diff.cwiseAbs().maxCoeff(), 1e-12 * expected.cwiseAbs().maxCoeff());
+  }
 }
 
 }  // namespace
