@@ -176,6 +176,8 @@ int run(int argc, char** argv) {
     } else if (a == "--relinearize-threshold" && i + 1 < argc) {
       io.isam2.relinearize_threshold = std::stod(argv[++i]);
       io.relinearize_all = false;
+    } else if (a == "--max-force-ratio" && i + 1 < argc) {
+      io.max_force_ratio = std::stod(argv[++i]);
     } else if (a == "--max-penalty" && i + 1 < argc) {
       io.max_penalty = std::stod(argv[++i]);
     } else if (a == "--stop-rise" && i + 1 < argc) {
@@ -205,7 +207,8 @@ int run(int argc, char** argv) {
                    "[--radius 0.2] [--shift 0.05] [--no-stiff] [--json FILE] "
                    "[--log-level warn|info|debug|trace] [--tol 1e-2] [--final-tol 1e-4] "
                    "[--relinearize-threshold X (instead of relinearizing all)] [--no-polish] "
-                   "[--polish-objective] [--max-penalty 1e4] [--stop-rise 0.25] "
+                   "[--polish-objective] [--max-penalty 1e4] [--max-force-ratio 0.1] "
+                   "[--stop-rise 0.25] "
                    "[--no-linearize-at-evaluation] [--stop-tol 1e-2] [--lambda-initial 1e-2] "
                    "[--lambda-decrease 100] [--lambda-min 1e-7] [--limit-epsilon X] [--only I]\n";
       return 1;

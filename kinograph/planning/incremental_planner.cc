@@ -492,14 +492,30 @@ Plan IncrementalPlanner::batch_solve(const Problem& problem, const Eigen::Matrix
   return plan;
 }
 
-bool IncrementalPlanner::adopt(const Problem& problem, BatchSolution& solution) {
+bool IncrementalPlanner::adopt(const Problem& problem, BatchSolution& solution, bool valid) {
   PlanningGraph& pg = solution.graph;
   const int n = problem.model->nq(), N = problem.steps;
   if (!solution.condensed || pg.steps != N || pg.nq != n || pg.values.size() == 0) return false;
   const bool joint_goal = problem.goal.kind == Goal::Kind::kJoint;
-  const double mu = std::clamp(options_.carried_penalty_fraction * solution.penalty,
-                               options_.penalty, options_.max_penalty);
   const graph::Values& values = pg.values;
+  double mu = std::clamp(options_.carried_penalty_fraction * solution.penalty, options_.penalty,
+                         options_.max_penalty);
+  if (valid && options_.max_force_ratio > 0) {
+    // A plan held by large constraint forces needs a stiffer μ: after a change the forces move
+    // by a part of themselves, and the rows by that over μ.
+    double force = 0;
+    for (const graph::FactorPtr& f : pg.graph.factors()) {
+      const auto* c = dynamic_cast<const ConstrainedFactor*>(f.get());
+      if (c == nullptr) continue;
+      for (int i = 0; i < c->residual_dim(); ++i) {
+        if (c->rows()[i].kind == RowKind::kEquality) {
+          force = std::max(force, std::abs(c->multipliers()[i]));
+        }
+      }
+    }
+    mu = std::clamp(force / options_.max_force_ratio, mu, options_.max_grown_penalty);
+    spdlog::debug("iDFGP first plan: largest equality force {:.4g}, carried mu {:.3g}", force, mu);
+  }
 
   // The batch graph's factors, in build_graph's order, are the incremental graph's own (same
   // factors, same workspace) except for the goal and the collision factors; each constraint
@@ -614,7 +630,7 @@ Plan IncrementalPlanner::plan(const Problem& problem, const Plan* warm) {
   state_.reset();
   bool adopted = false;
   try {
-    adopted = adopt(problem, solution);
+    adopted = adopt(problem, solution, batch.success());
   } catch (const std::exception& e) {
     spdlog::warn("incremental planner: adopting the batch solution: {}", e.what());
   }

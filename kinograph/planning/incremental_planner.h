@@ -17,8 +17,9 @@
 //    moving or removing one obstacle touches only its own factors; their multipliers are the
 //    batch collision factors' rows of the same (state, sub-step, robot geometry, obstacle);
 //  - the multipliers carry the constraint forces, and μ is a tenth of the batch's final μ
-//    (carried_penalty_fraction) clamped to [penalty, max_penalty] = [1e2, 1e4]; the multipliers
-//    absorb the change of μ (λ + μc is kept), so the batch plan stays stationary. Issue 6 warns
+//    (carried_penalty_fraction) clamped to [penalty, max_penalty] = [1e2, 1e4], or stiffer when
+//    the plan's forces are large (max_force_ratio); the multipliers absorb the change of μ
+//    (λ + μc is kept), so the batch plan stays stationary. Issue 6 warns
 //    that Gauss–Newton on a graph with large penalty weights blows up (measured with GTSAM).
 //    Measured here (bench/replanning/README.md, both caps in one run): with the safeguarded ISAM2
 //    and carried multipliers, keeping the batch's μ (up to 1e7) does not blow up either — same
@@ -74,6 +75,14 @@ struct IncrementalPlannerOptions {
   double carried_penalty_fraction = 0.1;
   /// Largest carried μ (the first plan's tree and the re-solve's).
   double max_penalty = 1e4;
+  /// A valid first plan's carried μ is at least its largest equality multiplier (scaled units)
+  /// over this ratio, up to max_grown_penalty; 0 turns it off. A change moves the constraint
+  /// forces by a part of themselves and the rows by that over μ, so a plan held by large forces
+  /// needs a stiffer μ. Measured (bench/replanning, 50 problems per row): only task 1's violent
+  /// first plan (objective 1.3e4, collocation force 8.9e3 against 1e2–7e2 elsewhere) is
+  /// affected; its goal change took 19 updates (64 ms) at μ = 1e4, 2 (5.7 ms) at μ = 1.1e5;
+  /// 0.05 and 0.2 instead of 0.1: 10 and 24 ms.
+  double max_force_ratio = 0.1;
   /// μ grows (×penalty_growth) up to this when the violation does not shrink between the
   /// multiplier rounds of a replan. Measured (bench/replanning): a task-1 goal change after a
   /// violent first plan (objective 1.3e4) stayed 0.021–0.030 rad off the validator's position
@@ -199,8 +208,9 @@ class IncrementalPlanner {
  private:
   struct State;
   /// Builds the incremental graph and its Bayes tree from the batch planner's final state
-  /// (factors shared, multipliers carried); false when it cannot (the DFG formulation).
-  bool adopt(const Problem& problem, BatchSolution& solution);
+  /// (factors shared, multipliers carried); false when it cannot (the DFG formulation). `valid`:
+  /// the batch plan validated (its multipliers are the forces of a solution).
+  bool adopt(const Problem& problem, BatchSolution& solution, bool valid);
   Plan batch_solve(const Problem& problem, const Eigen::MatrixXd* q, const Eigen::MatrixXd* qd,
                    const Eigen::MatrixXd* qdd, const std::string& method, bool keep_multipliers);
   /// The plan at the current estimate, validated; with_stats adds its cost and worst violation.

@@ -115,6 +115,33 @@ TEST(IncrementalFirstPlan, PoseGoalChangeReplansIncrementally) {
   EXPECT_LT(re.validation.goal_error, 1e-3);
 }
 
+// A plan held by large constraint forces is carried with a stiffer μ (max_force_ratio): above
+// the moderate cap, at most the grown cap, and the tree still holds the plan. The RR reach's
+// forces are small, so a tiny ratio stands in for a violent plan.
+TEST(IncrementalFirstPlan, LargeForcesStiffenTheCarriedPenalty) {
+  const Problem p = rr_joint_goal();
+  IncrementalPlannerOptions options;
+  options.settle_first_plan = false;
+  options.max_force_ratio = 0;
+  IncrementalPlanner moderate(options);
+  ASSERT_TRUE(moderate.plan(p).success());
+  EXPECT_LE(moderate.last_stats().penalty, options.max_penalty);
+
+  options.max_force_ratio = 1e-6;
+  IncrementalPlanner stiff(options);
+  const Plan first = stiff.plan(p);
+  ASSERT_TRUE(first.success()) << failures(first);
+  EXPECT_GT(stiff.last_stats().penalty, options.max_penalty);
+  EXPECT_LE(stiff.last_stats().penalty, options.max_grown_penalty);
+  const Plan same = stiff.replan(ProblemChange());
+  ASSERT_TRUE(same.success()) << failures(same);
+  EXPECT_LT(max_abs(same.q - first.q), 2e-2);
+  Goal g;
+  g.q = Eigen::Vector2d(1.1, 0.2);
+  const Plan re = stiff.set_goal(g);
+  EXPECT_TRUE(re.success()) << failures(re);
+}
+
 // The DFG formulation's graph has other variables: its plan is re-solved on the incremental
 // graph (the path before carrying), and replans still work.
 TEST(IncrementalFirstPlan, DfgFormulationIsResolved) {
