@@ -48,6 +48,7 @@ void Factor::set_noise(NoiseModelPtr noise) {
                                 std::to_string(residual_dim_));
   }
   noise_ = std::move(noise);
+  ++jacobian_version_;
 }
 
 void Factor::whitened(const double* const* x, Eigen::Ref<Eigen::VectorXd> r,

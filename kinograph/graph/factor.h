@@ -92,6 +92,19 @@ class Factor {
   void whitened(const double* const* x, Eigen::Ref<Eigen::VectorXd> r,
                 Eigen::Ref<Eigen::MatrixXd>* J) const;
 
+  /// For a factor linear in its variables (its whitened Jacobian then does not depend on them),
+  /// a number that changes whenever that Jacobian may change (noise model, penalty); −1 for
+  /// every other factor. Solvers may keep JᵀJ while it is unchanged.
+  long jacobian_version() const {
+    return linear_ && (!noise_ || noise_->constant_whitening()) ? jacobian_version_ : -1;
+  }
+
+ protected:
+  /// Declares evaluate() linear in the variables (the test suite checks the Jacobian is constant).
+  void set_linear() { linear_ = true; }
+  /// Marks a change of something, besides the noise model, the whitened Jacobian depends on.
+  void jacobian_changed() { ++jacobian_version_; }
+
  private:
   std::vector<Key> keys_;
   std::vector<int> dims_;
@@ -99,6 +112,8 @@ class Factor {
   int residual_dim_;
   int cols_;
   NoiseModelPtr noise_;
+  bool linear_ = false;
+  long jacobian_version_ = 0;
 };
 
 /// Moves the rows of a whitened Jacobian that are not all zero to its top (with their

@@ -85,34 +85,61 @@ bool ISAM2::evaluate_factor(int f, const Values& at, LinearizedFactor* out, doub
   if (r_.size() < rows) r_.resize(rows);
   auto r = r_.head(rows);
   r.setZero();
-  if (out == nullptr) {
-    factor.whitened(ptrs_.data(), r, nullptr);
-    *error = 0.5 * r.squaredNorm();
-    return true;
-  }
-  Eigen::Ref<Eigen::MatrixXd> J = J_.topLeftCorner(rows, cols);
-  factor.whitened(ptrs_.data(), r, &J);
-  if (error != nullptr) *error = 0.5 * r.squaredNorm();
-  if (!r.allFinite() || !J.allFinite()) {
+  const auto non_finite = [&] {
     if (reason != nullptr) {
       *reason = "factor " + std::to_string(f) + " (" + factor.name() +
                 ") returned a non-finite residual or Jacobian";
     }
     return false;
+  };
+  if (out == nullptr) {
+    factor.whitened(ptrs_.data(), r, nullptr);
+    *error = 0.5 * r.squaredNorm();
+    return true;
   }
   LinearizedFactor& lf = *out;
-  lf.error = 0.5 * r.squaredNorm();
-  const int active = compact_nonzero_rows(J, r);
-  lf.vars.clear();
-  lf.offsets.clear();
+  // The factor's free variables and their columns in J.
+  free_vars_.clear();
   free_cols_.clear();
-  int off = 0;
   for (int i = 0; i < nk; ++i) {
     if (at.is_fixed_slot(slots[i])) continue;
-    lf.vars.push_back(slots[i]);
-    lf.offsets.push_back(off);
+    free_vars_.push_back(slots[i]);
     for (int c = 0; c < factor.dims()[i]; ++c) free_cols_.push_back(factor.block_offsets()[i] + c);
-    off += factor.dims()[i];
+  }
+  const int off = static_cast<int>(free_cols_.size());
+  const long version = factor.jacobian_version();
+  if (options_.reuse_constant_jacobians && version >= 0 && lf.source == &factor &&
+      lf.jacobian_version == version && lf.vars == free_vars_) {
+    // A linear factor whose Jacobian is unchanged since lf.H was formed: only r and Jᵀr are new.
+    factor.whitened(ptrs_.data(), r, nullptr);
+    if (!r.allFinite()) return non_finite();
+    lf.error = 0.5 * r.squaredNorm();
+    if (error != nullptr) *error = lf.error;
+    lf.g.noalias() = lf.J.transpose() * r;
+    lf.active = true;
+    ++jacobians_kept_;
+    return true;
+  }
+  Eigen::Ref<Eigen::MatrixXd> J = J_.topLeftCorner(rows, cols);
+  factor.whitened(ptrs_.data(), r, &J);
+  if (!r.allFinite() || !J.allFinite()) return non_finite();
+  lf.error = 0.5 * r.squaredNorm();
+  if (error != nullptr) *error = lf.error;
+  lf.source = &factor;
+  lf.jacobian_version = options_.reuse_constant_jacobians ? version : -1;
+  if (lf.jacobian_version >= 0) {
+    lf.J.resize(rows, off);
+    for (int c = 0; c < off; ++c) lf.J.col(c) = J.col(free_cols_[c]);
+  } else {
+    lf.J.resize(0, 0);
+  }
+  const int active = compact_nonzero_rows(J, r);
+  lf.vars = free_vars_;
+  lf.offsets.clear();
+  for (int i = 0, o = 0; i < nk; ++i) {
+    if (at.is_fixed_slot(slots[i])) continue;
+    lf.offsets.push_back(o);
+    o += factor.dims()[i];
   }
   const auto Ja = J.topRows(active);
   const auto ra = r.head(active);
@@ -197,6 +224,7 @@ ISAM2Result ISAM2::update(const std::vector<FactorPtr>& new_factors,
                           const Values& new_values, const ISAM2UpdateOptions& update_options) {
   const auto t_start = Clock::now();
   ISAM2Result res;
+  const int kept_before = jacobians_kept_;
   const bool gauss_newton = options_.step == ISAM2Step::kGaussNewton;
   const bool evaluate = options_.safeguard || !gauss_newton;
 
@@ -534,6 +562,7 @@ ISAM2Result ISAM2::update(const std::vector<FactorPtr>& new_factors,
   }
   res.trust_radius = trust_radius_;
   tree_.clear_fresh();
+  res.jacobians_kept = jacobians_kept_ - kept_before;
   res.total_s = seconds_since(t_start);
   spdlog::debug(
       "ISAM2 update {}: {} vars re-eliminated in {} cliques ({}), {} relinearized, {} cliques "

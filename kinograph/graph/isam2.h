@@ -49,6 +49,10 @@ struct ISAM2Options {
   /// evaluating its factors a second time. The Jacobians cost little beside the residuals of
   /// collision and kinematic factors; a rejected step wastes them.
   bool linearize_at_evaluation = true;
+  /// Keep a linear factor's JᵀJ between linearizations while its Jacobian is unchanged
+  /// (Factor::jacobian_version; only Jᵀr is formed again). Measured (bench/replanning): the GP
+  /// priors and collocations of a trajectory are most of the JᵀJ work of an update.
+  bool reuse_constant_jacobians = true;
 
   /// Safeguard: evaluate the nonlinear error after each update (incrementally: only factors on
   /// variables that moved); with Gauss–Newton, if it rose, re-eliminate the affected top with
@@ -114,6 +118,7 @@ struct ISAM2Result {
   int variables_relinearized = 0;
   int factors_linearized = 0;  ///< new factors plus those touching relinearized variables
   int factors_reused = 0;      ///< of those, linearizations kept from the error evaluation
+  int jacobians_kept = 0;  ///< evaluations of linear factors that kept JᵀJ (all trials)
   int cliques_solved = 0;      ///< cliques back-substituted (last trial)
   int trials = 0;              ///< numeric eliminations (GN) or dogleg steps tried
   double lambda = 0;           ///< damping of the accepted GN trial
@@ -181,6 +186,7 @@ class ISAM2 {
   std::vector<LinearizedFactor> at_estimate_;   // per factor: linearized at the estimate
   std::vector<char> at_estimate_ok_;            // per factor: at_estimate_ is current
   int factors_reused_ = 0;                      // linearizations taken from at_estimate_
+  int jacobians_kept_ = 0;                      // evaluations that kept a linear factor's JᵀJ
   std::vector<std::vector<int>> factor_slots_;  // per factor: Values slot per key
   std::vector<double> factor_error_;            // per factor: error at the estimate
   std::vector<std::vector<int>> var_factors_;   // per slot: factor indices touching it
@@ -198,7 +204,7 @@ class ISAM2 {
   Eigen::VectorXd r_;
   Eigen::MatrixXd J_;
   std::vector<const double*> ptrs_;
-  std::vector<int> free_cols_;
+  std::vector<int> free_vars_, free_cols_;
 };
 
 }  // namespace kinograph::graph

@@ -24,6 +24,7 @@ LinearFactor::LinearFactor(std::vector<Key> keys, std::vector<Eigen::MatrixXd> A
                                   std::to_string(b_.size()));
     }
   }
+  set_linear();
 }
 
 void LinearFactor::evaluate(const FactorValues& x, Eigen::Ref<Eigen::VectorXd> e,

@@ -20,6 +20,9 @@ class NoiseModel {
   /// e ← r(e) and J ← dr/de · J (J has dim() rows and any number of columns).
   virtual void whiten_system(Eigen::Ref<Eigen::VectorXd> e,
                              Eigen::Ref<Eigen::MatrixXd> J) const = 0;
+  /// Whether dr/de is a constant (every model but a hinge), so that a factor linear in its
+  /// variables keeps a constant whitened Jacobian.
+  virtual bool constant_whitening() const { return true; }
 
  private:
   int dim_;
@@ -94,6 +97,7 @@ class HingeNoise final : public NoiseModel {
   double slope() const { return slope_; }
   void whiten_residual(Eigen::Ref<Eigen::VectorXd> e) const override;
   void whiten_system(Eigen::Ref<Eigen::VectorXd> e, Eigen::Ref<Eigen::MatrixXd> J) const override;
+  bool constant_whitening() const override { return false; }
 
  private:
   Eigen::VectorXd lower_;

@@ -8,7 +8,9 @@ PriorFactor::PriorFactor(Key key, const Eigen::Ref<const Eigen::VectorXd>& targe
                          NoiseModelPtr noise)
     : Factor({key}, {static_cast<int>(target.size())}, static_cast<int>(target.size()),
              std::move(noise)),
-      target_(target) {}
+      target_(target) {
+  set_linear();
+}
 
 void PriorFactor::evaluate(const FactorValues& x, Eigen::Ref<Eigen::VectorXd> e,
                            const Jacobians* J) const {

@@ -24,6 +24,7 @@ ConstrainedFactor::ConstrainedFactor(std::vector<graph::Key> keys, std::vector<i
 
 void ConstrainedFactor::set_penalty(double mu) {
   if (!(mu > 0)) throw std::invalid_argument("penalty must be positive");
+  if (mu != mu_) jacobian_changed();
   mu_ = mu;
 }
 
@@ -170,6 +171,16 @@ double ConstrainedFactor::scaled_violation(const graph::Values& values) const {
     worst = std::max(worst, row_violation(rows_[i], z[i]) / rows_[i].scale);
   }
   return worst;
+}
+
+void ConstrainedFactor::declare_linear() {
+  for (const RowSpec& row : rows_) {
+    // A bound's hinge switches its row on and off with the variables.
+    if (row.kind == RowKind::kBounds) {
+      throw std::logic_error(name() + ": a factor with bound rows is not linear");
+    }
+  }
+  set_linear();
 }
 
 }  // namespace kinograph::planning

@@ -81,6 +81,12 @@ class ConstrainedFactor : public graph::Factor {
   /// worst row before the update, from the same evaluation.
   Violation update_multipliers(const graph::Values& values);
 
+ protected:
+  /// For a subclass whose compute() is linear in the variables: with soft and equality rows only
+  /// the whitened Jacobian is then constant between penalty changes (Factor::jacobian_version).
+  /// Throws std::logic_error if a row is a bound.
+  void declare_linear();
+
  private:
   // check() and, with non-null multipliers, their update from the same evaluation.
   Violation scan(const graph::Values& values, Eigen::VectorXd* lambda,

@@ -25,7 +25,9 @@ StateTargetFactor::StateTargetFactor(std::vector<graph::Key> keys, int n,
     : StateTargetFactor(keys, n, target_rows(keys.size(), n, target, scale)) {}
 
 StateTargetFactor::StateTargetFactor(std::vector<graph::Key> keys, int n, std::vector<RowSpec> rows)
-    : ConstrainedFactor(keys, std::vector<int>(keys.size(), n), std::move(rows)), n_(n) {}
+    : ConstrainedFactor(keys, std::vector<int>(keys.size(), n), std::move(rows)), n_(n) {
+  declare_linear();
+}
 
 std::shared_ptr<StateTargetFactor> StateTargetFactor::soft(std::vector<graph::Key> keys, int n,
                                                            const Eigen::VectorXd& target,

@@ -37,6 +37,7 @@ GpPriorFactor::GpPriorFactor(int k, int n, double dt, double qc)
   const Eigen::Matrix3d info = gp_covariance(dt, qc).inverse();
   // R upper triangular with RᵀR = Q⁻¹: the transposed lower Cholesky factor.
   R_ = info.llt().matrixU();
+  set_linear();
 }
 
 void GpPriorFactor::evaluate(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> e,
@@ -73,7 +74,9 @@ std::vector<RowSpec> collocation_rows(int n, double dt, double scale) {
 CollocationFactor::CollocationFactor(int k, int n, double dt, double scale)
     : ConstrainedFactor(two_state_keys(k), std::vector<int>(6, n), collocation_rows(n, dt, scale)),
       n_(n),
-      dt_(dt) {}
+      dt_(dt) {
+  declare_linear();
+}
 
 void CollocationFactor::compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
                                 const graph::Jacobians* J) const {

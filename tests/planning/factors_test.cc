@@ -12,6 +12,7 @@
 #include "kinograph/planning/collision_factors.h"
 #include "kinograph/planning/dynamics_factors.h"
 #include "kinograph/planning/pose_factors.h"
+#include "kinograph/planning/replan_factors.h"
 #include "kinograph/planning/trajectory_factors.h"
 
 namespace kinograph::planning {
@@ -120,6 +121,44 @@ TEST(TrajectoryFactors, Jacobians) {
   EXPECT_GT(std::abs(r[2]), 0);  // q̈2 = −0.4 below −0.1
   EXPECT_EQ(r[1], 0);            // q̇1 inside
   EXPECT_NEAR(lim.violation(v), 0.3, 1e-12);
+}
+
+// Factors that declare themselves linear (solvers keep their JᵀJ) have the same Jacobian at any
+// two points, and a new version when the penalty or the noise model changes; hinges do not.
+TEST(TrajectoryFactors, LinearFactorsHaveConstantJacobians) {
+  std::mt19937 rng(3);
+  const int n = 3;
+  const graph::Values a = random_states(n, 1, rng, 2.0), b = random_states(n, 1, rng, 2.0);
+  auto col = std::make_shared<CollocationFactor>(0, n, 0.1);
+  col->set_penalty(7.0);
+  auto target = std::make_shared<StateTargetFactor>(std::vector<graph::Key>{q_key(1)}, n,
+                                                    Eigen::Vector3d(0.1, 0.2, 0.3), 0.01);
+  const std::vector<std::shared_ptr<graph::Factor>> linear = {
+      std::make_shared<GpPriorFactor>(0, n, 0.1, 1.3), col, target,
+      StateTargetFactor::soft({q_key(0), v_key(0)}, n, Eigen::VectorXd::Ones(2 * n), 1e3)};
+  for (const auto& f : linear) {
+    EXPECT_GE(f->jacobian_version(), 0) << f->name();
+    Eigen::VectorXd ra, rb;
+    Eigen::MatrixXd Ja, Jb;
+    f->linearize(a, ra, Ja);
+    f->linearize(b, rb, Jb);
+    EXPECT_NE(ra, rb) << f->name();
+    EXPECT_EQ(Ja, Jb) << f->name();
+  }
+  const long v = col->jacobian_version();
+  col->set_penalty(7.0);
+  EXPECT_EQ(col->jacobian_version(), v);
+  col->set_penalty(70.0);
+  EXPECT_NE(col->jacobian_version(), v);
+  const long w = linear[0]->jacobian_version();
+  linear[0]->set_noise(std::make_shared<graph::IsotropicNoise>(3 * n, 0.5));
+  EXPECT_NE(linear[0]->jacobian_version(), w);
+  // A hinge noise model makes even a linear factor's Jacobian depend on the point.
+  linear[0]->set_noise(std::make_shared<graph::HingeNoise>(
+      Eigen::VectorXd::Constant(3 * n, -1), Eigen::VectorXd::Constant(3 * n, 1), 0.1, 1.0));
+  EXPECT_EQ(linear[0]->jacobian_version(), -1);
+  StateLimitFactor lim(0, n, {{0, 0, -0.5, 0.5}});
+  EXPECT_EQ(lim.jacobian_version(), -1);
 }
 
 TEST(ConstrainedFactor, MultiplierUpdateClipsInequalities) {
