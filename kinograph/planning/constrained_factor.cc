@@ -162,6 +162,20 @@ double ConstrainedFactor::violation(const graph::Values& values) const {
   return worst;
 }
 
+ConstrainedFactor::Terms ConstrainedFactor::terms(const graph::Values& values) const {
+  const Eigen::Ref<Eigen::VectorXd> z = raw_values(*this, values);
+  Terms t;
+  for (int i = 0; i < residual_dim(); ++i) {
+    const RowSpec& row = rows_[i];
+    if (row.kind == RowKind::kSoft) {
+      t.soft_cost += 0.5 * std::pow(row.weight * (z[i] - row.lower), 2);
+    } else {
+      t.violation = std::max(t.violation, row_violation(row, z[i]));
+    }
+  }
+  return t;
+}
+
 double ConstrainedFactor::scaled_violation(const graph::Values& values) const {
   if (num_constraints_ == 0) return 0;
   const Eigen::Ref<Eigen::VectorXd> z = raw_values(*this, values);

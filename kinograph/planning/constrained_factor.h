@@ -50,6 +50,8 @@ class ConstrainedFactor : public graph::Factor {
   const std::vector<RowSpec>& rows() const { return rows_; }
   /// Whether any row is a constraint (so the augmented Lagrangian must track this factor).
   bool has_constraints() const { return num_constraints_ > 0; }
+  /// Whether any row is soft (part of the objective).
+  bool has_soft_rows() const { return num_constraints_ < residual_dim(); }
 
   /// Penalty μ of the constraint rows.
   double penalty() const { return mu_; }
@@ -75,6 +77,12 @@ class ConstrainedFactor : public graph::Factor {
   Violation check(const graph::Values& values) const;
   /// Largest constraint violation in the rows' own units (|z − t| or the bound excess).
   double violation(const graph::Values& values) const;
+  /// The soft rows' cost ½Σ(w(z − t))² and violation(), from one evaluation.
+  struct Terms {
+    double soft_cost = 0;
+    double violation = 0;
+  };
+  Terms terms(const graph::Values& values) const;
   /// Largest violation measured in scaled units (|c| = violation / s).
   double scaled_violation(const graph::Values& values) const;
   /// First-order multiplier update λ ← λ + μc (bounds clipped ≥ 0) at `values`; returns the

@@ -91,28 +91,30 @@ void carry_multipliers(const ConstrainedFactor* from, ConstrainedFactor* to) {
 
 }  // namespace
 
-double soft_cost(const graph::FactorGraph& graph, const graph::Values& values) {
+namespace {
+// The soft cost of `graph` at `values` and, with `violation`, the largest constraint violation
+// (own units), each factor evaluated once.
+double graph_terms(const graph::FactorGraph& graph, const graph::Values& values,
+                   double* violation) {
   double soft = 0;
-  Eigen::VectorXd z;
   for (const auto& f : graph.factors()) {
     if (!f) continue;
     if (auto* c = dynamic_cast<const ConstrainedFactor*>(f.get())) {
-      // Most constraint factors (collision, limits) have no soft rows: skip their evaluation.
-      const auto& rows = c->rows();
-      if (std::none_of(rows.begin(), rows.end(),
-                       [](const RowSpec& r) { return r.kind == RowKind::kSoft; })) {
-        continue;
-      }
-      c->values_at(values, z);
-      for (int i = 0; i < c->residual_dim(); ++i) {
-        const RowSpec& row = c->rows()[i];
-        if (row.kind == RowKind::kSoft) soft += 0.5 * std::pow(row.weight * (z[i] - row.lower), 2);
-      }
+      // Most constraint factors (collision, limits) have no soft rows: no evaluation for the cost.
+      if (violation == nullptr && !c->has_soft_rows()) continue;
+      const ConstrainedFactor::Terms t = c->terms(values);
+      soft += t.soft_cost;
+      if (violation != nullptr) *violation = std::max(*violation, t.violation);
       continue;
     }
     soft += f->error(values);
   }
   return soft;
+}
+}  // namespace
+
+double soft_cost(const graph::FactorGraph& graph, const graph::Values& values) {
+  return graph_terms(graph, values, nullptr);
 }
 
 // The incremental graph and its solver state.
@@ -331,12 +333,8 @@ Plan IncrementalPlanner::make_plan(const std::string& method, bool with_stats) {
 }
 
 void IncrementalPlanner::fill_stats(Plan& plan) const {
-  const graph::Values& values = state_->isam->estimate();
-  plan.stats.cost = soft_cost(state_->isam->graph(), values);
   double worst = 0;
-  for (const Entry& e : state_->entries) {
-    if (e.constrained) worst = std::max(worst, e.constrained->violation(values));
-  }
+  plan.stats.cost = graph_terms(state_->isam->graph(), state_->isam->estimate(), &worst);
   plan.stats.max_constraint_violation = worst;
 }
 
