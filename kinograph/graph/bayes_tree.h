@@ -10,8 +10,6 @@
 
 namespace kinograph::graph {
 
-class Factor;
-
 /// One factor linearized at the linearization point, in information form: ½‖J δ + r‖² =
 /// ½ δᵀHδ + gᵀδ + error. Only free (non-fixed) variables have blocks.
 struct LinearizedFactor {
@@ -21,9 +19,8 @@ struct LinearizedFactor {
   Eigen::VectorXd g;         ///< Jᵀr
   double error = 0;          ///< ½‖r‖² at the linearization point
   bool active = false;       ///< false for removed factors (slot kept empty)
-  /// The factor and its Factor::jacobian_version when H was formed, and for a linear factor its
-  /// whitened Jacobian over the free variables (H and J are kept while both hold).
-  const Factor* source = nullptr;
+  /// The factor's Factor::jacobian_version when H was formed, and for a linear factor its
+  /// whitened Jacobian over the free variables (H and J are kept while the version holds).
   long jacobian_version = -1;
   Eigen::MatrixXd J;
 };

@@ -2,6 +2,7 @@
 
 #include <cxxabi.h>
 
+#include <atomic>
 #include <cstdlib>
 #include <memory>
 #include <stdexcept>
@@ -48,7 +49,12 @@ void Factor::set_noise(NoiseModelPtr noise) {
                                 std::to_string(residual_dim_));
   }
   noise_ = std::move(noise);
-  ++jacobian_version_;
+  jacobian_changed();
+}
+
+void Factor::jacobian_changed() {
+  static std::atomic<long> last_version{0};
+  jacobian_version_ = ++last_version;
 }
 
 void Factor::whitened(const double* const* x, Eigen::Ref<Eigen::VectorXd> r,

@@ -94,7 +94,8 @@ class Factor {
 
   /// For a factor linear in its variables (its whitened Jacobian then does not depend on them),
   /// a number that changes whenever that Jacobian may change (noise model, penalty); −1 for
-  /// every other factor. Solvers may keep JᵀJ while it is unchanged.
+  /// every other factor. Numbers are unique across all factors of the process, so a solver may
+  /// keep J and JᵀJ under this number alone.
   long jacobian_version() const {
     return linear_ && (!noise_ || noise_->constant_whitening()) ? jacobian_version_ : -1;
   }
@@ -103,7 +104,7 @@ class Factor {
   /// Declares evaluate() linear in the variables (the test suite checks the Jacobian is constant).
   void set_linear() { linear_ = true; }
   /// Marks a change of something, besides the noise model, the whitened Jacobian depends on.
-  void jacobian_changed() { ++jacobian_version_; }
+  void jacobian_changed();
 
  private:
   std::vector<Key> keys_;

@@ -108,8 +108,8 @@ bool ISAM2::evaluate_factor(int f, const Values& at, LinearizedFactor* out, doub
   }
   const int off = static_cast<int>(free_cols_.size());
   const long version = factor.jacobian_version();
-  if (options_.reuse_constant_jacobians && version >= 0 && lf.source == &factor &&
-      lf.jacobian_version == version && lf.vars == free_vars_) {
+  if (options_.reuse_constant_jacobians && version >= 0 && lf.jacobian_version == version &&
+      lf.vars == free_vars_) {
     // A linear factor whose Jacobian is unchanged since lf.H was formed: only r and Jᵀr are new.
     factor.whitened(ptrs_.data(), r, nullptr);
     if (!r.allFinite()) return non_finite();
@@ -125,7 +125,6 @@ bool ISAM2::evaluate_factor(int f, const Values& at, LinearizedFactor* out, doub
   if (!r.allFinite() || !J.allFinite()) return non_finite();
   lf.error = 0.5 * r.squaredNorm();
   if (error != nullptr) *error = lf.error;
-  lf.source = &factor;
   lf.jacobian_version = options_.reuse_constant_jacobians ? version : -1;
   if (lf.jacobian_version >= 0) {
     lf.J.resize(rows, off);

@@ -134,6 +134,7 @@ NormalEquations::NormalEquations(const FactorGraph& graph, const Values& values,
     factors_.push_back(info);
   }
 
+  linear_.assign(factors_.size(), LinearCache());
   r_.setZero(max_rows);
   J_.setZero(max_rows, max_cols);
   JtJ_.setZero(max_cols, max_cols);
@@ -153,7 +154,8 @@ bool NormalEquations::run(const FactorGraph& graph, const Values& values, double
   }
   const double* base = values.vector().data();
   double total = 0;
-  for (const FactorInfo& info : factors_) {
+  for (size_t fi = 0; fi < factors_.size(); ++fi) {
+    const FactorInfo& info = factors_[fi];
     const Factor& f = *graph[info.slot];
     const int m = f.residual_dim();
     const int nk = static_cast<int>(f.keys().size());
@@ -173,10 +175,14 @@ bool NormalEquations::run(const FactorGraph& graph, const Values& values, double
       continue;
     } else {
       const int nc = f.jacobian_cols();
+      // A linear factor whose Jacobian is unchanged keeps J and JᵀJ: only r and Jᵀr are new.
+      const long version = f.jacobian_version();
+      LinearCache* cache = version >= 0 && info.num_pairs > 0 ? &linear_[fi] : nullptr;
+      const bool kept = cache != nullptr && cache->version == version;
       Eigen::Ref<Eigen::MatrixXd> J = J_.topLeftCorner(m, nc);
-      f.whitened(x_ptrs_.data(), r, &J);
+      f.whitened(x_ptrs_.data(), r, kept ? nullptr : &J);
       const bool r_ok = r.allFinite();
-      if (!r_ok || !J.allFinite()) {
+      if (!r_ok || (!kept && !J.allFinite())) {
         if (reason) {
           *reason = "factor " + std::to_string(info.slot) + " (" + f.name() +
                     ") has a non-finite " + (r_ok ? "Jacobian" : "residual");
@@ -185,13 +191,28 @@ bool NormalEquations::run(const FactorGraph& graph, const Values& values, double
       }
       total += 0.5 * r.squaredNorm();
       if (info.num_pairs == 0) continue;
-      const int active = compact_nonzero_rows(J, r);
-      if (active == 0) continue;  // e.g. a collision factor with every pair clear
-      const auto Ja = J.topRows(active);
-      auto JtJ = JtJ_.topLeftCorner(nc, nc);
-      jacobian_gram(Ja, JtJ, /*upper_only=*/true);  // only upper blocks are scattered
       auto Jtr = Jtr_.head(nc);
-      Jtr.noalias() = Ja.transpose() * r.head(active);
+      const double* jtj = nullptr;
+      Eigen::Index stride = 0;
+      if (kept) {
+        Jtr.noalias() = cache->J.transpose() * r;
+        jtj = cache->JtJ.data();
+        stride = cache->JtJ.outerStride();
+      } else {
+        if (cache != nullptr) cache->J = J;  // before the compaction reorders its rows
+        const int active = compact_nonzero_rows(J, r);
+        if (active == 0) continue;  // e.g. a collision factor with every pair clear
+        const auto Ja = J.topRows(active);
+        auto JtJ = JtJ_.topLeftCorner(nc, nc);
+        jacobian_gram(Ja, JtJ, /*upper_only=*/true);  // only upper blocks are scattered
+        Jtr.noalias() = Ja.transpose() * r.head(active);
+        jtj = JtJ.data();
+        stride = JtJ.outerStride();
+        if (cache != nullptr) {
+          cache->JtJ = JtJ;
+          cache->version = version;
+        }
+      }
       const auto& offsets = f.block_offsets();
       const auto& dims = f.dims();
       for (int k = 0; k < nk; ++k) {
@@ -203,18 +224,17 @@ bool NormalEquations::run(const FactorGraph& graph, const Values& values, double
         const Pair& pair = pairs_[p];
         const int ro = offsets[pair.row_key], co = offsets[pair.col_key];
         const int dr = dims[pair.row_key], dc = dims[pair.col_key];
-        const Eigen::Index stride = JtJ.outerStride();
         if (ro <= co) {  // the block lies in JᵀJ's upper triangle
           for (int k = 0; k < dc; ++k) {
             double* dst = h + col_ptr_[pair.first_col + k] + pair.within;
-            const double* src = JtJ.data() + (co + k) * stride + ro;
+            const double* src = jtj + (co + k) * stride + ro;
             const int rows = pair.diagonal ? k + 1 : dr;
             for (int i = 0; i < rows; ++i) dst[i] += src[i];
           }
         } else {  // below the diagonal of JᵀJ: read the mirrored entries from the upper triangle
           for (int k = 0; k < dc; ++k) {
             double* dst = h + col_ptr_[pair.first_col + k] + pair.within;
-            const double* src = JtJ.data() + ro * stride + co + k;
+            const double* src = jtj + ro * stride + co + k;
             for (int i = 0; i < dr; ++i) dst[i] += src[i * stride];
           }
         }

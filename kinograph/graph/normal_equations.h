@@ -89,6 +89,13 @@ class NormalEquations {
   std::vector<int> key_value_offset_;  // per factor key: offset into Values::vector()
   std::vector<int> key_col_;           // per factor key: first column of H, −1 if fixed
   std::vector<Pair> pairs_;
+  // A linear factor's whitened J and JᵀJ (upper triangle), kept under its
+  // Factor::jacobian_version (−1: none yet); one per entry of factors_.
+  struct LinearCache {
+    long version = -1;
+    Eigen::MatrixXd J, JtJ;
+  };
+  std::vector<LinearCache> linear_;
   // Workspaces sized for the largest factor.
   Eigen::VectorXd r_;
   Eigen::MatrixXd J_, JtJ_;

@@ -6,6 +6,8 @@
 #include <random>
 
 #include "kinograph/graph/levenberg_marquardt.h"
+#include "kinograph/graph/linear_factor.h"
+#include "kinograph/graph/normal_equations.h"
 #include "kinograph/graph/ordering.h"
 #include "tests/graph/problems.h"
 
@@ -216,6 +218,42 @@ TEST(Solver, JacobianGramIsJtJOnBothPaths) {
                                  Eigen::MatrixXd(expected.triangularView<Eigen::Upper>());
     EXPECT_LT(diff.cwiseAbs().maxCoeff(), 1e-12 * expected.cwiseAbs().maxCoeff());
   }
+}
+
+TEST(Solver, NormalEquationsKeepLinearFactorsExactly) {
+  // Linear factors keep J and JᵀJ between linearizations (Factor::jacobian_version): H, g and
+  // the cost equal a fresh structure's at new values and after a noise-model change.
+  const int n = 40;
+  auto p = problems::chain(n);
+  std::vector<std::shared_ptr<LinearFactor>> linear;
+  for (int k = 0; k + 2 < n; k += 3) {
+    Eigen::Matrix3d A;
+    A << 1, 0.2, 0, -0.1, 1, 0.3, 0, 0.4, 1;
+    linear.push_back(p.graph.emplace<LinearFactor>(
+        std::vector<Key>{Key('x', 0, k), Key('x', 0, k + 2)},
+        std::vector<Eigen::MatrixXd>{A, -A.transpose()}, Eigen::Vector3d(0.1, -0.2, 0.05),
+        isotropic(3, 0.5)));
+  }
+  NormalEquations kept(p.graph, p.start, OrderingMethod::kColamd);
+  Values v = p.start;
+  double e0 = 0;
+  ASSERT_TRUE(kept.linearize(p.graph, v, &e0, nullptr));
+  const auto expect_fresh = [&](const char* when) {
+    NormalEquations fresh(p.graph, v, OrderingMethod::kColamd);
+    double ek = 0, ef = 0;
+    ASSERT_TRUE(kept.linearize(p.graph, v, &ek, nullptr));
+    ASSERT_TRUE(fresh.linearize(p.graph, v, &ef, nullptr));
+    EXPECT_EQ(ek, ef) << when;
+    EXPECT_EQ(kept.hessian(), fresh.hessian()) << when;
+    EXPECT_EQ(kept.gradient(), fresh.gradient()) << when;
+  };
+  for (int k = 0; k < n; ++k) {
+    const Key key('x', 0, k);
+    v.update(key, v.at(key) + Eigen::Vector3d(0.1 * std::sin(k), 0.05, -0.02 * k));
+  }
+  expect_fresh("at new values");
+  linear.front()->set_noise(isotropic(3, 0.1));
+  expect_fresh("after a noise change");
 }
 
 }  // namespace
