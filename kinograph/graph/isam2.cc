@@ -100,10 +100,12 @@ bool ISAM2::evaluate_factor(int f, const Values& at, LinearizedFactor* out, doub
   LinearizedFactor& lf = *out;
   // The factor's free variables and their columns in J.
   free_vars_.clear();
+  free_offsets_.clear();
   free_cols_.clear();
   for (int i = 0; i < nk; ++i) {
     if (at.is_fixed_slot(slots[i])) continue;
     free_vars_.push_back(slots[i]);
+    free_offsets_.push_back(static_cast<int>(free_cols_.size()));
     for (int c = 0; c < factor.dims()[i]; ++c) free_cols_.push_back(factor.block_offsets()[i] + c);
   }
   const int off = static_cast<int>(free_cols_.size());
@@ -134,12 +136,7 @@ bool ISAM2::evaluate_factor(int f, const Values& at, LinearizedFactor* out, doub
   }
   const int active = compact_nonzero_rows(J, r);
   lf.vars = free_vars_;
-  lf.offsets.clear();
-  for (int i = 0, o = 0; i < nk; ++i) {
-    if (at.is_fixed_slot(slots[i])) continue;
-    lf.offsets.push_back(o);
-    o += factor.dims()[i];
-  }
+  lf.offsets = free_offsets_;
   const auto Ja = J.topRows(active);
   const auto ra = r.head(active);
   if (active == 0) {

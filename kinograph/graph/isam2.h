@@ -118,7 +118,7 @@ struct ISAM2Result {
   int variables_relinearized = 0;
   int factors_linearized = 0;  ///< new factors plus those touching relinearized variables
   int factors_reused = 0;      ///< of those, linearizations kept from the error evaluation
-  int jacobians_kept = 0;  ///< evaluations of linear factors that kept JᵀJ (all trials)
+  int jacobians_kept = 0;      ///< evaluations of linear factors that kept JᵀJ (all trials)
   int cliques_solved = 0;      ///< cliques back-substituted (last trial)
   int trials = 0;              ///< numeric eliminations (GN) or dogleg steps tried
   double lambda = 0;           ///< damping of the accepted GN trial
@@ -204,7 +204,7 @@ class ISAM2 {
   Eigen::VectorXd r_;
   Eigen::MatrixXd J_;
   std::vector<const double*> ptrs_;
-  std::vector<int> free_vars_, free_cols_;
+  std::vector<int> free_vars_, free_offsets_, free_cols_;
 };
 
 }  // namespace kinograph::graph

@@ -155,11 +155,7 @@ ConstrainedFactor::Violation ConstrainedFactor::scan(const graph::Values& values
 }
 
 double ConstrainedFactor::violation(const graph::Values& values) const {
-  if (num_constraints_ == 0) return 0;
-  const Eigen::Ref<Eigen::VectorXd> z = raw_values(*this, values);
-  double worst = 0;
-  for (int i = 0; i < residual_dim(); ++i) worst = std::max(worst, row_violation(rows_[i], z[i]));
-  return worst;
+  return num_constraints_ == 0 ? 0 : terms(values).violation;
 }
 
 ConstrainedFactor::Terms ConstrainedFactor::terms(const graph::Values& values) const {

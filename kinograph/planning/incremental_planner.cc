@@ -511,7 +511,7 @@ bool IncrementalPlanner::adopt(const Problem& problem, BatchSolution& solution, 
         }
       }
     }
-    mu = std::clamp(force / options_.max_force_ratio, mu, options_.max_grown_penalty);
+    mu = std::max(mu, std::min(force / options_.max_force_ratio, options_.max_grown_penalty));
     spdlog::debug("iDFGP first plan: largest equality force {:.4g}, carried mu {:.3g}", force, mu);
   }
 
