@@ -22,9 +22,9 @@
 #include <vector>
 
 #include "daemon/message_convert.h"
-#include "kinograph/planning/batch_planner.h"
-#include "kinograph/planning/incremental_planner.h"
-#include "kinograph/planning/scene.h"
+#include "kinograph/planning/batch/batch_planner.h"
+#include "kinograph/planning/incremental/incremental_planner.h"
+#include "kinograph/planning/io/scene.h"
 
 namespace lcm {
 class LCM;

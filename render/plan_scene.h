@@ -1,10 +1,10 @@
 #pragma once
-// Pictures of plan files: what the planner's reader (planning/plan_json.h) gives, turned into
+// Pictures of plan files: what the planner's reader (planning/io/plan_json.h) gives, turned into
 // what the renderer draws — the robot's trajectory and the obstacles with their colours.
 #include <vector>
 
 #include "kinograph/planning/plan.h"
-#include "kinograph/planning/plan_json.h"
+#include "kinograph/planning/io/plan_json.h"
 #include "render/render_scene.h"
 
 namespace kinograph::render {

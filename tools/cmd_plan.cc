@@ -7,9 +7,9 @@
 #include <optional>
 #include <string>
 
-#include "kinograph/planning/batch_planner.h"
-#include "kinograph/planning/plan_json.h"
-#include "kinograph/planning/scene.h"
+#include "kinograph/planning/batch/batch_planner.h"
+#include "kinograph/planning/io/plan_json.h"
+#include "kinograph/planning/io/scene.h"
 #include "tools/command_registry.h"
 
 namespace kinograph::tools {

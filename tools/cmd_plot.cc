@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "kinograph/planning/plan_json.h"
+#include "kinograph/planning/io/plan_json.h"
 #include "render/image.h"
 #include "render/plot.h"
 #include "tools/command_registry.h"

@@ -6,7 +6,7 @@
 #include <chrono>
 #include <string>
 
-#include "kinograph/planning/plan_json.h"
+#include "kinograph/planning/io/plan_json.h"
 #include "render/image.h"
 #include "render/plan_scene.h"
 #include "render/scene_camera.h"

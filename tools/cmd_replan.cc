@@ -8,10 +8,10 @@
 #include <memory>
 #include <string>
 
-#include "kinograph/planning/incremental_planner.h"
-#include "kinograph/planning/plan_json.h"
-#include "kinograph/planning/replan_change.h"
-#include "kinograph/planning/scene.h"
+#include "kinograph/planning/incremental/incremental_planner.h"
+#include "kinograph/planning/io/plan_json.h"
+#include "kinograph/planning/io/replan_change.h"
+#include "kinograph/planning/io/scene.h"
 #include "tools/command_registry.h"
 
 namespace kinograph::tools {

@@ -5,8 +5,8 @@
 #include <memory>
 #include <string>
 
-#include "kinograph/planning/plan_json.h"
-#include "kinograph/planning/scene.h"
+#include "kinograph/planning/io/plan_json.h"
+#include "kinograph/planning/io/scene.h"
 #include "kinograph/planning/validate.h"
 #include "tools/command_registry.h"
 

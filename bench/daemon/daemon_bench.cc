@@ -35,7 +35,7 @@
 #include "daemon/planner_node.h"
 #include "kinograph/dynamics/kinematics.h"
 #include "kinograph/planning/goal_sampler.h"
-#include "kinograph/planning/scene.h"
+#include "kinograph/planning/io/scene.h"
 #include "lcmtypes/safe_decode.h"
 
 namespace kinograph::bench {

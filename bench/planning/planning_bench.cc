@@ -17,10 +17,10 @@
 
 #include "bench/common/bench_stats.h"
 #include "bench/common/iiwa_goals.h"
-#include "kinograph/planning/batch_planner.h"
+#include "kinograph/planning/batch/batch_planner.h"
 #include "kinograph/planning/goal_sampler.h"
-#include "kinograph/planning/plan_json.h"
-#include "kinograph/planning/scene.h"
+#include "kinograph/planning/io/plan_json.h"
+#include "kinograph/planning/io/scene.h"
 
 namespace kinograph::bench {
 namespace {
@@ -49,10 +49,13 @@ Run plan_once(const planning::BatchPlanner& planner, const Problem& problem) {
 
 // Success rate and times of a set of runs (times over successful runs, as the paper).
 json summary(const std::vector<Run>& runs) {
-  std::vector<double> ok_times, all_times, iterations;
+  std::vector<double> ok_times, all_times, iterations, objectives;
+  std::vector<bool> valid;
   int ok = 0;
   for (const Run& r : runs) {
     all_times.push_back(r.wall_s);
+    objectives.push_back(r.plan.stats.cost);
+    valid.push_back(r.plan.success());
     iterations.push_back(r.plan.stats.iterations);
     if (r.plan.success()) {
       ++ok;
@@ -66,7 +69,9 @@ json summary(const std::vector<Run>& runs) {
           {"time_s_mean", mean(ok_times)},
           {"time_s_max", max_of(ok_times)},
           {"time_s_median_all", median(all_times)},
-          {"iterations_median", median(iterations)}};
+          {"iterations_median", median(iterations)},
+          {"valid_all", valid},           // per run, in run order
+          {"objective_all", objectives}};  // per run: the plan's soft cost
 }
 
 json failures_of(const std::vector<Run>& runs) {

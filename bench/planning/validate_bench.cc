@@ -14,8 +14,8 @@
 #include "bench/common/bench_stats.h"
 #include "kinograph/collision/collision_world.h"
 #include "kinograph/collision/segment_checker.h"
-#include "kinograph/planning/batch_planner.h"
-#include "kinograph/planning/scene.h"
+#include "kinograph/planning/batch/batch_planner.h"
+#include "kinograph/planning/io/scene.h"
 #include "kinograph/planning/validate.h"
 
 using namespace kinograph;

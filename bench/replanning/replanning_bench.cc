@@ -21,10 +21,10 @@
 
 #include "bench/common/bench_stats.h"
 #include "bench/common/iiwa_goals.h"
-#include "kinograph/planning/batch_planner.h"
+#include "kinograph/planning/batch/batch_planner.h"
 #include "kinograph/planning/goal_sampler.h"
-#include "kinograph/planning/incremental_planner.h"
-#include "kinograph/planning/scene.h"
+#include "kinograph/planning/incremental/incremental_planner.h"
+#include "kinograph/planning/io/scene.h"
 
 namespace kinograph::bench {
 namespace {
@@ -87,11 +87,13 @@ struct Row {
   Method L, W, inc;
   Method stiff;  // iDFGP with the other penalty cap (alt_penalty()), no fallback
   int problems = 0, first_failed = 0, no_change = 0;
+  std::vector<double> first_cost;  // per first plan: its soft cost, NaN where it failed
 };
 
 json row_json(const Row& r) {
   return {{"problems", r.problems},
           {"first_plan_failed", r.first_failed},
+          {"first_plan_objective_all", r.first_cost},
           {"no_nearby_change", r.no_change},
           {"DFGP-L", r.L.to_json()},
           {"DFGP-W", r.W.to_json()},
@@ -113,6 +115,7 @@ void replan_all(Row& row, const Problem& first_problem, const Problem& changed,
   ++row.problems;
   planning::IncrementalPlanner planner(io);
   const Plan first = planner.plan(first_problem);
+  row.first_cost.push_back(first.success() ? first.stats.cost : std::nan(""));
   if (!first.success()) {
     ++row.first_failed;
     return;

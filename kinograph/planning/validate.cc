@@ -9,7 +9,7 @@
 #include "kinograph/collision/segment_checker.h"
 #include "kinograph/dynamics/inverse_dynamics.h"
 #include "kinograph/dynamics/kinematics.h"
-#include "kinograph/planning/pose_error.h"
+#include "kinograph/planning/factors/pose_error.h"
 
 namespace kinograph::planning {
 namespace {

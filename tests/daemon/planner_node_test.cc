@@ -17,7 +17,7 @@
 
 #include "kinograph/dynamics/kinematics.h"
 #include "kinograph/planner_status_t.hpp"
-#include "kinograph/planning/scene.h"
+#include "kinograph/planning/io/scene.h"
 #include "kinograph/planning/validate.h"
 #include "lcmtypes/safe_decode.h"
 

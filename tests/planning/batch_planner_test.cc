@@ -1,6 +1,6 @@
 // End-to-end batch plans: Acrobot swing-up, RR reach past an obstacle, iiwa carrying the block
 // past a desk, and impossible problems that must fail cleanly.
-#include "kinograph/planning/batch_planner.h"
+#include "kinograph/planning/batch/batch_planner.h"
 
 #include <gtest/gtest.h>
 #include <spdlog/spdlog.h>

@@ -1,6 +1,6 @@
 // Tests of the DFG builder: structure of a step, initial values from RNEA, and solving a
 // single-step DFG with Levenberg–Marquardt for inverse and forward dynamics.
-#include "kinograph/planning/dfg_builder.h"
+#include "kinograph/planning/formulation/dfg_builder.h"
 
 #include <gtest/gtest.h>
 
@@ -22,10 +22,10 @@
 #include "kinograph/graph/prior_factor.h"
 #include "kinograph/graph/testing/numerical_jacobian.h"
 #include "kinograph/graph/values.h"
-#include "kinograph/planning/augmented_lagrangian.h"
-#include "kinograph/planning/dynamics_factors.h"
-#include "kinograph/planning/graph_builder.h"
-#include "kinograph/planning/initialization.h"
+#include "kinograph/planning/solver/augmented_lagrangian.h"
+#include "kinograph/planning/factors/dynamics_factors.h"
+#include "kinograph/planning/formulation/planning_graph.h"
+#include "kinograph/planning/formulation/initialization.h"
 #include "kinograph/planning/problem.h"
 
 namespace kinograph::planning {

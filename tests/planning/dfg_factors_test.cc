@@ -7,7 +7,7 @@
 // joint i's own rate moves body i, and the sign is + for a screw axis pointing along the joint's
 // positive direction. Lynch & Park's form is what dynamics::rnea computes, so the consistency
 // tests below check the factors against RNEA directly.
-#include "kinograph/planning/dfg_factors.h"
+#include "kinograph/planning/factors/dfg_factors.h"
 
 #include <gtest/gtest.h>
 

@@ -6,8 +6,8 @@
 #include <cmath>
 
 #include "kinograph/dynamics/kinematics.h"
-#include "kinograph/planning/batch_planner.h"
-#include "kinograph/planning/pose_error.h"
+#include "kinograph/planning/batch/batch_planner.h"
+#include "kinograph/planning/factors/pose_error.h"
 #include "tests/planning/test_problems.h"
 
 namespace kinograph::planning {

@@ -9,11 +9,11 @@
 #include "kinograph/dynamics/inverse_dynamics.h"
 #include "kinograph/dynamics/payload.h"
 #include "kinograph/graph/testing/numerical_jacobian.h"
-#include "kinograph/planning/collision_factors.h"
-#include "kinograph/planning/dynamics_factors.h"
-#include "kinograph/planning/pose_factors.h"
-#include "kinograph/planning/replan_factors.h"
-#include "kinograph/planning/trajectory_factors.h"
+#include "kinograph/planning/factors/collision_factors.h"
+#include "kinograph/planning/factors/dynamics_factors.h"
+#include "kinograph/planning/factors/pose_factors.h"
+#include "kinograph/planning/factors/state_target_factor.h"
+#include "kinograph/planning/factors/trajectory_factors.h"
 
 namespace kinograph::planning {
 namespace {

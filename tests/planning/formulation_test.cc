@@ -2,7 +2,7 @@
 // step) and the full dynamic factor graph — pose the same problem and must give the same plan.
 #include <gtest/gtest.h>
 
-#include "kinograph/planning/batch_planner.h"
+#include "kinograph/planning/batch/batch_planner.h"
 #include "tests/planning/test_problems.h"
 
 namespace kinograph::planning {

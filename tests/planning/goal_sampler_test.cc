@@ -7,7 +7,7 @@
 #include "kinograph/collision/collision_world.h"
 #include "kinograph/dynamics/data.h"
 #include "kinograph/dynamics/kinematics.h"
-#include "kinograph/planning/scene.h"
+#include "kinograph/planning/io/scene.h"
 
 namespace kinograph::planning {
 namespace {

@@ -5,9 +5,9 @@
 #include <string>
 
 #include "kinograph/dynamics/kinematics.h"
-#include "kinograph/planning/batch_planner.h"
-#include "kinograph/planning/incremental_planner.h"
-#include "kinograph/planning/scene.h"
+#include "kinograph/planning/batch/batch_planner.h"
+#include "kinograph/planning/incremental/incremental_planner.h"
+#include "kinograph/planning/io/scene.h"
 
 namespace kinograph::planning {
 namespace {

@@ -1,6 +1,6 @@
 // iDFGP (issue 6): incremental replans validate and agree with batch solves of the changed
 // problem; obstacle moves, removals and start updates behave as the problem says.
-#include "kinograph/planning/incremental_planner.h"
+#include "kinograph/planning/incremental/incremental_planner.h"
 
 #include <gtest/gtest.h>
 
@@ -9,11 +9,11 @@
 
 #include "kinograph/collision/collision_world.h"
 #include "kinograph/dynamics/kinematics.h"
-#include "kinograph/planning/batch_planner.h"
-#include "kinograph/planning/replan_change.h"
-#include "kinograph/planning/replan_factors.h"
-#include "kinograph/planning/scene.h"
-#include "kinograph/planning/trajectory_factors.h"
+#include "kinograph/planning/batch/batch_planner.h"
+#include "kinograph/planning/io/replan_change.h"
+#include "kinograph/planning/factors/state_target_factor.h"
+#include "kinograph/planning/io/scene.h"
+#include "kinograph/planning/factors/trajectory_factors.h"
 
 namespace kinograph::planning {
 namespace {

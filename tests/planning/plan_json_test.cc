@@ -1,6 +1,6 @@
 // Plan files: exact round trip of trajectories, stats and validation; the key names the
 // renderer reads; joint reordering; infinities and NaN; errors that name the key.
-#include "kinograph/planning/plan_json.h"
+#include "kinograph/planning/io/plan_json.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // Scene files: every field parsed into the Problem, the writer's round trip, each class of error
 // (with key and line), and the shipped scenes (start and goal within limits and collision-free).
-#include "kinograph/planning/scene.h"
+#include "kinograph/planning/io/scene.h"
 
 #include <gtest/gtest.h>
 

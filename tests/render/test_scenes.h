@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "kinograph/dynamics/model.h"
-#include "kinograph/planning/plan_json.h"
-#include "kinograph/planning/scene.h"
+#include "kinograph/planning/io/plan_json.h"
+#include "kinograph/planning/io/scene.h"
 #include "render/image.h"
 #include "render/render_scene.h"
 

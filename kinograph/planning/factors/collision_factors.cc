@@ -1,0 +1,104 @@
+#include "kinograph/planning/factors/collision_factors.h"
+
+#include <limits>
+#include <stdexcept>
+
+#include "kinograph/dynamics/kinematics.h"
+#include "kinograph/planning/factors/trajectory_factors.h"
+
+namespace kinograph::planning {
+
+CollisionContext::CollisionContext(std::shared_ptr<const dynamics::Model> m,
+                                   const std::vector<collision::Obstacle>& obstacles,
+                                   double query_dist)
+    : model(std::move(m)),
+      world(*model,
+            [&] {
+              collision::CollisionWorldOptions o;
+              o.query_distance = query_dist;
+              return o;
+            }()),
+      data(*model),
+      gradient_workspace(*model),
+      gradient(model->nq()),
+      q(model->nq()),
+      query_distance(query_dist) {
+  for (const collision::Obstacle& o : obstacles) {
+    const collision::Status s = world.add_obstacle(o);
+    if (!s.ok) throw std::invalid_argument("obstacle " + std::to_string(o.id) + ": " + s.reason);
+    obstacle_ids.push_back(o.id);
+  }
+  row_of.assign(model->collision.size(), std::vector<int>(obstacle_ids.size(), -1));
+  for (size_t g = 0; g < model->collision.size(); ++g) {
+    if (model->collision[g].body < 0) continue;
+    geoms.push_back(static_cast<int>(g));
+    for (size_t o = 0; o < obstacle_ids.size(); ++o) row_of[g][o] = num_pairs++;
+  }
+}
+
+namespace {
+std::vector<graph::Key> collision_keys(int k, double s) {
+  if (s == 0) return {q_key(k)};
+  return {q_key(k), v_key(k), q_key(k + 1), v_key(k + 1)};
+}
+std::vector<RowSpec> collision_rows(int pairs, double epsilon, double scale) {
+  if (pairs == 0) throw std::invalid_argument("CollisionFactor needs robot geometry and obstacles");
+  RowSpec r;
+  r.kind = RowKind::kBounds;
+  r.lower = epsilon;
+  r.upper = std::numeric_limits<double>::infinity();
+  r.scale = scale;
+  return std::vector<RowSpec>(pairs, r);
+}
+}  // namespace
+
+CollisionFactor::CollisionFactor(int k, double s, double dt, double epsilon, double scale,
+                                 std::shared_ptr<CollisionContext> context)
+    : ConstrainedFactor(collision_keys(k, s),
+                        std::vector<int>(s == 0 ? 1 : 4, context->model->nq()),
+                        collision_rows(context->num_pairs, epsilon, scale)),
+      s_(s),
+      dt_(dt),
+      t_((k + s) * dt),
+      ctx_(std::move(context)) {
+  if (!(s >= 0 && s < 1)) throw std::invalid_argument("CollisionFactor needs 0 <= s < 1");
+  const double s2 = s * s, s3 = s2 * s;
+  h_ << 2 * s3 - 3 * s2 + 1, s3 - 2 * s2 + s, -2 * s3 + 3 * s2, s3 - s2;
+}
+
+void CollisionFactor::compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
+                              const graph::Jacobians* J) const {
+  CollisionContext& c = *ctx_;
+  const dynamics::Model& model = *c.model;
+  Eigen::VectorXd& q = c.q;
+  if (s_ == 0) {
+    q = x[0];
+  } else {
+    q = h_[0] * x[0] + h_[1] * dt_ * x[1] + h_[2] * x[2] + h_[3] * dt_ * x[3];
+  }
+  dynamics::forward_kinematics(model, c.data, q);
+  z.setConstant(c.query_distance);
+  for (const collision::Proximity& p : c.world.query(c.data, t_)) {
+    if (p.is_self_collision() || p.robot_geom < 0) continue;
+    int slot = -1;
+    for (size_t o = 0; o < c.obstacle_ids.size(); ++o) {
+      if (c.obstacle_ids[o] == p.obstacle) slot = static_cast<int>(o);
+    }
+    if (slot < 0) continue;
+    const int row = c.row_of[p.robot_geom][slot];
+    if (row < 0) continue;
+    z[row] = p.distance;
+    if (J == nullptr) continue;
+    collision::distance_gradient(model, c.data, p, c.gradient_workspace, c.gradient);
+    if (s_ == 0) {
+      J->block(0).row(row) = c.gradient.transpose();
+    } else {
+      J->block(0).row(row) = h_[0] * c.gradient.transpose();
+      J->block(1).row(row) = h_[1] * dt_ * c.gradient.transpose();
+      J->block(2).row(row) = h_[2] * c.gradient.transpose();
+      J->block(3).row(row) = h_[3] * dt_ * c.gradient.transpose();
+    }
+  }
+}
+
+}  // namespace kinograph::planning

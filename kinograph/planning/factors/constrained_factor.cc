@@ -1,0 +1,196 @@
+#include "kinograph/planning/factors/constrained_factor.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace kinograph::planning {
+
+ConstrainedFactor::ConstrainedFactor(std::vector<graph::Key> keys, std::vector<int> dims,
+                                     std::vector<RowSpec> rows)
+    : graph::Factor(std::move(keys), std::move(dims), static_cast<int>(rows.size())),
+      rows_(std::move(rows)) {
+  for (const RowSpec& r : rows_) {
+    if (r.kind != RowKind::kSoft) {
+      ++num_constraints_;
+      if (!(r.scale > 0)) throw std::invalid_argument("constraint row scale must be positive");
+    }
+    if (r.kind == RowKind::kBounds && !(r.lower <= r.upper)) {
+      throw std::invalid_argument("constraint row has lower bound above upper bound");
+    }
+  }
+  reset_multipliers();
+}
+
+void ConstrainedFactor::set_penalty(double mu) {
+  if (!(mu > 0)) throw std::invalid_argument("penalty must be positive");
+  if (mu != mu_) jacobian_changed();
+  mu_ = mu;
+}
+
+void ConstrainedFactor::set_multipliers(const Eigen::VectorXd& lambda,
+                                        const Eigen::VectorXd& lambda_upper) {
+  if (lambda.size() != residual_dim() || lambda_upper.size() != residual_dim()) {
+    throw std::invalid_argument("multipliers have the wrong size");
+  }
+  lambda_ = lambda;
+  lambda_upper_ = lambda_upper;
+}
+
+void ConstrainedFactor::reset_multipliers() {
+  lambda_.setZero(residual_dim());
+  lambda_upper_.setZero(residual_dim());
+}
+
+void ConstrainedFactor::evaluate(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> e,
+                                 const graph::Jacobians* J) const {
+  compute(x, e, J);
+  const double sq = std::sqrt(mu_);
+  // dr/dz of every row, applied to the Jacobian blocks column by column afterwards (blocks are
+  // column-major: scaling row by row would stride through memory). Per-thread scratch that only
+  // grows, so linearizing allocates nothing after the first factor of the largest size.
+  thread_local Eigen::VectorXd scratch;
+  if (scratch.size() < residual_dim()) scratch.resize(residual_dim());
+  auto f = scratch.head(residual_dim());
+  for (int i = 0; i < residual_dim(); ++i) {
+    const RowSpec& row = rows_[i];
+    const double z = e[i];
+    switch (row.kind) {
+      case RowKind::kSoft:
+        f[i] = row.weight;
+        e[i] = row.weight * (z - row.lower);
+        break;
+      case RowKind::kEquality:
+        f[i] = sq / row.scale;
+        e[i] = f[i] * (z - row.lower) + lambda_[i] / sq;
+        break;
+      case RowKind::kBounds: {
+        const double a = sq * (row.lower - z) / row.scale + lambda_[i] / sq;
+        const double b = sq * (z - row.upper) / row.scale + lambda_upper_[i] / sq;
+        e[i] = std::max(0.0, a) - std::max(0.0, b);
+        f[i] = -(sq / row.scale) * ((a > 0 ? 1.0 : 0.0) + (b > 0 ? 1.0 : 0.0));
+        break;
+      }
+    }
+  }
+  if (J != nullptr) {
+    for (size_t k = 0; k < keys().size(); ++k) {
+      J->block(static_cast<int>(k)).array().colwise() *= f.array();
+    }
+  }
+}
+
+void ConstrainedFactor::values_at(const graph::Values& values, Eigen::VectorXd& z) const {
+  z.setZero(residual_dim());
+  compute_at(values, z);
+}
+
+void ConstrainedFactor::compute_at(const graph::Values& values,
+                                   Eigen::Ref<Eigen::VectorXd> z) const {
+  // Per-thread key pointers that only grow: the outer loop calls this for every factor.
+  thread_local std::vector<const double*> ptrs;
+  if (ptrs.size() < keys().size()) ptrs.resize(keys().size());
+  for (size_t k = 0; k < keys().size(); ++k) ptrs[k] = values.at(keys()[k]).data();
+  z.setZero();
+  compute(graph::FactorValues(ptrs.data(), dims().data()), z, nullptr);
+}
+
+namespace {
+// Violation of row i in its own units: |z − t| or the bound excess (0 for soft rows).
+double row_violation(const RowSpec& row, double z) {
+  switch (row.kind) {
+    case RowKind::kSoft:
+      return 0;
+    case RowKind::kEquality:
+      return std::abs(z - row.lower);
+    case RowKind::kBounds:
+      return std::max({0.0, row.lower - z, z - row.upper});
+  }
+  return 0;
+}
+
+// Raw values of `f` at `values` in a per-thread buffer (valid until the next call).
+Eigen::Ref<Eigen::VectorXd> raw_values(const ConstrainedFactor& f, const graph::Values& values) {
+  thread_local Eigen::VectorXd z;
+  if (z.size() < f.residual_dim()) z.resize(f.residual_dim());
+  auto head = z.head(f.residual_dim());
+  f.compute_at(values, head);
+  return head;
+}
+}  // namespace
+
+ConstrainedFactor::Violation ConstrainedFactor::check(const graph::Values& values) const {
+  return scan(values, nullptr, nullptr);
+}
+
+ConstrainedFactor::Violation ConstrainedFactor::update_multipliers(const graph::Values& values) {
+  return scan(values, &lambda_, &lambda_upper_);
+}
+
+ConstrainedFactor::Violation ConstrainedFactor::scan(const graph::Values& values,
+                                                     Eigen::VectorXd* lambda,
+                                                     Eigen::VectorXd* lambda_upper) const {
+  const bool update = lambda != nullptr;
+  Violation v;
+  if (num_constraints_ == 0) return v;
+  const Eigen::Ref<Eigen::VectorXd> z = raw_values(*this, values);
+  for (int i = 0; i < residual_dim(); ++i) {
+    const RowSpec& row = rows_[i];
+    if (row.kind == RowKind::kSoft) continue;
+    const double viol = row_violation(row, z[i]);
+    if (viol / row.scale > v.scaled) {
+      v.scaled = viol / row.scale;
+      v.own_units = viol;
+    }
+    if (!update) continue;
+    if (row.kind == RowKind::kEquality) {
+      (*lambda)[i] += mu_ * (z[i] - row.lower) / row.scale;
+    } else {
+      // Infinite bounds give -inf here and clip to 0.
+      (*lambda)[i] = std::max(0.0, (*lambda)[i] + mu_ * (row.lower - z[i]) / row.scale);
+      (*lambda_upper)[i] = std::max(0.0, (*lambda_upper)[i] + mu_ * (z[i] - row.upper) / row.scale);
+    }
+  }
+  return v;
+}
+
+double ConstrainedFactor::violation(const graph::Values& values) const {
+  return num_constraints_ == 0 ? 0 : terms(values).violation;
+}
+
+ConstrainedFactor::Terms ConstrainedFactor::terms(const graph::Values& values) const {
+  const Eigen::Ref<Eigen::VectorXd> z = raw_values(*this, values);
+  Terms t;
+  for (int i = 0; i < residual_dim(); ++i) {
+    const RowSpec& row = rows_[i];
+    if (row.kind == RowKind::kSoft) {
+      t.soft_cost += 0.5 * std::pow(row.weight * (z[i] - row.lower), 2);
+    } else {
+      t.violation = std::max(t.violation, row_violation(row, z[i]));
+    }
+  }
+  return t;
+}
+
+double ConstrainedFactor::scaled_violation(const graph::Values& values) const {
+  if (num_constraints_ == 0) return 0;
+  const Eigen::Ref<Eigen::VectorXd> z = raw_values(*this, values);
+  double worst = 0;
+  for (int i = 0; i < residual_dim(); ++i) {
+    if (rows_[i].kind == RowKind::kSoft) continue;
+    worst = std::max(worst, row_violation(rows_[i], z[i]) / rows_[i].scale);
+  }
+  return worst;
+}
+
+void ConstrainedFactor::declare_linear() {
+  for (const RowSpec& row : rows_) {
+    // A bound's hinge switches its row on and off with the variables.
+    if (row.kind == RowKind::kBounds) {
+      throw std::logic_error(name() + ": a factor with bound rows is not linear");
+    }
+  }
+  set_linear();
+}
+
+}  // namespace kinograph::planning

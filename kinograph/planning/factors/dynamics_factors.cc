@@ -1,0 +1,77 @@
+#include "kinograph/planning/factors/dynamics_factors.h"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "kinograph/dynamics/inverse_dynamics.h"
+#include "kinograph/planning/factors/trajectory_factors.h"
+
+namespace kinograph::planning {
+
+std::vector<RowSpec> DynamicsStepFactor::rows_for(const dynamics::Model& model,
+                                                  const DynamicsStepOptions& options,
+                                                  std::vector<int>* joint_of_row) {
+  std::vector<RowSpec> rows;
+  std::vector<int> joints;
+  for (int j = 0; j < model.nq(); ++j) {
+    const dynamics::Body& b = model.bodies[j];
+    RowSpec r;
+    r.scale = options.torque_scale;
+    if (!b.actuated) {
+      r.kind = RowKind::kEquality;
+      r.lower = 0;
+    } else if (std::isfinite(b.limits.effort)) {
+      r.kind = RowKind::kBounds;
+      const double e = std::max(0.0, b.limits.effort - options.limit_epsilon);
+      r.lower = -e;
+      r.upper = e;
+    } else {
+      continue;
+    }
+    rows.push_back(r);
+    joints.push_back(j);
+  }
+  if (options.min_torque > 0) {
+    for (int j = 0; j < model.nq(); ++j) {
+      RowSpec r;
+      r.kind = RowKind::kSoft;
+      r.weight = std::sqrt(2 * options.min_torque);
+      rows.push_back(r);
+      joints.push_back(j);
+    }
+  }
+  if (joint_of_row != nullptr) *joint_of_row = std::move(joints);
+  return rows;
+}
+
+DynamicsStepFactor::DynamicsStepFactor(int k, std::shared_ptr<const dynamics::Model> model,
+                                       std::shared_ptr<dynamics::Data> workspace,
+                                       const DynamicsStepOptions& options)
+    : ConstrainedFactor({q_key(k), v_key(k), a_key(k)}, {model->nq(), model->nq(), model->nq()},
+                        rows_for(*model, options)),
+      model_(std::move(model)),
+      data_(std::move(workspace)) {
+  rows_for(*model_, options, &joint_of_row_);
+}
+
+void DynamicsStepFactor::compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
+                                 const graph::Jacobians* J) const {
+  dynamics::Data& d = *data_;
+  if (J == nullptr) {
+    dynamics::rnea(*model_, d, x[0], x[1], x[2]);
+  } else {
+    dynamics::rnea_derivatives(*model_, d, x[0], x[1], x[2]);
+  }
+  for (size_t i = 0; i < joint_of_row_.size(); ++i) {
+    const int j = joint_of_row_[i];
+    z[static_cast<int>(i)] = d.tau[j];
+    if (J != nullptr) {
+      const int r = static_cast<int>(i);
+      J->block(0).row(r) = d.dtau_dq.row(j);
+      J->block(1).row(r) = d.dtau_dqd.row(j);
+      J->block(2).row(r) = d.M.row(j);
+    }
+  }
+}
+
+}  // namespace kinograph::planning

@@ -1,0 +1,39 @@
+#pragma once
+// Pose constraints through forward kinematics: the end-effector pose goal on the last state and
+// the task constraint (e.g. keep a carried block level) on every state.
+#include <Eigen/Geometry>
+#include <memory>
+
+#include "kinograph/dynamics/data.h"
+#include "kinograph/dynamics/model.h"
+#include "kinograph/planning/factors/constrained_factor.h"
+
+namespace kinograph::planning {
+
+/// Which parts of a frame's pose a PoseFactor constrains.
+enum class PoseParts { kFull, kPosition, kOrientation };
+
+/// Equality constraint on the world pose of `frame` at state k (key q_k): position rows p − p*
+/// (m) and/or orientation rows ½ vee(R*ᵀR − RᵀR*) (= sin θ·axis in the target frame, zero at
+/// R = R*). Orientation rows come first. Jacobians from the space and point Jacobians.
+class PoseFactor final : public ConstrainedFactor {
+ public:
+  /// Throws std::out_of_range for an unknown frame.
+  PoseFactor(int k, std::shared_ptr<const dynamics::Model> model,
+             std::shared_ptr<dynamics::Data> workspace, const std::string& frame,
+             const Eigen::Isometry3d& target, PoseParts parts, double scale);
+  void compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
+               const graph::Jacobians* J) const override;
+
+ private:
+  std::shared_ptr<const dynamics::Model> model_;
+  std::shared_ptr<dynamics::Data> data_;
+  int frame_;
+  int body_;
+  Eigen::Isometry3d target_;
+  bool position_, orientation_;
+  mutable Eigen::Matrix<double, 6, Eigen::Dynamic> J6_;
+  mutable Eigen::Matrix3Xd J3_;
+};
+
+}  // namespace kinograph::planning

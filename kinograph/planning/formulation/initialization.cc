@@ -1,0 +1,214 @@
+#include "kinograph/planning/formulation/initialization.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <stdexcept>
+
+#include "kinograph/collision/collision_world.h"
+#include "kinograph/dynamics/kinematics.h"
+
+namespace kinograph::planning {
+
+std::optional<Eigen::VectorXd> goal_configuration(const Problem& problem) {
+  const dynamics::Model& model = *problem.model;
+  const int n = model.nq();
+  if (problem.goal.kind == Goal::Kind::kJoint) return problem.goal.q;
+  int frame = -1;
+  try {
+    frame = model.frame_index(problem.goal.frame);
+  } catch (const std::out_of_range&) {
+    return std::nullopt;
+  }
+  const int body = model.frames[frame].body;
+  const bool orient = !problem.goal.position_only;
+  dynamics::Data data(model);
+  Eigen::VectorXd q = problem.start_q;
+  Eigen::Matrix<double, 6, Eigen::Dynamic> J6(6, n);
+  Eigen::Matrix3Xd J3(3, n);
+  const Eigen::Isometry3d& target = problem.goal.pose;
+  double lambda = 1e-2;
+  for (int it = 0; it < 200 && body >= 0; ++it) {
+    dynamics::forward_kinematics(model, data, q);
+    const Eigen::Isometry3d T = dynamics::frame_pose(model, data, frame);
+    // Error twist: world-frame rotation vector (small-angle from R R*ᵀ) and position error.
+    const Eigen::AngleAxisd aa(T.linear() * target.linear().transpose());
+    Eigen::VectorXd e(orient ? 6 : 3);
+    Eigen::MatrixXd J(orient ? 6 : 3, n);
+    dynamics::point_jacobian(model, data, body, T.translation(), J3);
+    if (orient) {
+      dynamics::space_jacobian(model, data, body, J6);
+      e << aa.angle() * aa.axis(), T.translation() - target.translation();
+      J << J6.topRows<3>(), J3;
+    } else {
+      e = T.translation() - target.translation();
+      J = J3;
+    }
+    if (e.norm() < 1e-9) break;
+    const Eigen::MatrixXd A =
+        J * J.transpose() + lambda * Eigen::MatrixXd::Identity(J.rows(), J.rows());
+    Eigen::VectorXd dq = -J.transpose() * A.ldlt().solve(e);
+    const double step = dq.cwiseAbs().maxCoeff();
+    if (step > 0.3) dq *= 0.3 / step;
+    q += dq;
+    for (int j = 0; j < n; ++j) {
+      const auto& l = model.bodies[j].limits;
+      q[j] = std::clamp(q[j], l.lower, l.upper);
+    }
+  }
+  return q;
+}
+
+Trajectory straight_line(const Problem& problem, const Eigen::VectorXd& q_goal) {
+  const int N = problem.steps, n = static_cast<int>(q_goal.size());
+  const double T = problem.horizon;
+  Trajectory tr;
+  tr.q.resize(N + 1, n);
+  tr.qd.resize(N + 1, n);
+  tr.qdd.resize(N + 1, n);
+  const Eigen::VectorXd q0 = problem.start_q;
+  const Eigen::VectorXd v0 =
+      problem.start_qd.size() == n ? problem.start_qd : Eigen::VectorXd::Zero(n);
+  // Quintic with q(0) = q0, q̇(0) = v0, q̈(0) = 0, q(T) = q_goal, q̇(T) = q̈(T) = 0, per joint:
+  // q = q0 + v0 t + c3 t³ + c4 t⁴ + c5 t⁵.
+  const Eigen::VectorXd d = q_goal - q0 - v0 * T;
+  // (c3, c4, c5) from the end conditions q(T) − q0 − v0 T = d, q̇(T) = 0, q̈(T) = 0.
+  Eigen::Matrix3d A;
+  A << std::pow(T, 3), std::pow(T, 4), std::pow(T, 5), 3 * T * T, 4 * std::pow(T, 3),
+      5 * std::pow(T, 4), 6 * T, 12 * T * T, 20 * std::pow(T, 3);
+  const Eigen::Matrix3d Ainv = A.inverse();
+  Eigen::MatrixXd C(3, n);
+  for (int j = 0; j < n; ++j) C.col(j) = Ainv * Eigen::Vector3d(d[j], -v0[j], 0);
+  for (int k = 0; k <= N; ++k) {
+    const double t = T * k / N;
+    const double t2 = t * t, t3 = t2 * t, t4 = t3 * t, t5 = t4 * t;
+    for (int j = 0; j < n; ++j) {
+      tr.q(k, j) = q0[j] + v0[j] * t + C(0, j) * t3 + C(1, j) * t4 + C(2, j) * t5;
+      tr.qd(k, j) = v0[j] + 3 * C(0, j) * t2 + 4 * C(1, j) * t3 + 5 * C(2, j) * t4;
+      tr.qdd(k, j) = 6 * C(0, j) * t + 12 * C(1, j) * t2 + 20 * C(2, j) * t3;
+    }
+  }
+  return tr;
+}
+
+Trajectory warm_start(const Problem& problem, const Plan& previous) {
+  const int n = problem.model->nq(), N = problem.steps;
+  const int M = static_cast<int>(previous.q.rows());
+  if (previous.q.cols() != n || M < 2 || previous.qd.rows() != M || previous.qdd.rows() != M) {
+    throw std::invalid_argument("warm start plan does not match the problem's robot");
+  }
+  Trajectory tr;
+  tr.q.resize(N + 1, n);
+  tr.qd.resize(N + 1, n);
+  tr.qdd.resize(N + 1, n);
+  for (int k = 0; k <= N; ++k) {
+    // Fraction of the previous plan's horizon (plans are resampled by normalized time).
+    const double u = static_cast<double>(k) / N * (M - 1);
+    const int i = std::min(static_cast<int>(std::floor(u)), M - 2);
+    const double s = u - i;
+    tr.q.row(k) = (1 - s) * previous.q.row(i) + s * previous.q.row(i + 1);
+    tr.qd.row(k) = (1 - s) * previous.qd.row(i) + s * previous.qd.row(i + 1);
+    tr.qdd.row(k) = (1 - s) * previous.qdd.row(i) + s * previous.qdd.row(i + 1);
+  }
+  tr.q.row(0) = problem.start_q.transpose();
+  if (problem.start_qd.size() == n) tr.qd.row(0) = problem.start_qd.transpose();
+  return tr;
+}
+
+Trajectory via_point(const Problem& problem, const Eigen::VectorXd& q_via,
+                     const Eigen::VectorXd& q_goal) {
+  const int N = problem.steps;
+  const int n = problem.model->nq();
+  if (N < 2) return straight_line(problem, q_goal);
+  const int half = N / 2;
+  Problem first = problem;
+  first.steps = half;
+  first.horizon = problem.dt() * half;
+  const Trajectory a = straight_line(first, q_via);
+  Problem second = problem;
+  second.steps = N - half;
+  second.horizon = problem.dt() * (N - half);
+  second.start_q = q_via;
+  second.start_qd = Eigen::VectorXd::Zero(n);
+  const Trajectory b = straight_line(second, q_goal);
+  Trajectory tr;
+  tr.q.resize(N + 1, n);
+  tr.qd.resize(N + 1, n);
+  tr.qdd.resize(N + 1, n);
+  tr.q << a.q, b.q.bottomRows(N - half);
+  tr.qd << a.qd, b.qd.bottomRows(N - half);
+  tr.qdd << a.qdd, b.qdd.bottomRows(N - half);
+  return tr;
+}
+
+namespace {
+// Smallest clearance along a → b, travelled from time t0 to t1 (for moving obstacles), with a
+// prepared world and workspace.
+double clearance_along(const dynamics::Model& model, collision::CollisionWorld& world,
+                       dynamics::Data& data, const Eigen::VectorXd& a, const Eigen::VectorXd& b,
+                       double t0, double t1, int samples, double stop_below) {
+  double worst = std::numeric_limits<double>::infinity();
+  for (int i = 0; i <= samples; ++i) {
+    const double s = static_cast<double>(i) / samples;
+    dynamics::forward_kinematics(model, data, (1 - s) * a + s * b);
+    worst = std::min(worst, world.closest(data, (1 - s) * t0 + s * t1).distance);
+    if (worst < stop_below) break;
+  }
+  return worst;
+}
+}  // namespace
+
+double segment_clearance(const Problem& problem, const Eigen::VectorXd& a, const Eigen::VectorXd& b,
+                         int samples) {
+  if (problem.obstacles.empty()) return std::numeric_limits<double>::infinity();
+  collision::CollisionWorld world(*problem.model);
+  for (const auto& o : problem.obstacles) world.add_obstacle(o);
+  dynamics::Data data(*problem.model);
+  return clearance_along(*problem.model, world, data, a, b, 0, problem.horizon,
+                         std::max(1, samples), -std::numeric_limits<double>::infinity());
+}
+
+std::vector<Detour> detour_candidates(const Problem& problem, const Eigen::VectorXd& q_goal,
+                                      const DetourOptions& options) {
+  if (problem.obstacles.empty() || options.candidates <= 0) return {};
+  const dynamics::Model& model = *problem.model;
+  const int n = model.nq();
+  collision::CollisionWorld world(model);
+  for (const auto& o : problem.obstacles) world.add_obstacle(o);
+  dynamics::Data data(model);
+  std::mt19937_64 rng(options.seed);
+  std::uniform_real_distribution<double> u(-options.spread, options.spread);
+  const Eigen::VectorXd mid = 0.5 * (problem.start_q + q_goal);
+  const double eps = problem.objectives.collision_epsilon;
+  const int samples = std::max(1, options.samples);
+  struct Candidate {
+    double score;
+    Detour detour;
+  };
+  std::vector<Candidate> ranked;
+  for (int c = 0; c < options.candidates; ++c) {
+    Eigen::VectorXd q = mid;
+    for (int j = 0; j < n; ++j) {
+      const auto& l = model.bodies[j].limits;
+      q[j] = std::clamp(q[j] + u(rng), l.lower, l.upper);
+    }
+    // Clearance capped at ε (anything clearer is as good), then a small preference for short
+    // detours, so the ranking is: collision-free first, then by joint-space length.
+    const double T = problem.horizon, half = problem.dt() * (problem.steps / 2);
+    const double c1 =
+        clearance_along(model, world, data, problem.start_q, q, 0, half, samples, -1e9);
+    const double c2 = clearance_along(model, world, data, q, q_goal, half, T, samples, -1e9);
+    const double length = (q - problem.start_q).norm() + (q_goal - q).norm();
+    ranked.push_back({std::min({c1, c2, eps}) - 1e-3 * length, Detour{q, std::min(c1, c2)}});
+  }
+  std::stable_sort(ranked.begin(), ranked.end(),
+                   [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
+  std::vector<Detour> out;
+  for (auto& c : ranked) out.push_back(std::move(c.detour));
+  return out;
+}
+
+}  // namespace kinograph::planning

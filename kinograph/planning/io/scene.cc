@@ -1,0 +1,741 @@
+#include "kinograph/planning/io/scene.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <set>
+#include <sstream>
+
+#include "kinograph/dynamics/payload.h"
+
+namespace kinograph::planning {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string format_error(const std::string& file, const std::string& key, int line,
+                         const std::string& message) {
+  std::ostringstream os;
+  os << "scene '" << (file.empty() ? "<text>" : file) << "'";
+  if (line > 0) os << " line " << line;
+  if (!key.empty()) os << ": '" << key << "'";
+  os << ": " << message;
+  return os.str();
+}
+
+// 1-based line of a node, 0 when yaml-cpp has no mark for it.
+int line_of(const YAML::Node& node) {
+  if (!node.IsDefined()) return 0;
+  const YAML::Mark mark = node.Mark();
+  return mark.is_null() ? 0 : mark.line + 1;
+}
+
+std::string join(const std::string& parent, const std::string& key) {
+  return parent.empty() ? key : parent + "." + key;
+}
+
+std::string index_key(const std::string& parent, std::size_t i) {
+  return parent + "[" + std::to_string(i) + "]";
+}
+
+// Reads typed values out of YAML nodes, naming the file, key path and line on every error.
+class Reader {
+ public:
+  explicit Reader(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const YAML::Node& node, const std::string& key,
+                         const std::string& message) const {
+    throw SceneError(file_, key, line_of(node), message);
+  }
+
+  // Requires a map whose keys are all in `allowed`.
+  void expect_map(const YAML::Node& node, const std::string& key,
+                  std::initializer_list<const char*> allowed) const {
+    if (!node.IsMap()) fail(node, key, "must be a map");
+    std::set<std::string> seen;
+    for (const auto& entry : node) {
+      if (!entry.first.IsScalar()) fail(entry.first, key, "has a key that is not a string");
+      const std::string name = entry.first.Scalar();
+      if (!seen.insert(name).second) fail(entry.first, join(key, name), "duplicate key");
+      bool known = false;
+      for (const char* a : allowed) known = known || name == a;
+      if (!known) {
+        std::string list;
+        for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
+        fail(entry.first, join(key, name), "unknown key (expected one of: " + list + ")");
+      }
+    }
+  }
+
+  // The child `name` of map `parent`; fails naming the key if it is missing.
+  YAML::Node required(const YAML::Node& parent, const std::string& parent_key,
+                      const std::string& name) const {
+    const YAML::Node child = parent[name];
+    if (!child) fail(parent, join(parent_key, name), "missing required key");
+    return child;
+  }
+
+  double number(const YAML::Node& node, const std::string& key) const {
+    if (!node.IsScalar()) fail(node, key, "must be a number");
+    const std::string text = node.Scalar();
+    // Angles may be written with pi: "pi", "-pi/2", "2*pi", "0.5*pi/3".
+    static const std::regex kPi(
+        R"(^\s*([+-]?)\s*(?:([0-9]*\.?[0-9]+(?:[eE][+-]?[0-9]+)?)\s*\*\s*)?pi\s*(?:/\s*([0-9]*\.?[0-9]+))?\s*$)");
+    std::smatch m;
+    if (std::regex_match(text, m, kPi)) {
+      double value = M_PI;
+      if (m[2].matched) value *= std::stod(m[2].str());
+      if (m[3].matched) value /= std::stod(m[3].str());
+      return m[1].str() == "-" ? -value : value;
+    }
+    double value = 0;
+    if (!YAML::convert<double>::decode(node, value)) {
+      fail(node, key, "must be a number, got '" + text + "'");
+    }
+    if (std::isnan(value)) fail(node, key, "must not be NaN");
+    return value;
+  }
+
+  double positive(const YAML::Node& node, const std::string& key) const {
+    const double v = number(node, key);
+    if (!(v > 0) || !std::isfinite(v)) fail(node, key, "must be a positive finite number");
+    return v;
+  }
+
+  double non_negative(const YAML::Node& node, const std::string& key) const {
+    const double v = number(node, key);
+    if (!(v >= 0) || !std::isfinite(v)) fail(node, key, "must be a finite number >= 0");
+    return v;
+  }
+
+  double finite(const YAML::Node& node, const std::string& key) const {
+    const double v = number(node, key);
+    if (!std::isfinite(v)) fail(node, key, "must be finite");
+    return v;
+  }
+
+  int integer(const YAML::Node& node, const std::string& key) const {
+    int value = 0;
+    if (!node.IsScalar() || !YAML::convert<int>::decode(node, value)) {
+      fail(node, key, "must be an integer");
+    }
+    return value;
+  }
+
+  bool boolean(const YAML::Node& node, const std::string& key) const {
+    bool value = false;
+    if (!node.IsScalar() || !YAML::convert<bool>::decode(node, value)) {
+      fail(node, key, "must be true or false");
+    }
+    return value;
+  }
+
+  std::string string(const YAML::Node& node, const std::string& key) const {
+    if (!node.IsScalar() || node.Scalar().empty()) fail(node, key, "must be a non-empty string");
+    return node.Scalar();
+  }
+
+  // A list of finite numbers; `size` < 0 accepts any length.
+  Eigen::VectorXd vector(const YAML::Node& node, const std::string& key, int size) const {
+    if (!node.IsSequence()) fail(node, key, "must be a list of numbers");
+    if (size >= 0 && static_cast<int>(node.size()) != size) {
+      fail(node, key,
+           "must have " + std::to_string(size) + " numbers, has " + std::to_string(node.size()));
+    }
+    Eigen::VectorXd v(node.size());
+    for (std::size_t i = 0; i < node.size(); ++i) v[i] = finite(node[i], index_key(key, i));
+    return v;
+  }
+
+  Eigen::Vector3d vector3(const YAML::Node& node, const std::string& key) const {
+    return vector(node, key, 3);
+  }
+
+  // Rotation from `rpy` (URDF fixed-axis roll, pitch, yaw: R = Rz Ry Rx) or `quaternion`
+  // [w, x, y, z]; nullopt when neither is given; both at once is an error.
+  std::optional<Eigen::Matrix3d> rotation(const YAML::Node& map, const std::string& key) const {
+    const YAML::Node rpy = map["rpy"], quat = map["quaternion"];
+    if (rpy && quat) fail(quat, join(key, "quaternion"), "give either rpy or quaternion, not both");
+    if (rpy) {
+      const Eigen::Vector3d a = vector3(rpy, join(key, "rpy"));
+      return (Eigen::AngleAxisd(a.z(), Eigen::Vector3d::UnitZ()) *
+              Eigen::AngleAxisd(a.y(), Eigen::Vector3d::UnitY()) *
+              Eigen::AngleAxisd(a.x(), Eigen::Vector3d::UnitX()))
+          .toRotationMatrix();
+    }
+    if (quat) {
+      const Eigen::VectorXd q = vector(quat, join(key, "quaternion"), 4);
+      Eigen::Quaterniond r(q[0], q[1], q[2], q[3]);
+      if (r.norm() < 1e-9) fail(quat, join(key, "quaternion"), "must not be zero");
+      return r.normalized().toRotationMatrix();
+    }
+    return std::nullopt;
+  }
+
+  const std::string& file() const { return file_; }
+
+ private:
+  std::string file_;
+};
+
+std::string anchor_of(const std::string& source) {
+  if (source.empty()) return fs::current_path().string();
+  return fs::absolute(fs::path(source)).parent_path().string();
+}
+
+Eigen::Isometry3d make_pose(const Eigen::Vector3d& position, const Eigen::Matrix3d& rotation) {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = rotation;
+  pose.translation() = position;
+  return pose;
+}
+
+class SceneParser {
+ public:
+  explicit SceneParser(std::string source) : r_(source), source_(std::move(source)) {
+    anchor_ = anchor_of(source_);
+  }
+
+  Scene parse(const YAML::Node& root) {
+    Scene scene;
+    scene.source = source_;
+    if (!root.IsDefined() || root.IsNull()) r_.fail(root, "", "the file is empty");
+    r_.expect_map(root, "",
+                  {"name", "robot", "horizon", "steps", "start", "goal", "obstacles", "limits",
+                   "task_constraints", "objectives", "planner", "camera"});
+    Problem& problem = scene.problem;
+    problem.name = root["name"] ? r_.string(root["name"], "name")
+                                : (source_.empty() ? "scene" : fs::path(source_).stem().string());
+    dynamics::Model model = parse_robot(root, scene);
+    if (const YAML::Node limits = root["limits"]) parse_limits(limits, scene, model);
+    problem.model = std::make_shared<const dynamics::Model>(std::move(model));
+    const dynamics::Model& m = *problem.model;
+
+    problem.horizon = r_.positive(r_.required(root, "", "horizon"), "horizon");
+    const YAML::Node steps = r_.required(root, "", "steps");
+    problem.steps = r_.integer(steps, "steps");
+    if (problem.steps < 1) r_.fail(steps, "steps", "must be at least 1");
+
+    const YAML::Node start = r_.required(root, "", "start");
+    r_.expect_map(start, "start", {"q", "qd"});
+    problem.start_q = r_.vector(r_.required(start, "start", "q"), "start.q", m.nq());
+    problem.start_qd = start["qd"] ? r_.vector(start["qd"], "start.qd", m.nq())
+                                   : Eigen::VectorXd::Zero(m.nq()).eval();
+
+    parse_goal(r_.required(root, "", "goal"), problem.goal, m);
+    if (const YAML::Node obstacles = root["obstacles"]) parse_obstacles(obstacles, scene);
+    if (const YAML::Node tasks = root["task_constraints"]) parse_tasks(tasks, problem, m);
+    if (const YAML::Node objectives = root["objectives"]) {
+      parse_objectives(objectives, problem.objectives);
+    }
+    if (const YAML::Node planner = root["planner"]) parse_planner(planner, scene.planner);
+    if (const YAML::Node camera = root["camera"]) {
+      // Read by the renderer (render/scene_camera.h); here only its form is checked.
+      if (!camera.IsMap()) r_.fail(camera, "camera", "must be a map");
+    }
+    return scene;
+  }
+
+ private:
+  std::string resolve(const YAML::Node& node, const std::string& key, const std::string& path) {
+    const std::optional<std::string> resolved = resolve_scene_path(path, anchor_);
+    if (!resolved) {
+      r_.fail(node, key,
+              "file '" + path + "' not found (looked next to the scene and in the " +
+                  "repository root)");
+    }
+    return *resolved;
+  }
+
+  dynamics::Model parse_robot(const YAML::Node& root, Scene& scene) {
+    const YAML::Node robot = r_.required(root, "", "robot");
+    r_.expect_map(robot, "robot", {"urdf", "payload"});
+    const YAML::Node urdf = r_.required(robot, "robot", "urdf");
+    scene.urdf = r_.string(urdf, "robot.urdf");
+    scene.urdf_path = resolve(urdf, "robot.urdf", scene.urdf);
+    dynamics::Model model;
+    try {
+      model = dynamics::Model::from_urdf_file(scene.urdf_path);
+    } catch (const std::exception& e) {
+      r_.fail(urdf, "robot.urdf", std::string("cannot load the robot: ") + e.what());
+    }
+    if (const YAML::Node p = robot["payload"]) {
+      r_.expect_map(p, "robot.payload", {"frame", "mass", "size", "offset"});
+      PayloadSpec payload;
+      payload.frame = r_.string(r_.required(p, "robot.payload", "frame"), "robot.payload.frame");
+      payload.mass = r_.non_negative(r_.required(p, "robot.payload", "mass"), "robot.payload.mass");
+      payload.size = r_.vector3(r_.required(p, "robot.payload", "size"), "robot.payload.size");
+      if (payload.size.minCoeff() <= 0) r_.fail(p["size"], "robot.payload.size", "must be > 0");
+      if (p["offset"]) payload.offset = r_.vector3(p["offset"], "robot.payload.offset");
+      try {
+        model =
+            dynamics::attach_box_payload(model, payload.frame, payload.mass, payload.size,
+                                         make_pose(payload.offset, Eigen::Matrix3d::Identity()));
+      } catch (const std::exception& e) {
+        r_.fail(p, "robot.payload", std::string("cannot attach: ") + e.what());
+      }
+      scene.payload = payload;
+    }
+    return model;
+  }
+
+  void parse_limits(const YAML::Node& limits, Scene& scene, dynamics::Model& model) {
+    if (!limits.IsMap()) r_.fail(limits, "limits", "must be a map from joint name to limits");
+    std::set<std::string> seen;
+    for (const auto& entry : limits) {
+      const std::string joint = entry.first.Scalar();
+      const std::string key = join("limits", joint);
+      if (!seen.insert(joint).second) r_.fail(entry.first, key, "duplicate joint");
+      int body = -1;
+      for (int i = 0; i < model.nq(); ++i) {
+        if (model.bodies[i].joint_name == joint) body = i;
+      }
+      if (body < 0) r_.fail(entry.first, key, "no such joint in the robot '" + model.name + "'");
+      const YAML::Node& node = entry.second;
+      r_.expect_map(node, key, {"lower", "upper", "velocity", "effort", "acceleration"});
+      LimitOverride o;
+      dynamics::JointLimits& l = model.bodies[body].limits;
+      if (node["lower"]) l.lower = *(o.lower = r_.number(node["lower"], join(key, "lower")));
+      if (node["upper"]) l.upper = *(o.upper = r_.number(node["upper"], join(key, "upper")));
+      if (!(l.lower <= l.upper)) r_.fail(node, key, "lower limit is above the upper limit");
+      const auto bound = [&](const char* name, std::optional<double>& slot, double& limit) {
+        if (!node[name]) return;
+        const double v = r_.number(node[name], join(key, name));
+        if (!(v >= 0)) r_.fail(node[name], join(key, name), "must be >= 0 (.inf for none)");
+        slot = v;
+        limit = v;
+      };
+      bound("velocity", o.velocity, l.velocity);
+      bound("effort", o.effort, l.effort);
+      bound("acceleration", o.acceleration, l.acceleration);
+      if (o.effort) model.bodies[body].actuated = *o.effort > 0;
+      scene.limits.emplace_back(joint, o);
+    }
+  }
+
+  void parse_goal(const YAML::Node& node, Goal& goal, const dynamics::Model& model) {
+    r_.expect_map(node, "goal", {"q", "frame", "position", "rpy", "quaternion", "position_only"});
+    if (node["q"]) {
+      for (const char* k : {"frame", "position", "rpy", "quaternion", "position_only"}) {
+        if (node[k]) r_.fail(node[k], join("goal", k), "a joint goal (goal.q) takes no pose keys");
+      }
+      goal.kind = Goal::Kind::kJoint;
+      goal.q = r_.vector(node["q"], "goal.q", model.nq());
+      return;
+    }
+    goal.kind = Goal::Kind::kPose;
+    const YAML::Node frame = node["frame"];
+    if (!frame) r_.fail(node, "goal", "needs either 'q' (joint goal) or 'frame' (pose goal)");
+    goal.frame = r_.string(frame, "goal.frame");
+    check_frame(frame, "goal.frame", goal.frame, model);
+    goal.position_only =
+        node["position_only"] && r_.boolean(node["position_only"], "goal.position_only");
+    const Eigen::Vector3d position =
+        r_.vector3(r_.required(node, "goal", "position"), "goal.position");
+    const std::optional<Eigen::Matrix3d> rotation = r_.rotation(node, "goal");
+    if (!rotation && !goal.position_only) {
+      r_.fail(node, "goal", "a pose goal needs 'rpy' or 'quaternion' (or position_only: true)");
+    }
+    goal.pose = make_pose(position, rotation.value_or(Eigen::Matrix3d::Identity()));
+  }
+
+  void check_frame(const YAML::Node& node, const std::string& key, const std::string& frame,
+                   const dynamics::Model& model) {
+    for (const dynamics::Frame& f : model.frames) {
+      if (f.name == frame) return;
+    }
+    r_.fail(node, key, "no frame '" + frame + "' in the robot '" + model.name + "'");
+  }
+
+  void parse_obstacles(const YAML::Node& list, Scene& scene) {
+    if (!list.IsSequence()) r_.fail(list, "obstacles", "must be a list");
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const YAML::Node node = list[i];
+      const std::string key = index_key("obstacles", i);
+      r_.expect_map(
+          node, key,
+          {"id", "shape", "size", "mesh", "scale", "position", "rpy", "quaternion", "motion"});
+      const std::string name = r_.string(r_.required(node, key, "id"), join(key, "id"));
+      for (const std::string& other : scene.obstacle_names) {
+        if (other == name)
+          r_.fail(node["id"], join(key, "id"), "duplicate obstacle id '" + name + "'");
+      }
+      collision::Obstacle obstacle;
+      obstacle.id = static_cast<int>(scene.obstacle_names.size());
+      obstacle.shape = parse_shape(node, key);
+      const Eigen::Vector3d position = node["position"]
+                                           ? r_.vector3(node["position"], join(key, "position"))
+                                           : Eigen::Vector3d::Zero().eval();
+      obstacle.pose =
+          make_pose(position, r_.rotation(node, key).value_or(Eigen::Matrix3d::Identity()));
+      if (const YAML::Node motion = node["motion"]) {
+        obstacle.trajectory = parse_motion(motion, join(key, "motion"));
+      }
+      scene.obstacle_names.push_back(name);
+      scene.problem.obstacles.push_back(std::move(obstacle));
+    }
+  }
+
+  collision::Shape parse_shape(const YAML::Node& node, const std::string& key) {
+    const YAML::Node kind_node = r_.required(node, key, "shape");
+    const std::string kind = r_.string(kind_node, join(key, "shape"));
+    const std::string size_key = join(key, "size");
+    const auto size = [&](int n) {
+      const Eigen::VectorXd s = r_.vector(r_.required(node, key, "size"), size_key, n);
+      if (s.minCoeff() <= 0) r_.fail(node["size"], size_key, "every size must be > 0");
+      return s;
+    };
+    const auto no_key = [&](const char* k) {
+      if (node[k])
+        r_.fail(node[k], join(key, k), "only a mesh obstacle takes '" + std::string(k) + "'");
+    };
+    if (kind == "mesh") {
+      if (node["size"]) r_.fail(node["size"], size_key, "a mesh takes 'scale', not 'size'");
+      const YAML::Node mesh = r_.required(node, key, "mesh");
+      const std::string path = resolve(mesh, join(key, "mesh"), r_.string(mesh, join(key, "mesh")));
+      Eigen::Vector3d scale = Eigen::Vector3d::Ones();
+      if (node["scale"]) scale = r_.vector3(node["scale"], join(key, "scale"));
+      if (scale.minCoeff() <= 0) r_.fail(node["scale"], join(key, "scale"), "must be > 0");
+      return collision::Shape::mesh(path, scale);
+    }
+    no_key("mesh");
+    no_key("scale");
+    if (kind == "box") {
+      const Eigen::VectorXd s = size(3);
+      return collision::Shape::box(s[0], s[1], s[2]);
+    }
+    if (kind == "sphere") return collision::Shape::sphere(size(1)[0]);
+    if (kind == "cylinder") {
+      const Eigen::VectorXd s = size(2);
+      return collision::Shape::cylinder(s[0], s[1]);
+    }
+    if (kind == "capsule") {
+      const Eigen::VectorXd s = size(2);
+      return collision::Shape::capsule(s[0], s[1]);
+    }
+    r_.fail(kind_node, join(key, "shape"),
+            "'" + kind + "' is not one of box, sphere, cylinder, capsule, mesh");
+  }
+
+  collision::PoseTrajectory parse_motion(const YAML::Node& list, const std::string& key) {
+    if (!list.IsSequence() || list.size() == 0) {
+      r_.fail(list, key, "must be a non-empty list of {t, position, rpy|quaternion}");
+    }
+    std::vector<double> times;
+    std::vector<Eigen::Isometry3d> poses;
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const YAML::Node node = list[i];
+      const std::string k = index_key(key, i);
+      r_.expect_map(node, k, {"t", "position", "rpy", "quaternion"});
+      const double t = r_.finite(r_.required(node, k, "t"), join(k, "t"));
+      if (!times.empty() && !(t > times.back())) {
+        r_.fail(node["t"], join(k, "t"), "times must increase strictly");
+      }
+      times.push_back(t);
+      poses.push_back(make_pose(r_.vector3(r_.required(node, k, "position"), join(k, "position")),
+                                r_.rotation(node, k).value_or(Eigen::Matrix3d::Identity())));
+    }
+    return collision::PoseTrajectory(std::move(times), std::move(poses));
+  }
+
+  void parse_tasks(const YAML::Node& list, Problem& problem, const dynamics::Model& model) {
+    if (!list.IsSequence()) r_.fail(list, "task_constraints", "must be a list");
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const YAML::Node node = list[i];
+      const std::string key = index_key("task_constraints", i);
+      r_.expect_map(node, key,
+                    {"frame", "orientation_only", "position", "rpy", "quaternion", "tolerance"});
+      TaskConstraint task;
+      const YAML::Node frame = r_.required(node, key, "frame");
+      task.frame = r_.string(frame, join(key, "frame"));
+      check_frame(frame, join(key, "frame"), task.frame, model);
+      if (node["orientation_only"]) {
+        task.orientation_only = r_.boolean(node["orientation_only"], join(key, "orientation_only"));
+      }
+      const std::optional<Eigen::Matrix3d> rotation = r_.rotation(node, key);
+      if (!rotation) r_.fail(node, key, "needs the target orientation ('rpy' or 'quaternion')");
+      Eigen::Vector3d position = Eigen::Vector3d::Zero();
+      if (node["position"]) {
+        if (task.orientation_only) {
+          r_.fail(node["position"], join(key, "position"),
+                  "an orientation-only constraint takes no position");
+        }
+        position = r_.vector3(node["position"], join(key, "position"));
+      } else if (!task.orientation_only) {
+        r_.fail(node, key, "a full-pose constraint (orientation_only: false) needs 'position'");
+      }
+      task.target = make_pose(position, *rotation);
+      if (node["tolerance"])
+        task.tolerance = r_.positive(node["tolerance"], join(key, "tolerance"));
+      problem.task_constraints.push_back(task);
+    }
+  }
+
+  void parse_objectives(const YAML::Node& node, Objectives& o) {
+    r_.expect_map(node, "objectives",
+                  {"min_torque", "qc", "collision_epsilon", "limit_epsilon", "collision_substeps"});
+    if (node["min_torque"]) {
+      o.min_torque = r_.non_negative(node["min_torque"], "objectives.min_torque");
+    }
+    if (node["qc"]) o.qc = r_.positive(node["qc"], "objectives.qc");
+    if (node["collision_epsilon"]) {
+      o.collision_epsilon =
+          r_.non_negative(node["collision_epsilon"], "objectives.collision_epsilon");
+    }
+    if (node["limit_epsilon"]) {
+      o.limit_epsilon = r_.non_negative(node["limit_epsilon"], "objectives.limit_epsilon");
+    }
+    if (node["collision_substeps"]) {
+      o.collision_substeps =
+          r_.integer(node["collision_substeps"], "objectives.collision_substeps");
+      if (o.collision_substeps < 0) {
+        r_.fail(node["collision_substeps"], "objectives.collision_substeps", "must be >= 0");
+      }
+    }
+  }
+
+  void parse_planner(const YAML::Node& node, PlannerSpec& planner) {
+    r_.expect_map(node, "planner", {"formulation", "init", "warm"});
+    if (node["formulation"]) {
+      planner.formulation = r_.string(node["formulation"], "planner.formulation");
+      if (planner.formulation != "condensed" && planner.formulation != "dfg") {
+        r_.fail(node["formulation"], "planner.formulation", "must be 'condensed' or 'dfg'");
+      }
+    }
+    if (node["init"]) {
+      planner.init = r_.string(node["init"], "planner.init");
+      if (planner.init != "L" && planner.init != "W") {
+        r_.fail(node["init"], "planner.init", "must be 'L' (straight line) or 'W' (warm start)");
+      }
+    }
+    if (node["warm"]) {
+      planner.warm = resolve(node["warm"], "planner.warm", r_.string(node["warm"], "planner.warm"));
+    }
+    if (planner.init == "W" && planner.warm.empty()) {
+      r_.fail(node, "planner.warm", "init W needs a plan file to warm-start from");
+    }
+  }
+
+  Reader r_;
+  std::string source_, anchor_;
+};
+
+// ---- writing ----
+
+void emit_vector(YAML::Emitter& out, const Eigen::VectorXd& v) {
+  out << YAML::Flow << YAML::BeginSeq;
+  for (Eigen::Index i = 0; i < v.size(); ++i) out << v[i];
+  out << YAML::EndSeq;
+}
+
+void emit_rotation(YAML::Emitter& out, const Eigen::Matrix3d& r) {
+  const Eigen::Quaterniond q(r);
+  out << YAML::Key << "quaternion" << YAML::Value;
+  emit_vector(out, Eigen::Vector4d(q.w(), q.x(), q.y(), q.z()));
+}
+
+void emit_pose(YAML::Emitter& out, const Eigen::Isometry3d& pose) {
+  out << YAML::Key << "position" << YAML::Value;
+  emit_vector(out, pose.translation());
+  emit_rotation(out, pose.linear());
+}
+
+}  // namespace
+
+SceneError::SceneError(std::string file, std::string key, int line, const std::string& message)
+    : std::runtime_error(format_error(file, key, line, message)),
+      file_(std::move(file)),
+      key_(std::move(key)),
+      line_(line) {}
+
+std::string shape_kind_name(collision::ShapeKind kind) {
+  switch (kind) {
+    case collision::ShapeKind::kSphere:
+      return "sphere";
+    case collision::ShapeKind::kBox:
+      return "box";
+    case collision::ShapeKind::kCylinder:
+      return "cylinder";
+    case collision::ShapeKind::kCapsule:
+      return "capsule";
+    case collision::ShapeKind::kMesh:
+      return "mesh";
+  }
+  return "box";
+}
+
+std::optional<collision::ShapeKind> shape_kind_from_name(const std::string& name) {
+  for (collision::ShapeKind kind :
+       {collision::ShapeKind::kSphere, collision::ShapeKind::kBox, collision::ShapeKind::kCylinder,
+        collision::ShapeKind::kCapsule, collision::ShapeKind::kMesh}) {
+    if (shape_kind_name(kind) == name) return kind;
+  }
+  return std::nullopt;
+}
+
+std::optional<std::string> resolve_scene_path(const std::string& path,
+                                              const std::string& anchor_dir) {
+  const fs::path p(path);
+  if (p.is_absolute()) {
+    if (fs::exists(p)) return p.lexically_normal().string();
+    return std::nullopt;
+  }
+  for (const fs::path& base : {fs::path(anchor_dir), fs::path(KINOGRAPH_SOURCE_DIR)}) {
+    const fs::path candidate = base / p;
+    if (fs::exists(candidate)) return fs::weakly_canonical(candidate).string();
+  }
+  return std::nullopt;
+}
+
+Scene parse_scene(const std::string& yaml, const std::string& source) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml);
+  } catch (const YAML::Exception& e) {
+    throw SceneError(source, "", e.mark.is_null() ? 0 : e.mark.line + 1,
+                     "not valid YAML: " + e.msg);
+  }
+  return SceneParser(source).parse(root);
+}
+
+Scene load_scene(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw SceneError(path, "", 0, "cannot open the file");
+  std::stringstream text;
+  text << in.rdbuf();
+  return parse_scene(text.str(), path);
+}
+
+std::string scene_to_yaml(const Scene& scene) {
+  const Problem& p = scene.problem;
+  YAML::Emitter out;
+  out.SetDoublePrecision(17);
+  out << YAML::BeginMap;
+  out << YAML::Key << "name" << YAML::Value << p.name;
+  out << YAML::Key << "robot" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "urdf" << YAML::Value << scene.urdf_path;
+  if (scene.payload) {
+    const PayloadSpec& pl = *scene.payload;
+    out << YAML::Key << "payload" << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "frame" << YAML::Value << pl.frame;
+    out << YAML::Key << "mass" << YAML::Value << pl.mass;
+    out << YAML::Key << "size" << YAML::Value;
+    emit_vector(out, pl.size);
+    out << YAML::Key << "offset" << YAML::Value;
+    emit_vector(out, pl.offset);
+    out << YAML::EndMap;
+  }
+  out << YAML::EndMap;
+  out << YAML::Key << "horizon" << YAML::Value << p.horizon;
+  out << YAML::Key << "steps" << YAML::Value << p.steps;
+  out << YAML::Key << "start" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "q" << YAML::Value;
+  emit_vector(out, p.start_q);
+  out << YAML::Key << "qd" << YAML::Value;
+  emit_vector(out, p.start_qd);
+  out << YAML::EndMap;
+  out << YAML::Key << "goal" << YAML::Value << YAML::BeginMap;
+  if (p.goal.kind == Goal::Kind::kJoint) {
+    out << YAML::Key << "q" << YAML::Value;
+    emit_vector(out, p.goal.q);
+  } else {
+    out << YAML::Key << "frame" << YAML::Value << p.goal.frame;
+    emit_pose(out, p.goal.pose);
+    out << YAML::Key << "position_only" << YAML::Value << p.goal.position_only;
+  }
+  out << YAML::EndMap;
+  if (!scene.limits.empty()) {
+    out << YAML::Key << "limits" << YAML::Value << YAML::BeginMap;
+    for (const auto& [joint, o] : scene.limits) {
+      out << YAML::Key << joint << YAML::Value << YAML::BeginMap;
+      const auto put = [&](const char* name, const std::optional<double>& v) {
+        if (v) out << YAML::Key << name << YAML::Value << *v;
+      };
+      put("lower", o.lower);
+      put("upper", o.upper);
+      put("velocity", o.velocity);
+      put("effort", o.effort);
+      put("acceleration", o.acceleration);
+      out << YAML::EndMap;
+    }
+    out << YAML::EndMap;
+  }
+  if (!p.obstacles.empty()) {
+    out << YAML::Key << "obstacles" << YAML::Value << YAML::BeginSeq;
+    for (std::size_t i = 0; i < p.obstacles.size(); ++i) {
+      const collision::Obstacle& o = p.obstacles[i];
+      out << YAML::BeginMap;
+      out << YAML::Key << "id" << YAML::Value
+          << (i < scene.obstacle_names.size() ? scene.obstacle_names[i] : std::to_string(o.id));
+      out << YAML::Key << "shape" << YAML::Value << shape_kind_name(o.shape.kind);
+      switch (o.shape.kind) {
+        case collision::ShapeKind::kBox:
+          out << YAML::Key << "size" << YAML::Value;
+          emit_vector(out, o.shape.size);
+          break;
+        case collision::ShapeKind::kSphere:
+          out << YAML::Key << "size" << YAML::Value;
+          emit_vector(out, o.shape.size.head<1>());
+          break;
+        case collision::ShapeKind::kCylinder:
+        case collision::ShapeKind::kCapsule:
+          out << YAML::Key << "size" << YAML::Value;
+          emit_vector(out, o.shape.size.head<2>());
+          break;
+        case collision::ShapeKind::kMesh:
+          out << YAML::Key << "mesh" << YAML::Value << o.shape.mesh_path;
+          out << YAML::Key << "scale" << YAML::Value;
+          emit_vector(out, o.shape.mesh_scale);
+          break;
+      }
+      emit_pose(out, o.pose);
+      if (o.is_moving()) {
+        out << YAML::Key << "motion" << YAML::Value << YAML::BeginSeq;
+        for (std::size_t k = 0; k < o.trajectory.times().size(); ++k) {
+          out << YAML::BeginMap << YAML::Key << "t" << YAML::Value << o.trajectory.times()[k];
+          emit_pose(out, o.trajectory.poses()[k]);
+          out << YAML::EndMap;
+        }
+        out << YAML::EndSeq;
+      }
+      out << YAML::EndMap;
+    }
+    out << YAML::EndSeq;
+  }
+  if (!p.task_constraints.empty()) {
+    out << YAML::Key << "task_constraints" << YAML::Value << YAML::BeginSeq;
+    for (const TaskConstraint& t : p.task_constraints) {
+      out << YAML::BeginMap;
+      out << YAML::Key << "frame" << YAML::Value << t.frame;
+      out << YAML::Key << "orientation_only" << YAML::Value << t.orientation_only;
+      if (t.orientation_only) {
+        emit_rotation(out, t.target.linear());
+      } else {
+        emit_pose(out, t.target);
+      }
+      out << YAML::Key << "tolerance" << YAML::Value << t.tolerance;
+      out << YAML::EndMap;
+    }
+    out << YAML::EndSeq;
+  }
+  const Objectives& o = p.objectives;
+  out << YAML::Key << "objectives" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "min_torque" << YAML::Value << o.min_torque;
+  out << YAML::Key << "qc" << YAML::Value << o.qc;
+  out << YAML::Key << "collision_epsilon" << YAML::Value << o.collision_epsilon;
+  out << YAML::Key << "limit_epsilon" << YAML::Value << o.limit_epsilon;
+  out << YAML::Key << "collision_substeps" << YAML::Value << o.collision_substeps;
+  out << YAML::EndMap;
+  out << YAML::Key << "planner" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "formulation" << YAML::Value << scene.planner.formulation;
+  out << YAML::Key << "init" << YAML::Value << scene.planner.init;
+  if (!scene.planner.warm.empty()) out << YAML::Key << "warm" << YAML::Value << scene.planner.warm;
+  out << YAML::EndMap;
+  out << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
+}
+
+}  // namespace kinograph::planning
