@@ -35,11 +35,11 @@ int main(int argc, char** argv) {
   bool batch_only = false;
   app.add_flag("--batch-only", batch_only,
                "plan every request with a batch solve (no incremental replanning)");
-  app.add_option("--max-goal-change", options.max_incremental_goal_change,
+  app.add_option("--max-goal-change", options.replanning.max_incremental_goal_change,
                  "plan joint goals that moved more than this (rad) from scratch (default: never)")
       ->check(CLI::PositiveNumber);
   CLI11_PARSE(app, argc, argv);
-  options.incremental = !batch_only;
+  options.replanning.use_incremental = !batch_only;
   spdlog::set_level(spdlog::level::from_str(level));
 
   std::signal(SIGINT, on_signal);

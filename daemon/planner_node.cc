@@ -23,44 +23,12 @@ std::string upper(std::string s) {
   return s;
 }
 
-// plan_t.method names: "batch", "warm-start", "incremental", "batch after warm-start" or
-// "batch after incremental".
-std::string method_name(std::string stats_method) {
-  for (auto [from, to] : {std::pair{"batch-L", "batch"}, std::pair{"batch-W", "warm-start"}}) {
-    if (stats_method.rfind(from, 0) == 0) stats_method.replace(0, std::strlen(from), to);
-  }
-  return stats_method;
-}
-
-planning::IncrementalPlannerOptions incremental_options(const PlannerNodeOptions& options) {
-  planning::IncrementalPlannerOptions o = options.incremental_planner;
-  o.batch = options.planner;
-  return o;
-}
-
-bool same_obstacle(const collision::Obstacle& a, const collision::Obstacle& b) {
-  return a.id == b.id && a.shape.kind == b.shape.kind && a.shape.size == b.shape.size &&
-         a.shape.mesh_path == b.shape.mesh_path && a.shape.mesh_scale == b.shape.mesh_scale &&
-         a.pose.matrix() == b.pose.matrix() && a.trajectory.empty() && b.trajectory.empty();
-}
-
-// Largest joint change between two joint goals; infinity when either is not a joint goal.
-double joint_goal_change(const planning::Goal& a, const planning::Goal& b) {
-  using Kind = planning::Goal::Kind;
-  if (a.kind != Kind::kJoint || b.kind != Kind::kJoint || a.q.size() != b.q.size() ||
-      a.q.size() == 0) {
-    return std::numeric_limits<double>::infinity();
-  }
-  return (a.q - b.q).cwiseAbs().maxCoeff();
-}
-
 }  // namespace
 
 PlannerNode::PlannerNode(planning::Scene scene, PlannerNodeOptions options, lcm::LCM* shared)
     : scene_(std::move(scene)),
       options_(std::move(options)),
-      planner_(options_.planner),
-      incremental_(incremental_options(options_)) {
+      replanner_(options_.replanning) {
   if (!scene_.problem.model) throw std::invalid_argument("PlannerNode: the scene has no robot");
   identity_.model_name = scene_.problem.model->name;
   identity_.channel_prefix =
@@ -237,140 +205,6 @@ bool PlannerNode::apply_obstacles(const std::vector<ObstacleUpdate>& updates, bo
   return changed;
 }
 
-planning::Plan PlannerNode::solve_batch(const planning::Problem& problem, bool replan,
-                                        std::string& method) {
-  // An obstacle change keeps the goal: the previous plan is the natural starting point.
-  const bool warm = replan && last_plan_ && last_plan_->q.rows() == problem.steps + 1;
-  planning::Plan plan = planner_.plan(problem, warm ? &*last_plan_ : nullptr);
-  // A warm start can be trapped on the wrong side of a new obstacle; a plan from the
-  // straight line is the fallback, and its statistics say so.
-  if (warm && !plan.success()) {
-    spdlog::info("warm-started replan did not validate ({}); planning from scratch",
-                 plan.stats.reason);
-    const double warm_time = plan.stats.solve_time_s;
-    plan = planner_.plan(problem);
-    plan.stats.solve_time_s += warm_time;
-    plan.stats.method += " after warm-start";
-  }
-  method = method_name(plan.stats.method);
-  return plan;
-}
-
-planning::Plan PlannerNode::plan_from_scratch(const planning::Problem& problem,
-                                              std::string& method) {
-  planning::Plan plan = incremental_.plan(problem);
-  incremental_ready_ = plan.success();
-  if (!plan.success() && plan.stats.status != "invalid_problem") {
-    // iDFGP's first plan carries the batch planner's solution into its tree and settles it
-    // (re-solving on its own graph only when neither validates); when that still does not
-    // validate, a batch plan from scratch may (seen once in 18 medium goal changes of
-    // bench/daemon, with the earlier re-solving first plan). Answer with it; the next change then
-    // plans from scratch again.
-    planning::Plan batch = planner_.plan(problem);
-    if (batch.success()) {
-      spdlog::info("iDFGP's first plan did not validate ({}); answering with the batch plan",
-                   plan.stats.reason);
-      batch.stats.solve_time_s += plan.stats.solve_time_s;
-      plan = std::move(batch);
-    }
-  }
-  method = method_name(plan.stats.method);
-  return plan;
-}
-
-planning::Plan PlannerNode::solve_incremental(const planning::Problem& problem, bool new_goal,
-                                              bool new_state, std::string& method) {
-  bool from_scratch = !incremental_ready_ || !incremental_.has_plan() ||
-                      incremental_.problem().steps != problem.steps;
-  // Far goals. Measured with bench/daemon on the iiwa desk (20 problems, 18 with a valid first
-  // plan): independent far goals (largest joint change 1.9–5.1 rad) replanned incrementally
-  // validated 18/18 (13 directly, 4 after the planner's warm batch fallback, 1 from scratch after
-  // an earlier failure), median 97 ms end to end; the batch path (BatchPlanner from the straight
-  // line) 18/18, median 98 ms. A fallback costs about 0.5 s, but planning far goals from scratch
-  // here cost IncrementalPlanner::plan's median 236 ms every time when its first plan re-solved
-  // the batch plan on the incremental graph. Goals within 1.3 rad replanned at 23–47 ms median
-  // against 134–156 ms for the batch path. So every goal replans incrementally by default
-  // (max_incremental_goal_change = ∞); the option remains for robots where far goals fall back
-  // more often. The first plan now carries the batch solution instead (about the batch plan's
-  // time plus 10–25 ms); re-measured with it (bench/daemon --max-goal-change 1.5 against the
-  // default, 20 problems each): far goals planned from scratch on this node took a median of
-  // 63 ms (max 422 ms) against 55 ms (max 253 ms, 4 of 18 fallbacks) replanned incrementally, so
-  // the default stays.
-  if (!from_scratch && new_goal) {
-    const double change = joint_goal_change(incremental_.problem().goal, problem.goal);
-    // Pose goals have no joint distance (infinity here): they always replan incrementally.
-    if (std::isfinite(change) && change > options_.max_incremental_goal_change) {
-      spdlog::info("goal moved by {:.2f} rad (> {:.2f}): planning from scratch", change,
-                   options_.max_incremental_goal_change);
-      from_scratch = true;
-    }
-  }
-  if (from_scratch) return plan_from_scratch(problem, method);
-
-  // The change from the planner's problem to `problem`: obstacles by stable int id (fixed
-  // scene obstacles never change), the goal, the measured start, the duration.
-  planning::ProblemChange change;
-  const planning::Problem& current = incremental_.problem();
-  std::map<int, const collision::Obstacle*> planned;
-  for (const auto& o : current.obstacles) planned[o.id] = &o;
-  for (const auto& o : scene_.problem.obstacles) planned.erase(o.id);
-  for (const auto& o : problem.obstacles) {
-    const auto it = planned.find(o.id);
-    const bool fixed = std::any_of(scene_.problem.obstacles.begin(), scene_.problem.obstacles.end(),
-                                   [&](const collision::Obstacle& f) { return f.id == o.id; });
-    if (fixed) continue;
-    if (it == planned.end() || !same_obstacle(*it->second, o)) change.add_or_move.push_back(o);
-    if (it != planned.end()) planned.erase(it);
-  }
-  for (const auto& [id, o] : planned) change.remove.push_back(id);
-  if (new_goal) change.goal = problem.goal;
-  if (new_state) {
-    change.start_q = problem.start_q;
-    change.start_qd = problem.start_qd;
-  }
-  if (problem.horizon != current.horizon) change.horizon = problem.horizon;
-
-  planning::Plan plan = incremental_.replan(change);
-  // replan() reports a fallback by its batch method (last_stats() is not reset when a change is
-  // refused before it is applied, so the plan's own method is the reliable sign).
-  const bool fell_back = plan.stats.method != "incremental";
-  const planning::IncrementalStats& st = incremental_.last_stats();
-  method = fell_back ? "batch after incremental" : "incremental";
-  const bool refused = !fell_back && plan.stats.status == "invalid_problem";
-  // A refused change left the planner as it was: it can still replan. Any other failure leaves
-  // it at a trajectory that did not validate, a poor start for the next change: plan the next
-  // goal or obstacle change from scratch.
-  incremental_ready_ = plan.success() || (refused && incremental_ready_);
-  {
-    std::lock_guard lock(mutex_);
-    if (!refused) ++counters_.incremental;
-    if (fell_back) ++counters_.fallbacks;
-  }
-  if (!refused) {
-    spdlog::info(
-        "iDFGP: {} ISAM2 updates, {} multiplier rounds, {} cliques re-eliminated, factors {} "
-        "replaced + {} added, {:.1f} ms incremental{}",
-        st.updates, st.rounds, st.cliques_reeliminated, st.factors_replaced, st.factors_added,
-        st.incremental_time_s * 1e3,
-        fell_back ? fmt::format(", fell back ({}) {:.1f} ms", st.fallback_reason,
-                                st.fallback_time_s * 1e3)
-                  : "");
-  }
-  // The planner's own fallback is warm-started from the previous plan, which a far goal or an
-  // obstacle across the path can leave on the wrong side; a solve from scratch (straight line
-  // and detours) is the last resort before answering with a failure.
-  if (!plan.success() && !refused && options_.retry_from_scratch) {
-    spdlog::info("replan did not validate ({}); planning from scratch", plan.stats.reason);
-    const double spent = plan.stats.solve_time_s;
-    std::string unused;
-    planning::Plan fresh = plan_from_scratch(problem, unused);
-    fresh.stats.solve_time_s += spent;
-    method = "batch after incremental";
-    return fresh;
-  }
-  return plan;
-}
-
 void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan) {
   planning::Problem problem = scene_.problem;
   bool new_state = false;
@@ -390,17 +224,15 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan) {
   if (goal.duration_s > 0) problem.horizon = goal.duration_s;
 
   planning::Plan plan;
-  std::string method;
   bool threw = false;
   std::string error;
   try {
-    plan = options_.incremental ? solve_incremental(problem, !replan, new_state, method)
-                                : solve_batch(problem, replan, method);
+    plan = replanner_.plan(problem, /*new_goal=*/!replan);
   } catch (const std::exception& e) {
     threw = true;
     error = e.what();
-    incremental_ready_ = false;
   }
+  const planning::ReplanReport& report = replanner_.last_report();
   // A state the incremental planner refused (or never saw, after an exception) is offered again.
   if (threw || !plan.success()) {
     std::lock_guard lock(mutex_);
@@ -414,6 +246,8 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan) {
     last_plan_id_ = plan_id;
     ++counters_.plans_published;
     if (replan) ++counters_.replans;
+    if (!threw && report.incremental) ++counters_.incremental;
+    if (!threw && report.fell_back) ++counters_.fallbacks;
     if (threw || !plan.success()) ++counters_.failures;
     state_ = threw ? planner_status_t::ERROR : planner_status_t::IDLE;
     last_message_ = threw ? error : (plan.success() ? "" : plan.stats.reason);
@@ -426,11 +260,10 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan) {
   } else {
     msg = plan_to_message(plan, *problem.model, identity_.model_name, plan_id, goal.goal_id,
                           now_utime());
-    msg.method = method;
+    msg.method = report.method;
     spdlog::info("goal {}: plan {} {} ({}, {} iterations, {:.1f} ms)", goal.goal_id, plan_id,
                  plan.success() ? "valid" : "INVALID", msg.method, plan.stats.iterations,
                  plan.stats.solve_time_s * 1e3);
-    if (plan.success()) last_plan_ = std::move(plan);
   }
   lcm_->publish(channel("PLAN"), &msg);
   publish_status();

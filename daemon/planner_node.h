@@ -3,13 +3,9 @@
 // obstacle updates and measured states, plans off the LCM thread (the newest goal wins), and
 // answers every goal with a plan_t — a trajectory or a failure status with its reason.
 //
-// Replanning (iDFGP). The node keeps one planning::IncrementalPlanner. The first goal, and any
-// goal after a plan that failed, is planned from scratch (batch solve, plan_t.method "batch");
-// after that a new goal, an obstacle added / moved / removed, a newly measured start state or a
-// new duration is applied as a ProblemChange to the current plan ("incremental"), and a replan
-// that does not validate is redone by a warm-started batch solve ("batch after incremental").
-// With PlannerNodeOptions::incremental off every plan is a batch solve, warm-started from the
-// current plan after an obstacle change ("warm-start", "batch after warm-start").
+// Which plans are incremental replans and what answers a plan that does not validate is the
+// planning::Replanner's policy; plan_t.method names the path that answered ("batch",
+// "incremental", "batch after incremental", "warm-start", "batch after warm-start").
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
@@ -22,9 +18,8 @@
 #include <vector>
 
 #include "daemon/message_convert.h"
-#include "kinograph/planning/batch/batch_planner.h"
-#include "kinograph/planning/incremental/incremental_planner.h"
 #include "kinograph/planning/io/scene.h"
+#include "kinograph/planning/replanner.h"
 
 namespace lcm {
 class LCM;
@@ -45,21 +40,8 @@ struct PlannerNodeOptions {
   std::string channel_prefix;
   /// Period of the planner_status_t heartbeat (s).
   double status_period_s = 1.0;
-  /// Options of the batch planner: every batch solve, including the incremental planner's first
-  /// plans and fallbacks (they replace incremental_planner.batch).
-  planning::BatchPlannerOptions planner;
-  /// Replan incrementally (iDFGP) after the first plan; false = every plan is a batch solve (the
-  /// node's behaviour before iDFGP, kept for comparison and as a conservative mode).
-  bool incremental = true;
-  /// Options of the incremental planner (ISAM2, penalty, stopping rule, fallback).
-  planning::IncrementalPlannerOptions incremental_planner;
-  /// A new joint goal farther than this from the current plan's goal (largest joint change,
-  /// rad) is planned from scratch instead of incrementally; pose goals always replan
-  /// incrementally. Infinity = always incremental; see the measurement in planner_node.cc.
-  double max_incremental_goal_change = std::numeric_limits<double>::infinity();
-  /// When a replan does not validate even after the incremental planner's warm-started
-  /// fallback, plan the same request once more from scratch before answering.
-  bool retry_from_scratch = true;
+  /// The planners and the replanning policy (incremental or batch only, fallbacks).
+  planning::ReplannerOptions replanning;
 };
 
 /// What a node has done since it started (for its status and for tests).
@@ -104,15 +86,6 @@ class PlannerNode {
   void worker_loop(const std::atomic<bool>& stop);
   bool apply_obstacles(const std::vector<ObstacleUpdate>& updates, bool replace_all);
   void plan_and_publish(const GoalRequest& goal, bool replan);
-  /// The batch path: from scratch, or warm-started from the current plan for a replan.
-  planning::Plan solve_batch(const planning::Problem& problem, bool replan, std::string& method);
-  /// A plan from scratch that also becomes the incremental planner's current plan (when it
-  /// validates on the planner's graph).
-  planning::Plan plan_from_scratch(const planning::Problem& problem, std::string& method);
-  /// The incremental path: a ProblemChange from the planner's problem to `problem` when the
-  /// planner holds a usable plan, else a plan from scratch.
-  planning::Plan solve_incremental(const planning::Problem& problem, bool new_goal, bool new_state,
-                                   std::string& method);
   void publish_status();
   int64_t now_utime() const;
 
@@ -122,7 +95,6 @@ class PlannerNode {
   std::unique_ptr<lcm::LCM> owned_lcm_;
   lcm::LCM* lcm_ = nullptr;
   std::vector<lcm::Subscription*> subscriptions_;
-  planning::BatchPlanner planner_;
 
   // Shared between the LCM thread and the worker, under mutex_.
   mutable std::mutex mutex_;
@@ -143,11 +115,7 @@ class PlannerNode {
   std::map<std::string, collision::Obstacle> live_obstacles_;
   int next_obstacle_id_ = 0;
   std::optional<GoalRequest> current_goal_;
-  std::optional<planning::Plan> last_plan_;
-  planning::IncrementalPlanner incremental_;
-  // The incremental planner's plan may be changed: it validated, or a change was refused
-  // before it touched the planner's state (invalid goal). False after any other failure.
-  bool incremental_ready_ = false;
+  planning::Replanner replanner_;
   std::uint64_t used_state_count_ = 0;  // state_count_ when the planner's start was last set
 };
 

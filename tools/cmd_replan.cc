@@ -8,10 +8,10 @@
 #include <memory>
 #include <string>
 
-#include "kinograph/planning/incremental/incremental_planner.h"
 #include "kinograph/planning/io/plan_json.h"
 #include "kinograph/planning/io/replan_change.h"
 #include "kinograph/planning/io/scene.h"
+#include "kinograph/planning/replanner.h"
 #include "tools/command_registry.h"
 
 namespace kinograph::tools {
@@ -23,17 +23,18 @@ struct ReplanArgs {
   bool quiet = false;
 };
 
-std::string describe(const planning::IncrementalStats& s, const planning::Plan& plan) {
+std::string describe(const planning::ReplanReport& r, const planning::Plan& plan) {
+  const planning::IncrementalStats& s = r.statistics;
   char buf[512];
   std::snprintf(buf, sizeof buf,
                 "replan: method %s%s, %d ISAM2 updates, %d multiplier rounds, %ld cliques "
                 "re-eliminated, %ld variables relinearized, %d factors replaced, %d added, "
-                "%d re-added; incremental %.1f ms, fallback %.1f ms, total %.1f ms\n",
-                s.method.c_str(),
-                s.fell_back ? " (fell back: the incremental plan did not validate)" : "", s.updates,
-                s.rounds, s.cliques_reeliminated, s.variables_relinearized, s.factors_replaced,
-                s.factors_added, s.factors_readded, s.incremental_time_s * 1e3,
-                s.fallback_time_s * 1e3, plan.stats.solve_time_s * 1e3);
+                "%d re-added; incremental %.1f ms, total %.1f ms\n",
+                r.method.c_str(),
+                r.fell_back ? " (fell back: the incremental plan did not validate)" : "",
+                s.updates, s.rounds, s.cliques_reeliminated, s.variables_relinearized,
+                s.factors_replaced, s.factors_added, s.factors_readded,
+                s.incremental_time_s * 1e3, plan.stats.solve_time_s * 1e3);
   return buf;
 }
 
@@ -46,8 +47,8 @@ void run_replan(const ReplanArgs& args) {
   } catch (const std::exception& e) {
     throw CommandFailure(e.what());
   }
-  planning::IncrementalPlanner planner;
-  const planning::Plan before = planner.plan(scene.problem);
+  planning::Replanner planner;
+  const planning::Plan before = planner.plan(scene.problem, /*new_goal=*/true);
   if (!args.quiet) {
     std::cout << "plan " << scene.problem.name << " (" << args.scene << ")\n"
               << planning::summarize(before);
@@ -65,7 +66,7 @@ void run_replan(const ReplanArgs& args) {
   const planning::Plan after = planner.replan(change.change);
   if (!args.quiet) {
     std::cout << "\nreplan after " << args.change << "\n"
-              << describe(planner.last_stats(), after) << planning::summarize(after);
+              << describe(planner.last_report(), after) << planning::summarize(after);
   }
   try {
     if (!args.out_after.empty()) {

@@ -196,8 +196,8 @@ int main(int argc, char** argv) {
       daemon::PlannerNodeOptions options;
       options.channel_prefix = "IIWA";
       options.status_period_s = 10;
-      options.incremental = mode == "incremental";
-      options.max_incremental_goal_change = max_goal_change;
+      options.replanning.use_incremental = mode == "incremental";
+      options.replanning.max_incremental_goal_change = max_goal_change;
       daemon::PlannerNode node(scene, options, &lcm);
       Client client(lcm);
       std::atomic<bool> stop{false};

@@ -23,7 +23,7 @@
 #include "bench/common/iiwa_goals.h"
 #include "kinograph/planning/batch/batch_planner.h"
 #include "kinograph/planning/goal_sampler.h"
-#include "kinograph/planning/incremental/incremental_planner.h"
+#include "kinograph/planning/replanner.h"
 #include "kinograph/planning/io/scene.h"
 
 namespace kinograph::bench {
@@ -85,7 +85,6 @@ struct Method {
 
 struct Row {
   Method L, W, inc;
-  Method stiff;  // iDFGP with the other penalty cap (alt_penalty()), no fallback
   int problems = 0, first_failed = 0, no_change = 0;
   std::vector<double> first_cost;  // per first plan: its soft cost, NaN where it failed
 };
@@ -97,30 +96,21 @@ json row_json(const Row& r) {
           {"no_nearby_change", r.no_change},
           {"DFGP-L", r.L.to_json()},
           {"DFGP-W", r.W.to_json()},
-          {"iDFGP", r.inc.to_json()},
-          {"iDFGP_other_penalty_cap", r.stiff.to_json()}};
-}
-
-// The penalty cap the comparison row uses: a moderate 1e4 when the planner keeps the batch's
-// penalty, else the batch's.
-double alt_penalty(const planning::IncrementalPlannerOptions& io) {
-  const double batch_cap = io.batch.augmented_lagrangian.max_penalty;
-  return io.max_penalty >= batch_cap ? 1e4 : batch_cap;
+          {"iDFGP", r.inc.to_json()}};
 }
 
 // Plans `first`, applies `change` to a copy for the batch methods, and replans with all three.
 void replan_all(Row& row, const Problem& first_problem, const Problem& changed,
-                const planning::ProblemChange& change,
-                const planning::IncrementalPlannerOptions& io, bool stiff) {
+                const planning::ProblemChange& change, const planning::ReplannerOptions& ro) {
   ++row.problems;
-  planning::IncrementalPlanner planner(io);
-  const Plan first = planner.plan(first_problem);
+  planning::Replanner planner(ro);
+  const Plan first = planner.plan(first_problem, /*new_goal=*/true);
   row.first_cost.push_back(first.success() ? first.stats.cost : std::nan(""));
   if (!first.success()) {
     ++row.first_failed;
     return;
   }
-  const planning::BatchPlanner batch;
+  const planning::BatchPlanner batch(ro.incremental.batch);
   auto t0 = Clock::now();
   const Plan l = batch.plan(changed);
   row.L.add(l, seconds_since(t0));
@@ -130,34 +120,24 @@ void replan_all(Row& row, const Problem& first_problem, const Problem& changed,
   t0 = Clock::now();
   const Plan inc = planner.replan(change);
   row.inc.add(inc, seconds_since(t0));
-  const auto& st = planner.last_stats();
-  row.inc.updates.push_back(st.updates);
-  if (st.fell_back) ++row.inc.fell_back;
-  if (inc.success() && !st.fell_back) ++row.inc.incremental_ok;
-  if (!stiff) return;
-  // The same replan with the other penalty cap and without fallback: the warning about
-  // Gauss–Newton on a stiff graph (μ up to the batch's 1e7), measured against a moderate cap.
-  planning::IncrementalPlannerOptions so = io;
-  so.max_penalty = alt_penalty(io);
-  so.fallback = false;
-  planning::IncrementalPlanner stiff_planner(so);
-  if (!stiff_planner.plan(first_problem).success()) return;
-  t0 = Clock::now();
-  const Plan s = stiff_planner.replan(change);
-  row.stiff.add(s, seconds_since(t0));
-  row.stiff.updates.push_back(stiff_planner.last_stats().updates);
-  if (s.success()) ++row.stiff.incremental_ok;
+  const planning::ReplanReport& report = planner.last_report();
+  row.inc.updates.push_back(report.statistics.updates);
+  if (report.fell_back) ++row.inc.fell_back;
+  if (inc.success() && !report.fell_back) ++row.inc.incremental_ok;
 }
 
 int run(int argc, char** argv) {
   int problems = 50, obstacle_problems = -1;
   double radius = 0.2, shift = 0.05;
-  bool stiff = true;
   double limit_epsilon = -1;  // < 0: the scenes' own
   int only = -1;              // >= 0: replan only this problem of each row (debugging)
   std::string json_path;
   spdlog::level::level_enum log_level = spdlog::level::warn;
-  planning::IncrementalPlannerOptions io;
+  // iDFGP as Table II measures it: the incremental replan, and the warm-started batch solve
+  // when it does not validate (no further retry from scratch).
+  planning::ReplannerOptions ro;
+  ro.retry_from_scratch = false;
+  planning::IncrementalPlannerOptions& io = ro.incremental;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--problems" && i + 1 < argc) {
@@ -168,29 +148,12 @@ int run(int argc, char** argv) {
       radius = std::stod(argv[++i]);
     } else if (a == "--shift" && i + 1 < argc) {
       shift = std::stod(argv[++i]);
-    } else if (a == "--no-stiff") {
-      stiff = false;
     } else if (a == "--json" && i + 1 < argc) {
       json_path = argv[++i];
-    } else if (a == "--final-tol" && i + 1 < argc) {
-      io.final_relative_error_tol = std::stod(argv[++i]);
-    } else if (a == "--tol" && i + 1 < argc) {
-      io.relative_error_tol = std::stod(argv[++i]);
-    } else if (a == "--relinearize-threshold" && i + 1 < argc) {
-      io.isam2.relinearize_threshold = std::stod(argv[++i]);
-      io.relinearize_all = false;
-    } else if (a == "--max-force-ratio" && i + 1 < argc) {
-      io.max_force_ratio = std::stod(argv[++i]);
-    } else if (a == "--max-penalty" && i + 1 < argc) {
-      io.max_penalty = std::stod(argv[++i]);
-    } else if (a == "--stop-rise" && i + 1 < argc) {
-      io.stop_objective_rise = std::stod(argv[++i]);
     } else if (a == "--polish-objective") {
-      io.stop_when_valid = false;
+      io.stop_at_first_valid = false;
     } else if (a == "--no-linearize-at-evaluation") {
       io.isam2.linearize_at_evaluation = false;
-    } else if (a == "--stop-tol" && i + 1 < argc) {
-      io.stop_objective_tol = std::stod(argv[++i]);
     } else if (a == "--lambda-initial" && i + 1 < argc) {
       io.isam2.lambda_initial = std::stod(argv[++i]);
     } else if (a == "--lambda-min" && i + 1 < argc) {
@@ -201,18 +164,13 @@ int run(int argc, char** argv) {
       limit_epsilon = std::stod(argv[++i]);
     } else if (a == "--only" && i + 1 < argc) {
       only = std::stoi(argv[++i]);
-    } else if (a == "--no-polish") {
-      io.polish = false;
     } else if (a == "--log-level" && i + 1 < argc) {
       log_level = spdlog::level::from_str(argv[++i]);
     } else {
       std::cerr << "usage: replanning_bench [--problems 50] [--obstacle-problems N] "
-                   "[--radius 0.2] [--shift 0.05] [--no-stiff] [--json FILE] "
-                   "[--log-level warn|info|debug|trace] [--tol 1e-2] [--final-tol 1e-4] "
-                   "[--relinearize-threshold X (instead of relinearizing all)] [--no-polish] "
-                   "[--polish-objective] [--max-penalty 1e4] [--max-force-ratio 0.1] "
-                   "[--stop-rise 0.25] "
-                   "[--no-linearize-at-evaluation] [--stop-tol 1e-2] [--lambda-initial 1e-2] "
+                   "[--radius 0.2] [--shift 0.05] [--json FILE] "
+                   "[--log-level warn|info|debug|trace] [--polish-objective] "
+                   "[--no-linearize-at-evaluation] [--lambda-initial 1e-2] "
                    "[--lambda-decrease 100] [--lambda-min 1e-7] [--limit-epsilon X] [--only I]\n";
       return 1;
     }
@@ -243,7 +201,7 @@ int run(int argc, char** argv) {
       change.goal->q = *next;
       Problem changed = first;
       changed.goal = *change.goal;
-      replan_all(row, first, changed, change, io, stiff);
+      replan_all(row, first, changed, change, ro);
       std::cerr << tasks[t][0] << " " << i << ": L " << row.L.ok << " W " << row.W.ok << " iDFGP "
                 << row.inc.ok << " / " << row.L.runs << "\n";
     }
@@ -279,7 +237,7 @@ int run(int argc, char** argv) {
       }
       planning::ProblemChange change;
       change.add_or_move.push_back(o);
-      replan_all(moved, first, changed, change, io, stiff);
+      replan_all(moved, first, changed, change, ro);
       std::cerr << "obstacle move " << i << ": L " << moved.L.ok << " W " << moved.W.ok << " iDFGP "
                 << moved.inc.ok << " / " << moved.L.runs << "\n";
     }
@@ -290,8 +248,6 @@ int run(int argc, char** argv) {
       {"obstacle_problems", obstacle_problems},
       {"goal_change_radius_rad", radius},
       {"desk_shift_m", shift},
-      {"max_penalty", io.max_penalty},
-      {"other_penalty_cap", stiff ? alt_penalty(io) : 0.0},
       {"time", "wall time of the replanning call (build, solve, validate, fallback)"},
       {"success", "the plan validates (planning::validate)"},
       {"total_torque", "sum over states and joints of |tau| (N·m), mean over successes"}};
@@ -318,16 +274,6 @@ int run(int argc, char** argv) {
                 << " | " << cell(max_of(x.ok_times), 1e3, 1) << " | " << cell(mean(x.torque), 1, 0)
                 << " | " << paper[r][m] << " | " << paper_t[r][m] << " |\n";
     }
-  }
-  for (int r = 0; r < 3; ++r) {
-    const Method& x = all[r]->stiff;
-    if (x.runs == 0) continue;
-    std::cout << "| " << names[r] << " | iDFGP, μ ≤ " << alt_penalty(io) << " (no fallback) | "
-              << x.ok << "/" << x.runs << " ("
-              << cell(x.runs ? double(x.ok) / x.runs : std::nan(""), 100) << " %) | "
-              << cell(mean(x.ok_times), 1e3, 1) << " | " << cell(median(x.ok_times), 1e3, 1)
-              << " | " << cell(max_of(x.ok_times), 1e3, 1) << " | " << cell(mean(x.torque), 1, 0)
-              << " | – | – |\n";
   }
   for (int r = 0; r < 3; ++r) {
     const Method& x = all[r]->inc;

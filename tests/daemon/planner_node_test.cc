@@ -440,9 +440,9 @@ TEST_F(ReplanFixture, InvalidGoalAfterAPlanKeepsServing) {
 // the next goal: it is planned from scratch and validates.
 TEST_F(ReplanFixture, AFailedReplanIsFollowedByAPlanFromScratch) {
   PlannerNodeOptions options;
-  options.incremental_planner.max_updates = 0;
-  options.incremental_planner.fallback = false;
-  options.retry_from_scratch = false;
+  options.replanning.incremental.max_updates = 0;
+  options.replanning.fallback = false;
+  options.replanning.retry_from_scratch = false;
   start_reach(options);
   ASSERT_EQ(plan_goal(1, kGoal, 1).status, plan_t::SUCCESS);
   const plan_t failed = plan_goal(2, Eigen::Vector2d(0.9, 0.5), 2);
@@ -459,8 +459,8 @@ TEST_F(ReplanFixture, AFailedReplanIsFollowedByAPlanFromScratch) {
 // and answered with a valid plan.
 TEST_F(ReplanFixture, AFailedReplanIsRetriedFromScratch) {
   PlannerNodeOptions options;
-  options.incremental_planner.max_updates = 0;
-  options.incremental_planner.fallback = false;
+  options.replanning.incremental.max_updates = 0;
+  options.replanning.fallback = false;
   start_reach(options);
   ASSERT_EQ(plan_goal(1, kGoal, 1).status, plan_t::SUCCESS);
   const Eigen::Vector2d goal(0.9, 0.5);
@@ -475,7 +475,7 @@ TEST_F(ReplanFixture, AFailedReplanIsRetriedFromScratch) {
 // planned from scratch (the node before iDFGP).
 TEST_F(ReplanFixture, BatchModeWarmStartsObstacleReplans) {
   PlannerNodeOptions options;
-  options.incremental = false;
+  options.replanning.use_incremental = false;
   start_reach(options);
   const plan_t first = plan_goal(1, kGoal, 1);
   ASSERT_EQ(first.status, plan_t::SUCCESS);

@@ -156,7 +156,7 @@ TEST(BatchPlanner, ImpossibleProblemsFailCleanly) {
     weak->bodies[1].limits.effort = 0.2;
     p.model = weak;
     BatchPlannerOptions o;
-    o.max_total_iterations = 150;
+    o.outer_loop.max_total_iterations = 150;
     const Plan plan = BatchPlanner(o).plan(p);
     EXPECT_FALSE(plan.success());
     EXPECT_EQ(plan.stats.status, "infeasible");

@@ -266,9 +266,10 @@ TEST(DfgBuilder, ConstraintStepMatchesCondensedRows) {
       }
     }
     for (const auto& f : s.factors) {
-      f->set_penalty(30.0);
-      f->set_multipliers(uniform(rng, f->residual_dim(), 1.0),
-                         uniform(rng, f->residual_dim(), 1.0).cwiseAbs());
+      auto m = std::make_shared<Multipliers>(f->residual_dim(), 30.0);
+      m->lower = uniform(rng, f->residual_dim(), 1.0);
+      m->upper = uniform(rng, f->residual_dim(), 1.0).cwiseAbs();
+      f->bind(m);
       const auto check = graph::testing::check_jacobians(*f, values);
       EXPECT_TRUE(check.ok) << f->name() << "\n" << check.report();
     }
@@ -305,7 +306,16 @@ TEST(DfgBuilder, ConstrainedSingleStepAgreesWithCondensed) {
       graph.add(f);
       constraints.push_back(f);
     }
-    AugmentedLagrangian al(constraints);
+    std::vector<FactorEntry> entries;
+    for (size_t i = 0; i < constraints.size(); ++i) {
+      entries.push_back(make_entry(constraints[i], {FactorRole::kDynamics, 0, static_cast<int>(i)}));
+    }
+    std::vector<const FactorEntry*> tracked;
+    for (const FactorEntry& e : entries) {
+      if (e.constrained->has_constraints()) tracked.push_back(&e);
+    }
+    ConstraintState state;
+    AugmentedLagrangian al(tracked, state);
     graph::LevenbergMarquardtOptions lm_options;
     lm_options.relative_error_tol = 1e-10;
     graph::LevenbergMarquardt lm(lm_options);
@@ -359,13 +369,15 @@ TEST(DfgBuilder, WholeTrajectoryAgreesWithCondensed) {
       }
       // 4·nq equation factors + the torque rows per step, all constraints.
       size_t dfg_constraints = 0;
-      for (const auto& c : pg.constraints) {
-        dfg_constraints += dynamic_cast<const DfgConstraintFactor*>(c.get()) != nullptr ||
-                           dynamic_cast<const DfgTorqueRowsFactor*>(c.get()) != nullptr;
+      for (const FactorEntry* e : pg.constraints(false)) {
+        const ConstrainedFactor* c = e->constrained.get();
+        dfg_constraints += dynamic_cast<const DfgConstraintFactor*>(c) != nullptr ||
+                           dynamic_cast<const DfgTorqueRowsFactor*>(c) != nullptr;
       }
       EXPECT_EQ(dfg_constraints, (problem.steps + 1) * (4u * model.nq() + 1));
     }
-    AugmentedLagrangian al(pg.constraints);
+    ConstraintState state;
+    AugmentedLagrangian al(pg.constraints(false), state);
     graph::LevenbergMarquardtOptions lm_options;
     lm_options.relative_error_tol = 1e-12;
     lm_options.max_iterations = 100;

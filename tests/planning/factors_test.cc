@@ -19,6 +19,15 @@ namespace kinograph::planning {
 namespace {
 
 using graph::testing::check_jacobians;
+
+// Binds `f` to its own multipliers record at penalty μ (zero multipliers unless given).
+void bind(ConstrainedFactor& f, double mu, const Eigen::VectorXd& lower = {},
+          const Eigen::VectorXd& upper = {}) {
+  auto m = std::make_shared<Multipliers>(f.residual_dim(), mu);
+  if (lower.size() > 0) m->lower = lower;
+  if (upper.size() > 0) m->upper = upper;
+  f.bind(m);
+}
 using graph::testing::JacobianCheckOptions;
 
 std::shared_ptr<const dynamics::Model> load(const std::string& rel) {
@@ -98,7 +107,7 @@ TEST(TrajectoryFactors, Jacobians) {
   auto c = check_jacobians(gp, v);
   EXPECT_TRUE(c.ok) << c.report();
   CollocationFactor col(0, n, 0.1);
-  col.set_penalty(7.0);
+  bind(col, 7.0);
   c = check_jacobians(col, v, {1e-6, 1e-5, true});
   EXPECT_TRUE(c.ok) << c.report();
   c = check_jacobians(col, v);
@@ -107,10 +116,9 @@ TEST(TrajectoryFactors, Jacobians) {
   std::vector<StateLimitFactor::Limit> limits = {
       {0, 0, -0.5, 0.5}, {1, 1, -2, 2}, {2, 2, -0.1, 0.1}, {0, 2, -3, 3}};
   StateLimitFactor lim(0, n, limits, 0.5);
-  lim.set_penalty(3);
   Eigen::VectorXd lam = Eigen::VectorXd::Zero(4), lam_u = Eigen::VectorXd::Zero(4);
   lam[3] = 0.2;
-  lim.set_multipliers(lam, lam_u);
+  bind(lim, 3, lam, lam_u);
   v.update(q_key(0), Eigen::Vector3d(0.8, 0.1, 0.2));
   v.update(a_key(0), Eigen::Vector3d(0.1, 0.1, -0.4));
   c = check_jacobians(lim, v, {1e-6, 1e-5, true});
@@ -130,7 +138,7 @@ TEST(TrajectoryFactors, LinearFactorsHaveConstantJacobians) {
   const int n = 3;
   const graph::Values a = random_states(n, 1, rng, 2.0), b = random_states(n, 1, rng, 2.0);
   auto col = std::make_shared<CollocationFactor>(0, n, 0.1);
-  col->set_penalty(7.0);
+  bind(*col, 7.0);
   auto target = std::make_shared<StateTargetFactor>(std::vector<graph::Key>{q_key(1)}, n,
                                                     Eigen::Vector3d(0.1, 0.2, 0.3), 0.01);
   const std::vector<std::shared_ptr<graph::Factor>> linear = {
@@ -146,9 +154,9 @@ TEST(TrajectoryFactors, LinearFactorsHaveConstantJacobians) {
     EXPECT_EQ(Ja, Jb) << f->name();
   }
   const long v = col->jacobian_version();
-  col->set_penalty(7.0);
+  bind(*col, 7.0);
   EXPECT_EQ(col->jacobian_version(), v);
-  col->set_penalty(70.0);
+  bind(*col, 70.0);
   EXPECT_NE(col->jacobian_version(), v);
   const long w = linear[0]->jacobian_version();
   linear[0]->set_noise(std::make_shared<graph::IsotropicNoise>(3 * n, 0.5));
@@ -166,14 +174,14 @@ TEST(ConstrainedFactor, MultiplierUpdateClipsInequalities) {
   graph::Values v = random_states(1, 0, rng);
   v.update(q_key(0), Eigen::VectorXd::Constant(1, 0.2));
   StateLimitFactor lim(0, 1, {{0, 0, -1, 1}});
-  lim.set_penalty(10);
-  lim.update_multipliers(v);  // inside: multipliers stay 0
-  EXPECT_EQ(lim.multipliers()[0], 0);
-  EXPECT_EQ(lim.multipliers_upper()[0], 0);
+  Multipliers m(1, 10);
+  lim.update_multipliers(v, m);  // inside: multipliers stay 0
+  EXPECT_EQ(m.lower[0], 0);
+  EXPECT_EQ(m.upper[0], 0);
   v.update(q_key(0), Eigen::VectorXd::Constant(1, 1.5));
-  lim.update_multipliers(v);
-  EXPECT_NEAR(lim.multipliers_upper()[0], 10 * 0.5, 1e-12);
-  EXPECT_EQ(lim.multipliers()[0], 0);
+  lim.update_multipliers(v, m);
+  EXPECT_NEAR(m.upper[0], 10 * 0.5, 1e-12);
+  EXPECT_EQ(m.lower[0], 0);
 }
 
 TEST(DynamicsStepFactor, JacobiansOnIiwaWithPayloadAndAcrobot) {
@@ -189,7 +197,7 @@ TEST(DynamicsStepFactor, JacobiansOnIiwaWithPayloadAndAcrobot) {
     o.torque_scale = 2.0;
     auto ws = std::make_shared<dynamics::Data>(*model);
     DynamicsStepFactor f(0, model, ws, o);
-    f.set_penalty(5);
+    bind(f, 5);
     auto c = check_jacobians(f, v, {1e-6, 1e-5, false});
     EXPECT_TRUE(c.ok) << c.report();
     // Raw rows are the inverse-dynamics torques.

@@ -12,10 +12,10 @@ namespace {
 // with a loose objective tolerance, where two solvers' plans may differ along the flat objective.
 BatchPlannerOptions tight() {
   BatchPlannerOptions o;
-  o.constraint_tolerance = 1e-5;
-  o.inner_tolerance_final = 1e-8;
-  o.max_outer_iterations = 30;
-  o.max_total_iterations = 1500;
+  o.outer_loop.constraint_tolerance = 1e-5;
+  o.outer_loop.inner_tolerance_final = 1e-8;
+  o.outer_loop.max_outer_iterations = 30;
+  o.outer_loop.max_total_iterations = 1500;
   return o;
 }
 

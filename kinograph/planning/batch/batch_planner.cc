@@ -6,35 +6,10 @@
 #include <cmath>
 #include <sstream>
 
-#include "kinograph/collision/collision_world.h"
-#include "kinograph/dynamics/inverse_dynamics.h"
-#include "kinograph/dynamics/kinematics.h"
-#include "kinograph/graph/levenberg_marquardt.h"
 #include "kinograph/planning/formulation/initialization.h"
 
 namespace kinograph::planning {
 namespace {
-
-std::string joint_list_outside(const dynamics::Model& model, const Eigen::VectorXd& q,
-                               const char* what) {
-  std::ostringstream os;
-  for (int j = 0; j < model.nq(); ++j) {
-    const auto& l = model.bodies[j].limits;
-    if (q[j] < l.lower || q[j] > l.upper) {
-      os << what << " joint '" << model.bodies[j].joint_name << "' = " << q[j] << " is outside ["
-         << l.lower << ", " << l.upper << "]; ";
-    }
-  }
-  return os.str();
-}
-
-double min_clearance(const Problem& problem, const Eigen::VectorXd& q) {
-  collision::CollisionWorld world(*problem.model);
-  for (const auto& o : problem.obstacles) world.add_obstacle(o);
-  dynamics::Data data(*problem.model);
-  dynamics::forward_kinematics(*problem.model, data, q);
-  return world.closest(data, 0).distance;
-}
 
 Plan failed_plan(const Problem& problem, const std::string& status, const std::string& reason) {
   Plan plan;
@@ -51,53 +26,14 @@ Plan failed_plan(const Problem& problem, const std::string& status, const std::s
 
 std::string to_string(Formulation f) { return f == Formulation::kCondensed ? "condensed" : "dfg"; }
 
-std::string check_problem(const Problem& p) {
-  if (!p.model) return "problem has no robot model";
-  const dynamics::Model& model = *p.model;
-  const int n = model.nq();
-  if (p.steps < 1) return "steps must be at least 1";
-  if (!(p.horizon > 0) || !std::isfinite(p.horizon)) return "horizon must be positive and finite";
-  if (p.start_q.size() != n)
-    return "start_q has " + std::to_string(p.start_q.size()) + " entries, the robot has " +
-           std::to_string(n) + " joints";
-  if (p.start_qd.size() != 0 && p.start_qd.size() != n) return "start_qd has the wrong size";
-  if (!p.start_q.allFinite() || !p.start_qd.allFinite()) return "start state holds NaN or inf";
-  if (!(p.objectives.qc > 0) || !std::isfinite(p.objectives.qc)) return "Qc must be positive";
-  if (!(p.objectives.min_torque >= 0) || !(p.objectives.collision_epsilon >= 0) ||
-      !(p.objectives.limit_epsilon >= 0))
-    return "objective weights and margins must be non-negative numbers";
-  std::string r = joint_list_outside(model, p.start_q, "start");
-  if (!r.empty()) return r;
-  if (p.goal.kind == Goal::Kind::kJoint) {
-    if (p.goal.q.size() != n) return "joint goal has the wrong size";
-    if (!p.goal.q.allFinite()) return "joint goal holds NaN or inf";
-    r = joint_list_outside(model, p.goal.q, "goal");
-    if (!r.empty()) return r;
-  } else {
-    if (!p.goal.pose.matrix().allFinite()) return "goal pose holds NaN or inf";
-    try {
-      model.frame_index(p.goal.frame);
-    } catch (const std::out_of_range&) {
-      return "goal frame '" + p.goal.frame + "' is not in the model";
-    }
+OuterLoopOptions outer_loop_options(const BatchPlannerOptions& options) {
+  OuterLoopOptions loop = options.outer_loop;
+  if (options.formulation == Formulation::kDynamicFactorGraph) {
+    loop.constraint_tolerance = std::min(loop.constraint_tolerance, options.dfg_constraint_tolerance);
+    loop.inner_tolerance_final =
+        std::min(loop.inner_tolerance_final, options.dfg_inner_tolerance_final);
   }
-  for (const auto& t : p.task_constraints) {
-    try {
-      model.frame_index(t.frame);
-    } catch (const std::out_of_range&) {
-      return "task-constraint frame '" + t.frame + "' is not in the model";
-    }
-  }
-  if (!p.obstacles.empty()) {
-    try {
-      if (min_clearance(p, p.start_q) < 0) return "the start configuration is in collision";
-      if (p.goal.kind == Goal::Kind::kJoint && min_clearance(p, p.goal.q) < 0)
-        return "the goal configuration is in collision";
-    } catch (const std::exception& e) {
-      return std::string("bad obstacle: ") + e.what();
-    }
-  }
-  return "";
+  return loop;
 }
 
 BatchPlanner::BatchPlanner(BatchPlannerOptions options) : options_(std::move(options)) {}
@@ -196,11 +132,7 @@ Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init, const s
                          BatchSolution* solution) const {
   const auto t0 = std::chrono::steady_clock::now();
   if (solution != nullptr) *solution = BatchSolution();  // empty unless the solve runs
-  auto elapsed = [&t0] {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  };
   const int n = problem.model->nq(), N = problem.steps;
-
   PlanningGraph pg;
   std::vector<DfgConstraintStep> dfg_steps;
   try {
@@ -213,88 +145,11 @@ Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init, const s
     p.stats.method = method;
     return p;
   }
-  AugmentedLagrangian al(pg.constraints, options_.augmented_lagrangian);
-  const double tolerance = dfg_steps.empty() ? options_.constraint_tolerance
-                                             : std::min(options_.constraint_tolerance,
-                                                        options_.dfg_constraint_tolerance);
-  const double tolerance_final = dfg_steps.empty() ? options_.inner_tolerance_final
-                                                   : std::min(options_.inner_tolerance_final,
-                                                              options_.dfg_inner_tolerance_final);
-
-  graph::LevenbergMarquardtOptions lm_options;
-  lm_options.record_history = false;
-  lm_options.max_iterations = options_.max_inner_iterations;
-  lm_options.relative_error_tol = options_.inner_tolerance_initial;
-  graph::LevenbergMarquardt lm(lm_options);
-
-  struct {
-    double symbolic = 0, linearize = 0, factorize = 0, solve = 0, evaluate = 0, lm = 0, al = 0,
-           lm_wall = 0;
-  } timing;
-  const double t_built = elapsed();
-  SolveStats stats;
-  stats.method = method;
-  std::string status = "infeasible";
-  std::string reason;
-  double violation = 0;
-  for (int outer = 0; outer < options_.max_outer_iterations; ++outer) {
-    lm_options.max_iterations =
-        std::min(options_.max_inner_iterations, options_.max_total_iterations - stats.iterations);
-    if (lm_options.max_iterations <= 0) break;
-    lm.set_options(lm_options);
-    const double t_lm = elapsed();
-    const graph::OptimizationResult r = lm.optimize(pg.graph, pg.values);
-    timing.lm_wall += elapsed() - t_lm;
-    timing.symbolic += r.symbolic_s;
-    timing.linearize += r.linearize_s;
-    timing.factorize += r.factorize_s;
-    timing.solve += r.solve_s;
-    timing.evaluate += r.evaluate_s;
-    timing.lm += r.total_s;
-    stats.iterations += r.iterations;
-    stats.linear_solves += r.trials;
-    stats.outer_iterations = outer + 1;
-    if (r.status == graph::SolverStatus::kNonFinite) {
-      status = "non_finite";
-      reason = r.reason;
-      break;
-    }
-    double t_al = elapsed();
-    const ConstraintReport worst = al.report(pg.values);
-    timing.al += elapsed() - t_al;
-    violation = worst.scaled_violation;
-    spdlog::debug("AL outer {}: mu={:.3g} LM {} its ({}), cost {:.6g}, worst {:.3g} at {}", outer,
-                  al.penalty(), r.iterations, graph::to_string(r.status), r.final_error,
-                  worst.scaled_violation, worst.where);
-    if (violation <= tolerance && lm_options.relative_error_tol <= tolerance_final * 1.0001) {
-      status = "converged";
-      break;
-    }
-    if (violation <= tolerance) {
-      // Feasible: one more solve at the final tolerance to settle the objective.
-      lm_options.relative_error_tol = tolerance_final;
-      t_al = elapsed();
-      al.update(pg.values);
-      timing.al += elapsed() - t_al;
-      continue;
-    }
-    t_al = elapsed();
-    al.update(pg.values);
-    timing.al += elapsed() - t_al;
-    lm_options.relative_error_tol = std::max(tolerance_final, lm_options.relative_error_tol * 0.1);
-  }
-  const double t_loop = elapsed();
-  const ConstraintReport worst = al.report(pg.values);
-  stats.max_constraint_violation = worst.violation;
-  if (status == "infeasible" && worst.scaled_violation <= tolerance) {
-    status = "converged";
-  }
-  if (status == "infeasible") {
-    std::ostringstream os;
-    os << "constraints still violated after " << stats.outer_iterations << " outer and "
-       << stats.iterations << " LM iterations: worst " << worst.violation << " at " << worst.where;
-    reason = os.str();
-  }
+  const OuterLoopOptions loop =
+      dfg_steps.empty() ? options_.outer_loop : outer_loop_options(options_);
+  ConstraintState state;
+  AugmentedLagrangian al(pg.constraints(false), state, options_.augmented_lagrangian);
+  const OuterLoopResult r = solve_outer_loop(pg.graph, pg.values, al, loop, problem.name);
 
   // The plan: trajectory from the values; τ from inverse dynamics in the condensed formulation
   // (which eliminates it, so it equals RNEA exactly), the DFG's own τ variables otherwise (so
@@ -304,46 +159,20 @@ Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init, const s
     plan.tau.row(s.step) =
         dfg_torques(pg.values, *problem.model, s.step, options_.dfg.keys).transpose();
   }
-  // Soft cost without the constraint terms: zero the penalty contributions by evaluating the
-  // soft factors only.
-  double soft = 0;
-  for (const auto& f : pg.graph.factors()) {
-    if (!f) continue;
-    if (auto* c = dynamic_cast<const ConstrainedFactor*>(f.get())) {
-      if (c->has_constraints()) {
-        // Soft rows of mixed factors (min-torque) count; their constraint rows do not.
-        Eigen::VectorXd z;
-        c->values_at(pg.values, z);
-        for (int i = 0; i < c->residual_dim(); ++i) {
-          const RowSpec& row = c->rows()[i];
-          if (row.kind == RowKind::kSoft)
-            soft += 0.5 * std::pow(row.weight * (z[i] - row.lower), 2);
-        }
-        continue;
-      }
-    }
-    soft += f->error(pg.values);
-  }
-  stats.cost = soft;
-  stats.status = status;
-  stats.reason = reason;
-  plan.stats = stats;
-  const double t_solved = elapsed();
+  plan.stats.method = method;
+  plan.stats.status = r.status;
+  plan.stats.reason = r.reason;
+  plan.stats.iterations = r.iterations;
+  plan.stats.outer_iterations = r.outer_iterations;
+  plan.stats.linear_solves = r.linear_solves;
+  plan.stats.max_constraint_violation = r.worst.violation;
+  plan.stats.cost = soft_cost(pg.entries, pg.values);
   plan.validation = validate(problem, plan, options_.validation);
-  plan.stats.solve_time_s = elapsed();
-  spdlog::debug(
-      "plan {}: build {:.1f} ms, LM {:.1f} ms (symbolic {:.1f}, linearize {:.1f}, factorize "
-      "{:.1f}, "
-      "solve {:.1f}, evaluate {:.1f}; wall {:.1f}), multipliers {:.1f} ms, rest of the loop {:.1f} "
-      "ms, plan and cost {:.1f} ms, validate {:.1f} ms",
-      problem.name, 1e3 * t_built, 1e3 * timing.lm, 1e3 * timing.symbolic, 1e3 * timing.linearize,
-      1e3 * timing.factorize, 1e3 * timing.solve, 1e3 * timing.evaluate, 1e3 * timing.lm_wall,
-      1e3 * timing.al, 1e3 * (t_loop - t_built - timing.lm_wall - timing.al),
-      1e3 * (t_solved - t_loop), 1e3 * (plan.stats.solve_time_s - t_solved));
+  plan.stats.solve_time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (solution != nullptr) {
-    solution->penalty = al.penalty();
-    solution->condensed = dfg_steps.empty();
     solution->graph = std::move(pg);
+    solution->constraints = std::move(state);
   }
   return plan;
 }

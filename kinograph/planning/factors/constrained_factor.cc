@@ -19,33 +19,33 @@ ConstrainedFactor::ConstrainedFactor(std::vector<graph::Key> keys, std::vector<i
       throw std::invalid_argument("constraint row has lower bound above upper bound");
     }
   }
-  reset_multipliers();
+  m_ = std::make_shared<const Multipliers>(residual_dim());
 }
 
-void ConstrainedFactor::set_penalty(double mu) {
-  if (!(mu > 0)) throw std::invalid_argument("penalty must be positive");
-  if (mu != mu_) jacobian_changed();
-  mu_ = mu;
-}
+Multipliers::Multipliers(int rows, double mu)
+    : penalty(mu), lower(Eigen::VectorXd::Zero(rows)), upper(Eigen::VectorXd::Zero(rows)) {}
 
-void ConstrainedFactor::set_multipliers(const Eigen::VectorXd& lambda,
-                                        const Eigen::VectorXd& lambda_upper) {
-  if (lambda.size() != residual_dim() || lambda_upper.size() != residual_dim()) {
-    throw std::invalid_argument("multipliers have the wrong size");
+void ConstrainedFactor::bind(std::shared_ptr<const Multipliers> m) {
+  if (!m) throw std::invalid_argument(name() + ": null multipliers");
+  if (m->lower.size() != residual_dim() || m->upper.size() != residual_dim()) {
+    throw std::invalid_argument(name() + ": multipliers have the wrong size");
   }
-  lambda_ = lambda;
-  lambda_upper_ = lambda_upper;
+  m_ = std::move(m);
+  penalty_changed();
 }
 
-void ConstrainedFactor::reset_multipliers() {
-  lambda_.setZero(residual_dim());
-  lambda_upper_.setZero(residual_dim());
+void ConstrainedFactor::penalty_changed() {
+  if (!(m_->penalty > 0)) throw std::invalid_argument("penalty must be positive");
+  if (m_->penalty != penalty_read_) jacobian_changed();
+  penalty_read_ = m_->penalty;
 }
 
 void ConstrainedFactor::evaluate(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> e,
                                  const graph::Jacobians* J) const {
   compute(x, e, J);
-  const double sq = std::sqrt(mu_);
+  const Eigen::VectorXd& lambda = m_->lower;
+  const Eigen::VectorXd& lambda_upper = m_->upper;
+  const double sq = std::sqrt(m_->penalty);
   // dr/dz of every row, applied to the Jacobian blocks column by column afterwards (blocks are
   // column-major: scaling row by row would stride through memory). Per-thread scratch that only
   // grows, so linearizing allocates nothing after the first factor of the largest size.
@@ -62,11 +62,11 @@ void ConstrainedFactor::evaluate(const graph::FactorValues& x, Eigen::Ref<Eigen:
         break;
       case RowKind::kEquality:
         f[i] = sq / row.scale;
-        e[i] = f[i] * (z - row.lower) + lambda_[i] / sq;
+        e[i] = f[i] * (z - row.lower) + lambda[i] / sq;
         break;
       case RowKind::kBounds: {
-        const double a = sq * (row.lower - z) / row.scale + lambda_[i] / sq;
-        const double b = sq * (z - row.upper) / row.scale + lambda_upper_[i] / sq;
+        const double a = sq * (row.lower - z) / row.scale + lambda[i] / sq;
+        const double b = sq * (z - row.upper) / row.scale + lambda_upper[i] / sq;
         e[i] = std::max(0.0, a) - std::max(0.0, b);
         f[i] = -(sq / row.scale) * ((a > 0 ? 1.0 : 0.0) + (b > 0 ? 1.0 : 0.0));
         break;
@@ -120,17 +120,20 @@ Eigen::Ref<Eigen::VectorXd> raw_values(const ConstrainedFactor& f, const graph::
 }  // namespace
 
 ConstrainedFactor::Violation ConstrainedFactor::check(const graph::Values& values) const {
-  return scan(values, nullptr, nullptr);
+  return scan(values, nullptr);
 }
 
-ConstrainedFactor::Violation ConstrainedFactor::update_multipliers(const graph::Values& values) {
-  return scan(values, &lambda_, &lambda_upper_);
+ConstrainedFactor::Violation ConstrainedFactor::update_multipliers(const graph::Values& values,
+                                                                   Multipliers& m) const {
+  if (m.lower.size() != residual_dim() || m.upper.size() != residual_dim()) {
+    throw std::invalid_argument(name() + ": multipliers have the wrong size");
+  }
+  return scan(values, &m);
 }
 
 ConstrainedFactor::Violation ConstrainedFactor::scan(const graph::Values& values,
-                                                     Eigen::VectorXd* lambda,
-                                                     Eigen::VectorXd* lambda_upper) const {
-  const bool update = lambda != nullptr;
+                                                     Multipliers* m) const {
+  const bool update = m != nullptr;
   Violation v;
   if (num_constraints_ == 0) return v;
   const Eigen::Ref<Eigen::VectorXd> z = raw_values(*this, values);
@@ -143,12 +146,13 @@ ConstrainedFactor::Violation ConstrainedFactor::scan(const graph::Values& values
       v.own_units = viol;
     }
     if (!update) continue;
+    const double mu = m->penalty;
     if (row.kind == RowKind::kEquality) {
-      (*lambda)[i] += mu_ * (z[i] - row.lower) / row.scale;
+      m->lower[i] += mu * (z[i] - row.lower) / row.scale;
     } else {
       // Infinite bounds give -inf here and clip to 0.
-      (*lambda)[i] = std::max(0.0, (*lambda)[i] + mu_ * (row.lower - z[i]) / row.scale);
-      (*lambda_upper)[i] = std::max(0.0, (*lambda_upper)[i] + mu_ * (z[i] - row.upper) / row.scale);
+      m->lower[i] = std::max(0.0, m->lower[i] + mu * (row.lower - z[i]) / row.scale);
+      m->upper[i] = std::max(0.0, m->upper[i] + mu * (z[i] - row.upper) / row.scale);
     }
   }
   return v;

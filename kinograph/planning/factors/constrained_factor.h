@@ -1,9 +1,10 @@
 #pragma once
 // A factor whose rows are soft terms or must-hold constraints. Constraint rows enter the cost
-// through an augmented Lagrangian: the factor holds each row's multipliers and the penalty μ, so
-// the outer loop changes them between LM solves without touching the graph's structure (the
-// solver keeps its symbolic analysis).
+// through an augmented Lagrangian whose multipliers and penalty μ are not the factor's own: they
+// live in a Multipliers record beside it (owned by a solver's ConstraintState), which the factor
+// only reads. The outer loop changes them between solves without touching the graph's structure.
 #include <Eigen/Core>
+#include <memory>
 #include <vector>
 
 #include "kinograph/graph/factor.h"
@@ -28,13 +29,22 @@ struct RowSpec {
   double weight = 1;  ///< soft rows: r = weight·(z − lower)
 };
 
+/// The augmented-Lagrangian state of one factor's rows: penalty μ and per-row multipliers.
+struct Multipliers {
+  explicit Multipliers(int rows = 0, double penalty = 1);
+  double penalty = 1;     ///< μ > 0
+  Eigen::VectorXd lower;  ///< λ of equality rows, λ_l ≥ 0 of lower bounds
+  Eigen::VectorXd upper;  ///< λ_u ≥ 0 of upper bounds
+};
+
 /// Base of the planner's factors. Subclasses compute the raw values z (one per row) and dz/dx;
 /// this class turns them into whitened residuals:
 ///   soft:      r = w (z − t)
 ///   equality:  r = √μ c + λ/√μ,                      c = (z − t)/s
 ///   bounds:    r = max(0, √μ c_l + λ_l/√μ) − max(0, √μ c_u + λ_u/√μ),
 ///              c_l = (lower − z)/s ≤ 0,  c_u = (z − upper)/s ≤ 0,
-/// so ½r² is the augmented-Lagrangian term of the row (up to a constant).
+/// so ½r² is the augmented-Lagrangian term of the row (up to a constant); μ and λ come from the
+/// bound Multipliers.
 class ConstrainedFactor : public graph::Factor {
  public:
   /// Throws std::invalid_argument on empty rows, non-positive scales or crossed bounds.
@@ -53,14 +63,14 @@ class ConstrainedFactor : public graph::Factor {
   /// Whether any row is soft (part of the objective).
   bool has_soft_rows() const { return num_constraints_ < residual_dim(); }
 
-  /// Penalty μ of the constraint rows.
-  double penalty() const { return mu_; }
-  void set_penalty(double mu);
-  /// Multipliers: of equality rows (λ) and of lower/upper bounds (λ_l, λ_u ≥ 0) per row.
-  const Eigen::VectorXd& multipliers() const { return lambda_; }
-  const Eigen::VectorXd& multipliers_upper() const { return lambda_upper_; }
-  void set_multipliers(const Eigen::VectorXd& lambda, const Eigen::VectorXd& lambda_upper);
-  void reset_multipliers();
+  /// Reads μ and the multipliers from `m` from now on (a new factor reads μ = 1, λ = 0).
+  /// Marks the Jacobian changed when μ differs from the one read so far. Throws
+  /// std::invalid_argument if m is null, its sizes are not residual_dim or μ ≤ 0.
+  void bind(std::shared_ptr<const Multipliers> m);
+  /// The multipliers read by evaluate().
+  const Multipliers& multipliers() const { return *m_; }
+  /// Call after changing the bound record's penalty in place (marks the Jacobian changed).
+  void penalty_changed();
 
   /// Raw values z at `values` (for reports and multiplier updates).
   void values_at(const graph::Values& values, Eigen::VectorXd& z) const;
@@ -85,9 +95,9 @@ class ConstrainedFactor : public graph::Factor {
   Terms terms(const graph::Values& values) const;
   /// Largest violation measured in scaled units (|c| = violation / s).
   double scaled_violation(const graph::Values& values) const;
-  /// First-order multiplier update λ ← λ + μc (bounds clipped ≥ 0) at `values`; returns the
-  /// worst row before the update, from the same evaluation.
-  Violation update_multipliers(const graph::Values& values);
+  /// First-order multiplier update λ ← λ + μc of `m` (bounds clipped ≥ 0, μ = m.penalty) at
+  /// `values`; returns the worst row before the update, from the same evaluation.
+  Violation update_multipliers(const graph::Values& values, Multipliers& m) const;
 
  protected:
   /// For a subclass whose compute() is linear in the variables: with soft and equality rows only
@@ -97,13 +107,12 @@ class ConstrainedFactor : public graph::Factor {
 
  private:
   // check() and, with non-null multipliers, their update from the same evaluation.
-  Violation scan(const graph::Values& values, Eigen::VectorXd* lambda,
-                 Eigen::VectorXd* lambda_upper) const;
+  Violation scan(const graph::Values& values, Multipliers* update) const;
 
   std::vector<RowSpec> rows_;
   int num_constraints_ = 0;
-  double mu_ = 1.0;
-  Eigen::VectorXd lambda_, lambda_upper_;
+  std::shared_ptr<const Multipliers> m_;
+  double penalty_read_ = 1;  // μ of the last bind or penalty_changed
 };
 
 }  // namespace kinograph::planning

@@ -236,13 +236,16 @@ std::vector<DfgConstraintStep> use_dfg_dynamics(PlanningGraph& pg, const Problem
                                                 const DfgOptions& options) {
   if (!problem.model) throw std::invalid_argument("use_dfg_dynamics: problem has no model");
   std::vector<int> steps;
-  for (size_t i = 0; i < pg.graph.size(); ++i) {
-    const auto* f = dynamic_cast<const DynamicsStepFactor*>(pg.graph[i].get());
-    if (f == nullptr) continue;
-    steps.push_back(static_cast<int>(f->keys()[0].step()));
-    std::erase_if(pg.constraints, [f](const auto& c) { return c.get() == f; });
-    pg.graph.remove(i);
+  std::vector<FactorEntry> kept;
+  for (FactorEntry& e : pg.entries) {
+    if (e.key.role != FactorRole::kDynamics) {
+      kept.push_back(std::move(e));
+      continue;
+    }
+    steps.push_back(e.key.step);
+    if (!e.anchor) pg.graph.remove(e.slot);
   }
+  pg.entries = std::move(kept);
   // The rows build_graph gives the condensed factor.
   DynamicsStepOptions rows;
   rows.limit_epsilon = problem.objectives.limit_epsilon;
@@ -252,11 +255,15 @@ std::vector<DfgConstraintStep> use_dfg_dynamics(PlanningGraph& pg, const Problem
     pg.dynamics_workspace = std::make_shared<dynamics::Data>(*problem.model);
   }
   std::vector<DfgConstraintStep> out;
+  graph::FactorGraph scratch;  // add_dfg_constraints' indices are not needed here
   for (int k : steps) {
-    out.push_back(add_dfg_constraints(pg.graph, pg.values, *problem.model, *pg.dynamics_workspace,
+    out.push_back(add_dfg_constraints(scratch, pg.values, *problem.model, *pg.dynamics_workspace,
                                       k, rows, options));
-    for (const auto& f : out.back().factors) {
-      if (f->has_constraints()) pg.constraints.push_back(f);
+    DfgConstraintStep& step = out.back();
+    step.indices.clear();
+    for (size_t i = 0; i < step.factors.size(); ++i) {
+      pg.add(make_entry(step.factors[i], {FactorRole::kDynamics, k, static_cast<int>(i)}));
+      step.indices.push_back(pg.entries.back().slot);
     }
   }
   return out;

@@ -1,122 +1,272 @@
 #include "kinograph/planning/formulation/planning_graph.h"
 
 #include <cmath>
+#include <set>
 #include <stdexcept>
+#include <string>
 
 #include "kinograph/dynamics/inverse_dynamics.h"
 #include "kinograph/planning/factors/dynamics_factors.h"
 #include "kinograph/planning/factors/pose_factors.h"
+#include "kinograph/planning/factors/state_target_factor.h"
 #include "kinograph/planning/factors/trajectory_factors.h"
 
 namespace kinograph::planning {
+namespace {
 
-PlanningGraph build_graph(const Problem& problem, const Trajectory& init,
-                          const GraphOptions& options) {
-  if (!problem.model) throw std::invalid_argument("problem has no model");
-  const auto& model = problem.model;
-  const int n = model->nq(), N = problem.steps;
-  const double dt = problem.dt();
-  const Objectives& obj = problem.objectives;
-  if (init.q.rows() != N + 1 || init.q.cols() != n || init.qd.rows() != N + 1 ||
-      init.qdd.rows() != N + 1) {
-    throw std::invalid_argument("initial trajectory has the wrong shape");
-  }
-  PlanningGraph pg;
-  pg.steps = N;
-  pg.nq = n;
-  pg.dynamics_workspace = std::make_shared<dynamics::Data>(*model);
-  auto add_constraint = [&pg](std::shared_ptr<ConstrainedFactor> f) {
-    pg.graph.add(f);
-    if (f->has_constraints()) pg.constraints.push_back(std::move(f));
-  };
+// Weight of the start prior w·(x_0 − start): a linear soft term outside the augmented
+// Lagrangian (it does not stiffen as μ grows) that holds the start to about force/w², far
+// inside the validator's start threshold.
+constexpr double kStartPriorWeight = 1e5;
+// Scale of the joint goal's equality rows (rad).
+constexpr double kJointGoalScale = 1e-2;
 
-  for (int k = 0; k <= N; ++k) {
-    pg.values.insert(q_key(k), init.q.row(k).transpose());
-    pg.values.insert(v_key(k), init.qd.row(k).transpose());
-    pg.values.insert(a_key(k), init.qdd.row(k).transpose());
-  }
-  // Start: exact by fixing the variables.
-  pg.values.update(q_key(0), problem.start_q);
-  pg.values.update(v_key(0),
-                   problem.start_qd.size() == n ? problem.start_qd : Eigen::VectorXd::Zero(n));
-  pg.values.set_fixed(q_key(0));
-  pg.values.set_fixed(v_key(0));
-  // Goal at rest.
-  pg.values.update(v_key(N), Eigen::VectorXd::Zero(n));
-  pg.values.update(a_key(N), Eigen::VectorXd::Zero(n));
-  pg.values.set_fixed(v_key(N));
-  pg.values.set_fixed(a_key(N));
-  if (problem.goal.kind == Goal::Kind::kJoint) {
-    if (problem.goal.q.size() != n) throw std::invalid_argument("joint goal has the wrong size");
-    pg.values.update(q_key(N), problem.goal.q);
-    pg.values.set_fixed(q_key(N));
-  } else {
-    const PoseParts parts = problem.goal.position_only ? PoseParts::kPosition : PoseParts::kFull;
-    add_constraint(std::make_shared<PoseFactor>(N, model, pg.dynamics_workspace, problem.goal.frame,
-                                                problem.goal.pose, parts, options.pose_scale));
-  }
-
-  // Between states: GP prior (soft) and collocation (must hold).
-  for (int k = 0; k < N; ++k) {
-    pg.graph.emplace<GpPriorFactor>(k, n, dt, obj.qc);
-    add_constraint(std::make_shared<CollocationFactor>(k, n, dt, options.collocation_scale));
-  }
-
-  // Per-state limits and dynamics.
+std::vector<StateLimitFactor::Limit> joint_limits(const dynamics::Model& model, double eps) {
   std::vector<StateLimitFactor::Limit> limits;
-  for (int j = 0; j < n; ++j) {
-    const dynamics::JointLimits& l = model->bodies[j].limits;
-    const double eps = obj.limit_epsilon;
+  for (int j = 0; j < model.nq(); ++j) {
+    const dynamics::JointLimits& l = model.bodies[j].limits;
     if (std::isfinite(l.lower) || std::isfinite(l.upper))
       limits.push_back({0, j, l.lower + eps, l.upper - eps});
     if (std::isfinite(l.velocity)) limits.push_back({1, j, -l.velocity + eps, l.velocity - eps});
     if (std::isfinite(l.acceleration))
       limits.push_back({2, j, -l.acceleration + eps, l.acceleration - eps});
   }
+  return limits;
+}
+
+// Limits and condensed dynamics of every state, state by state.
+void add_state_factors(PlanningGraph& pg, const Problem& problem, const GraphOptions& options) {
+  const auto& model = problem.model;
+  const Objectives& obj = problem.objectives;
+  const std::vector<StateLimitFactor::Limit> limits = joint_limits(*model, obj.limit_epsilon);
   DynamicsStepOptions dyn;
   dyn.limit_epsilon = obj.limit_epsilon;
   dyn.min_torque = obj.min_torque;
   dyn.torque_scale = options.torque_scale;
   const bool has_dynamics = !DynamicsStepFactor::rows_for(*model, dyn).empty();
-  for (int k = 0; k <= N; ++k) {
+  for (int k = 0; k <= problem.steps; ++k) {
     if (!limits.empty()) {
-      auto f = std::make_shared<StateLimitFactor>(k, n, limits, options.limit_scale);
-      add_constraint(f);
+      pg.add(make_entry(
+          std::make_shared<StateLimitFactor>(k, model->nq(), limits, options.limit_scale),
+          {FactorRole::kLimits, k}));
     }
     if (has_dynamics) {
-      add_constraint(std::make_shared<DynamicsStepFactor>(k, model, pg.dynamics_workspace, dyn));
+      pg.add(make_entry(std::make_shared<DynamicsStepFactor>(k, model, pg.dynamics_workspace, dyn),
+                        {FactorRole::kDynamics, k}));
     }
   }
-  // Collision at every state and at interpolated states between them.
-  if (!problem.obstacles.empty() && !model->collision.empty()) {
-    pg.collision = std::make_shared<CollisionContext>(
-        model, problem.obstacles, obj.collision_epsilon + options.collision_query_margin);
-    if (pg.collision->num_pairs > 0) {
-      const int sub = std::max(0, obj.collision_substeps);
-      for (int k = 0; k <= N; ++k) {
-        if (k > 0) {  // the start state is fixed; its clearance is checked before planning
-          add_constraint(std::make_shared<CollisionFactor>(k, 0.0, dt, obj.collision_epsilon,
-                                                           options.collision_scale, pg.collision));
-        }
-        if (k == N) break;
-        for (int i = 1; i <= sub; ++i) {
-          add_constraint(std::make_shared<CollisionFactor>(k, static_cast<double>(i) / (sub + 1),
-                                                           dt, obj.collision_epsilon,
-                                                           options.collision_scale, pg.collision));
-        }
-      }
-    }
-  }
+}
 
-  // Task constraints on every free state.
-  for (const TaskConstraint& task : problem.task_constraints) {
+// Task constraints on every free state, task by task.
+void add_task_factors(PlanningGraph& pg, const Problem& problem, const GraphOptions& options) {
+  for (size_t t = 0; t < problem.task_constraints.size(); ++t) {
+    const TaskConstraint& task = problem.task_constraints[t];
     const PoseParts parts = task.orientation_only ? PoseParts::kOrientation : PoseParts::kFull;
-    for (int k = 1; k <= N; ++k) {
-      add_constraint(std::make_shared<PoseFactor>(k, model, pg.dynamics_workspace, task.frame,
-                                                  task.target, parts, options.pose_scale));
+    for (int k = 1; k <= problem.steps; ++k) {
+      pg.add(make_entry(std::make_shared<PoseFactor>(k, problem.model, pg.dynamics_workspace,
+                                                     task.frame, task.target, parts,
+                                                     options.pose_scale),
+                        {FactorRole::kTask, k, 0, static_cast<int>(t)}));
     }
+  }
+}
+
+// Variables of every state from `init`; the start fixed, the goal at rest, a joint goal fixed.
+graph::Values initial_values(const Problem& problem, const Trajectory& init) {
+  const int n = problem.model->nq(), N = problem.steps;
+  graph::Values values;
+  for (int k = 0; k <= N; ++k) {
+    values.insert(q_key(k), init.q.row(k).transpose());
+    values.insert(v_key(k), init.qd.row(k).transpose());
+    values.insert(a_key(k), init.qdd.row(k).transpose());
+  }
+  values.update(q_key(0), problem.start_q);
+  values.update(v_key(0),
+                problem.start_qd.size() == n ? problem.start_qd : Eigen::VectorXd::Zero(n));
+  values.set_fixed(q_key(0));
+  values.set_fixed(v_key(0));
+  values.update(v_key(N), Eigen::VectorXd::Zero(n));
+  values.update(a_key(N), Eigen::VectorXd::Zero(n));
+  values.set_fixed(v_key(N));
+  values.set_fixed(a_key(N));
+  if (problem.goal.kind == Goal::Kind::kJoint) {
+    if (problem.goal.q.size() != n) throw std::invalid_argument("joint goal has the wrong size");
+    values.update(q_key(N), problem.goal.q);
+    values.set_fixed(q_key(N));
+  }
+  return values;
+}
+
+}  // namespace
+
+void PlanningGraph::add(FactorEntry entry) {
+  if (!entry.anchor) entry.slot = graph.add(entry.factor);
+  entries.push_back(std::move(entry));
+}
+
+std::vector<const FactorEntry*> PlanningGraph::constraints(bool with_anchors) const {
+  std::vector<const FactorEntry*> out;
+  for (const FactorEntry& e : entries) {
+    if (e.constrained && e.constrained->has_constraints() && (with_anchors || !e.anchor)) {
+      out.push_back(&e);
+    }
+  }
+  return out;
+}
+
+FactorEntry make_entry(std::shared_ptr<ConstrainedFactor> factor, FactorKey key) {
+  FactorEntry e;
+  e.factor = factor;
+  e.constrained = std::move(factor);
+  e.key = key;
+  return e;
+}
+
+FactorEntry make_soft_entry(graph::FactorPtr soft_factor, FactorKey key) {
+  FactorEntry e;
+  e.factor = std::move(soft_factor);
+  e.key = key;
+  return e;
+}
+
+std::vector<FactorEntry> timing_entries(const Problem& problem, const GraphOptions& options) {
+  std::vector<FactorEntry> out;
+  const int n = problem.model->nq();
+  const double dt = problem.dt();
+  for (int k = 0; k < problem.steps; ++k) {
+    out.push_back(make_soft_entry(std::make_shared<GpPriorFactor>(k, n, dt, problem.objectives.qc),
+                             {FactorRole::kGpPrior, k}));
+    out.push_back(make_entry(
+        std::make_shared<CollocationFactor>(k, n, dt, options.collocation_scale),
+        {FactorRole::kCollocation, k}));
+  }
+  return out;
+}
+
+std::shared_ptr<CollisionContext> collision_context(
+    const Problem& problem, const std::vector<collision::Obstacle>& obstacles,
+    const GraphOptions& options) {
+  return std::make_shared<CollisionContext>(
+      problem.model, obstacles,
+      problem.objectives.collision_epsilon + options.collision_query_margin);
+}
+
+std::vector<FactorEntry> collision_entries(const Problem& problem,
+                                           const std::shared_ptr<CollisionContext>& context,
+                                           int obstacle, const GraphOptions& options) {
+  std::vector<FactorEntry> out;
+  if (!context || context->num_pairs == 0) return out;
+  const Objectives& obj = problem.objectives;
+  const int N = problem.steps, sub = std::max(0, obj.collision_substeps);
+  const double dt = problem.dt();
+  for (int k = 0; k <= N; ++k) {
+    if (k > 0) {  // the start state is fixed; its clearance is checked before planning
+      out.push_back(make_entry(
+          std::make_shared<CollisionFactor>(k, 0.0, dt, obj.collision_epsilon,
+                                            options.collision_scale, context),
+          {FactorRole::kCollision, k, 0, obstacle}));
+    }
+    if (k == N) break;
+    for (int i = 1; i <= sub; ++i) {
+      out.push_back(make_entry(std::make_shared<CollisionFactor>(
+                                   k, static_cast<double>(i) / (sub + 1), dt,
+                                   obj.collision_epsilon, options.collision_scale, context),
+                               {FactorRole::kCollision, k, i, obstacle}));
+    }
+  }
+  return out;
+}
+
+FactorEntry start_entry(const Problem& problem) {
+  const int n = problem.model->nq();
+  Eigen::VectorXd target(2 * n);
+  target << problem.start_q,
+      (problem.start_qd.size() == n ? problem.start_qd : Eigen::VectorXd::Zero(n));
+  FactorEntry e = make_entry(
+      StateTargetFactor::soft({q_key(0), v_key(0)}, n, target, kStartPriorWeight),
+      {FactorRole::kStart});
+  e.anchor = true;
+  return e;
+}
+
+FactorEntry goal_entry(const Problem& problem, const std::shared_ptr<dynamics::Data>& workspace,
+                       const GraphOptions& options) {
+  const int N = problem.steps;
+  if (problem.goal.kind == Goal::Kind::kJoint) {
+    FactorEntry e = make_entry(
+        std::make_shared<StateTargetFactor>(std::vector<graph::Key>{q_key(N)},
+                                            problem.model->nq(), problem.goal.q, kJointGoalScale),
+        {FactorRole::kGoal, N});
+    e.anchor = true;
+    return e;
+  }
+  const PoseParts parts = problem.goal.position_only ? PoseParts::kPosition : PoseParts::kFull;
+  return make_entry(std::make_shared<PoseFactor>(N, problem.model, workspace, problem.goal.frame,
+                                                 problem.goal.pose, parts, options.pose_scale),
+                    {FactorRole::kGoal, N});
+}
+
+PlanningGraph build_graph(const Problem& problem, const Trajectory& init,
+                          const GraphOptions& options, GraphForm form) {
+  if (!problem.model) throw std::invalid_argument("problem has no model");
+  const int n = problem.model->nq(), N = problem.steps;
+  if (init.q.rows() != N + 1 || init.q.cols() != n || init.qd.rows() != N + 1 ||
+      init.qdd.rows() != N + 1) {
+    throw std::invalid_argument("initial trajectory has the wrong shape");
+  }
+  PlanningGraph pg;
+  pg.form = form;
+  pg.steps = N;
+  pg.nq = n;
+  pg.dynamics_workspace = std::make_shared<dynamics::Data>(*problem.model);
+  pg.values = initial_values(problem, init);
+  const bool pose_goal = problem.goal.kind == Goal::Kind::kPose;
+  const bool with_collision = !problem.obstacles.empty() && !problem.model->collision.empty();
+  if (form == GraphForm::kBatch) {
+    if (pose_goal) pg.add(goal_entry(problem, pg.dynamics_workspace, options));
+    for (FactorEntry& e : timing_entries(problem, options)) pg.add(std::move(e));
+    add_state_factors(pg, problem, options);
+    if (with_collision) {
+      auto ctx = collision_context(problem, problem.obstacles, options);
+      pg.collision[-1] = ctx;
+      for (FactorEntry& e : collision_entries(problem, ctx, -1, options)) pg.add(std::move(e));
+    }
+    add_task_factors(pg, problem, options);
+    return pg;
+  }
+  for (FactorEntry& e : timing_entries(problem, options)) pg.add(std::move(e));
+  add_state_factors(pg, problem, options);
+  add_task_factors(pg, problem, options);
+  pg.add(start_entry(problem));
+  pg.add(goal_entry(problem, pg.dynamics_workspace, options));
+  std::set<int> ids;
+  for (const collision::Obstacle& o : problem.obstacles) {
+    if (!ids.insert(o.id).second) {
+      throw std::invalid_argument("obstacle id " + std::to_string(o.id) + " is repeated");
+    }
+    if (problem.model->collision.empty()) continue;
+    auto ctx = collision_context(problem, {o}, options);
+    pg.collision[o.id] = ctx;
+    for (FactorEntry& e : collision_entries(problem, ctx, o.id, options)) pg.add(std::move(e));
   }
   return pg;
+}
+
+double soft_cost(const std::vector<FactorEntry>& entries, const graph::Values& values,
+                 double* violation) {
+  double soft = 0;
+  for (const FactorEntry& e : entries) {
+    if (!e.constrained) {
+      soft += e.factor->error(values);
+      continue;
+    }
+    // Most constraint factors (collision, limits) have no soft rows: no evaluation for the cost.
+    if (violation == nullptr && !e.constrained->has_soft_rows()) continue;
+    const ConstrainedFactor::Terms t = e.constrained->terms(values);
+    soft += t.soft_cost;
+    if (violation != nullptr) *violation = std::max(*violation, t.violation);
+  }
+  return soft;
 }
 
 Trajectory read_trajectory(const graph::Values& values, int steps, int nq) {

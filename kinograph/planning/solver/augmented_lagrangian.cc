@@ -1,29 +1,32 @@
 #include "kinograph/planning/solver/augmented_lagrangian.h"
 
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
+#include <chrono>
+#include <sstream>
+
+#include "kinograph/graph/levenberg_marquardt.h"
 
 namespace kinograph::planning {
 
-AugmentedLagrangian::AugmentedLagrangian(std::vector<std::shared_ptr<ConstrainedFactor>> factors,
+AugmentedLagrangian::AugmentedLagrangian(std::vector<const FactorEntry*> constraints,
+                                         ConstraintState& state,
                                          AugmentedLagrangianOptions options)
-    : factors_(std::move(factors)), options_(options), mu_(options.initial_penalty) {
-  set_penalty(mu_);
-}
-
-void AugmentedLagrangian::set_penalty(double mu) {
-  mu_ = mu;
-  for (auto& f : factors_) f->set_penalty(mu);
+    : constraints_(std::move(constraints)), state_(state), options_(options) {
+  for (const FactorEntry* e : constraints_) state_.bind(*e);
+  state_.set_penalty(options_.initial_penalty);
 }
 
 ConstraintReport AugmentedLagrangian::report(const graph::Values& values) const {
   ConstraintReport r;
   const ConstrainedFactor* worst = nullptr;
-  for (const auto& f : factors_) {
-    const ConstrainedFactor::Violation v = f->check(values);
+  for (const FactorEntry* e : constraints_) {
+    const ConstrainedFactor::Violation v = e->constrained->check(values);
     if (v.scaled > r.scaled_violation) {
       r.scaled_violation = v.scaled;
       r.violation = v.own_units;
-      worst = f.get();
+      worst = e->constrained.get();
     }
   }
   if (worst != nullptr) r.where = worst->name() + " " + worst->keys().front().to_string();
@@ -32,18 +35,82 @@ ConstraintReport AugmentedLagrangian::report(const graph::Values& values) const 
 
 double AugmentedLagrangian::update(const graph::Values& values) {
   double worst = 0;
-  for (auto& f : factors_) worst = std::max(worst, f->update_multipliers(values).scaled);
+  for (const FactorEntry* e : constraints_) {
+    worst = std::max(worst, e->constrained->update_multipliers(values, state_.at(e->key)).scaled);
+  }
   if (last_violation_ >= 0 && worst > options_.required_decrease * last_violation_) {
-    set_penalty(std::min(options_.max_penalty, mu_ * options_.penalty_growth));
+    state_.set_penalty(std::min(options_.max_penalty, state_.penalty() * options_.penalty_growth));
   }
   last_violation_ = worst;
   return worst;
 }
 
-void AugmentedLagrangian::reset() {
-  for (auto& f : factors_) f->reset_multipliers();
-  last_violation_ = -1;
-  set_penalty(options_.initial_penalty);
+namespace {
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+}  // namespace
+
+OuterLoopResult solve_outer_loop(const graph::FactorGraph& graph, graph::Values& values,
+                                 AugmentedLagrangian& al, const OuterLoopOptions& options,
+                                 const std::string& name) {
+  const auto t0 = Clock::now();
+  graph::LevenbergMarquardtOptions lm_options;
+  lm_options.record_history = false;
+  lm_options.max_iterations = options.max_inner_iterations;
+  lm_options.relative_error_tol = options.inner_tolerance_initial;
+  graph::LevenbergMarquardt lm(lm_options);
+  const double tol = options.constraint_tolerance, tol_final = options.inner_tolerance_final;
+  OuterLoopResult out;
+  out.status = "infeasible";
+  double lm_s = 0, al_s = 0;
+  for (int outer = 0; outer < options.max_outer_iterations; ++outer) {
+    lm_options.max_iterations =
+        std::min(options.max_inner_iterations, options.max_total_iterations - out.iterations);
+    if (lm_options.max_iterations <= 0) break;
+    lm.set_options(lm_options);
+    const graph::OptimizationResult r = lm.optimize(graph, values);
+    lm_s += r.total_s;
+    out.iterations += r.iterations;
+    out.linear_solves += r.trials;
+    out.outer_iterations = outer + 1;
+    if (r.status == graph::SolverStatus::kNonFinite) {
+      out.status = "non_finite";
+      out.reason = r.reason;
+      break;
+    }
+    const auto t_al = Clock::now();
+    const ConstraintReport worst = al.report(values);
+    spdlog::debug("AL outer {}: mu={:.3g} LM {} its ({}), cost {:.6g}, worst {:.3g} at {}", outer,
+                  al.penalty(), r.iterations, graph::to_string(r.status), r.final_error,
+                  worst.scaled_violation, worst.where);
+    // Converged once feasible at the final inner tolerance (the slack absorbs the rounding of
+    // the repeated 10× tightening).
+    if (worst.scaled_violation <= tol && lm_options.relative_error_tol <= tol_final * 1.0001) {
+      out.status = "converged";
+      al_s += seconds_since(t_al);
+      break;
+    }
+    al.update(values);
+    al_s += seconds_since(t_al);
+    // Feasible: one more solve at the final tolerance settles the objective.
+    lm_options.relative_error_tol = worst.scaled_violation <= tol
+                                        ? tol_final
+                                        : std::max(tol_final, lm_options.relative_error_tol * 0.1);
+  }
+  out.worst = al.report(values);
+  if (out.status == "infeasible" && out.worst.scaled_violation <= tol) out.status = "converged";
+  if (out.status == "infeasible") {
+    std::ostringstream os;
+    os << "constraints still violated after " << out.outer_iterations << " outer and "
+       << out.iterations << " LM iterations: worst " << out.worst.violation << " at "
+       << out.worst.where;
+    out.reason = os.str();
+  }
+  spdlog::debug("{}: outer loop {:.1f} ms (LM {:.1f}, multipliers {:.1f})", name,
+                1e3 * seconds_since(t0), 1e3 * lm_s, 1e3 * al_s);
+  return out;
 }
 
 }  // namespace kinograph::planning

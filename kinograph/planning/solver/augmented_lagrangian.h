@@ -1,14 +1,18 @@
 #pragma once
-// The augmented-Lagrangian outer loop's state: the constraint factors of a graph, their shared
-// penalty μ and the schedule that updates multipliers and grows μ. Changing them never changes
-// the graph's structure, so warm-started LM solves reuse their symbolic analysis (and the
-// incremental replanner can carry multipliers over from a previous plan).
-#include <memory>
+// The augmented-Lagrangian method over a planning graph's constraint factors: the penalty
+// schedule, the multiplier updates, and the outer loop around Levenberg–Marquardt inner solves
+// that both planners run (the batch planner for every plan, the incremental planner when it
+// has to solve its own graph). Multipliers live in a ConstraintState beside the graph, so
+// changing them never changes the graph's structure and the LM solves keep their symbolic
+// analysis.
 #include <string>
 #include <vector>
 
+#include "kinograph/graph/factor_graph.h"
 #include "kinograph/graph/values.h"
-#include "kinograph/planning/factors/constrained_factor.h"
+#include "kinograph/planning/formulation/planning_graph.h"
+#include "kinograph/planning/plan.h"
+#include "kinograph/planning/solver/constraint_state.h"
 
 namespace kinograph::planning {
 
@@ -27,30 +31,54 @@ struct ConstraintReport {
   std::string where;            ///< factor name and first key, e.g. "DynamicsStepFactor q(0,12)"
 };
 
-/// Owns the schedule over a set of constraint factors (the factors hold the multipliers).
+/// The schedule over a set of constraint entries whose multipliers live in `state`.
 class AugmentedLagrangian {
  public:
-  AugmentedLagrangian(std::vector<std::shared_ptr<ConstrainedFactor>> factors,
+  /// Binds every entry to `state` and sets μ₀. The entries and the state must outlive this.
+  AugmentedLagrangian(std::vector<const FactorEntry*> constraints, ConstraintState& state,
                       AugmentedLagrangianOptions options = {});
 
-  /// Sets μ on every factor.
-  void set_penalty(double mu);
-  double penalty() const { return mu_; }
+  double penalty() const { return state_.penalty(); }
   /// The worst scaled violation at `values` and where it is.
   ConstraintReport report(const graph::Values& values) const;
   /// After an inner solve: λ ← λ + μc on every factor, then μ grows unless the worst scaled
   /// violation fell below required_decrease × the previous one. Returns that violation.
   double update(const graph::Values& values);
-  /// Zeroes all multipliers and sets μ₀.
-  void reset();
-
-  const std::vector<std::shared_ptr<ConstrainedFactor>>& factors() const { return factors_; }
 
  private:
-  std::vector<std::shared_ptr<ConstrainedFactor>> factors_;
+  std::vector<const FactorEntry*> constraints_;
+  ConstraintState& state_;
   AugmentedLagrangianOptions options_;
-  double mu_;
   double last_violation_ = -1;
 };
+
+/// Limits and tolerances of the outer loop.
+struct OuterLoopOptions {
+  /// Stop when every constraint row's scaled violation |z/s| is below this.
+  double constraint_tolerance = 1e-3;
+  int max_outer_iterations = 15;          ///< augmented-Lagrangian updates
+  int max_inner_iterations = 15;          ///< LM linearizations per outer iteration
+  int max_total_iterations = 400;         ///< LM linearizations over the whole solve
+  double inner_tolerance_initial = 1e-2;  ///< LM relative decrease in the first outer iteration
+  /// ... tightened by 10× per outer iteration down to this (feasible plans stop here).
+  double inner_tolerance_final = 1e-3;
+};
+
+/// What the outer loop ended with.
+struct OuterLoopResult {
+  std::string status;  ///< "converged", "infeasible" or "non_finite"
+  std::string reason;  ///< why, when not converged
+  int iterations = 0;  ///< LM linearizations
+  int outer_iterations = 0;
+  int linear_solves = 0;
+  ConstraintReport worst;  ///< at the end
+};
+
+/// Runs LM on `graph` from `values` inside the augmented-Lagrangian outer loop until the
+/// constraints hold at the final inner tolerance or a limit is reached; `values` ends at the
+/// last iterate. `name` labels the debug log lines.
+OuterLoopResult solve_outer_loop(const graph::FactorGraph& graph, graph::Values& values,
+                                 AugmentedLagrangian& al, const OuterLoopOptions& options,
+                                 const std::string& name);
 
 }  // namespace kinograph::planning

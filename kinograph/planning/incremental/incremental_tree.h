@@ -1,0 +1,65 @@
+#pragma once
+// The incremental planner's solver state: the planning graph's factor table in its incremental
+// form, the ISAM2 Bayes tree over it, the constraint multipliers beside it, and the factor
+// changes waiting for the next ISAM2 update.
+#include <map>
+#include <memory>
+#include <vector>
+
+#include "kinograph/graph/isam2.h"
+#include "kinograph/planning/formulation/planning_graph.h"
+#include "kinograph/planning/solver/constraint_state.h"
+
+namespace kinograph::planning {
+
+/// Totals of the ISAM2 updates of one replan.
+struct UpdateTotals {
+  int updates = 0;
+  long cliques_reeliminated = 0;
+  long variables_relinearized = 0;
+  int full_reeliminations = 0;
+  double isam2_s = 0;
+};
+
+/// The Bayes tree of a planning graph and the table of its factors (slots are ISAM2 indices).
+struct IncrementalTree {
+  explicit IncrementalTree(graph::ISAM2Options options) : isam2_options(options) {}
+
+  graph::ISAM2Options isam2_options;
+  std::unique_ptr<graph::ISAM2> isam;
+  std::vector<FactorEntry> entries;  ///< live factors
+  std::map<int, std::shared_ptr<CollisionContext>> contexts;  ///< collision world per obstacle
+  std::shared_ptr<dynamics::Data> workspace;
+  ConstraintState constraints;
+  double last_violation = -1;  ///< worst scaled violation at the last multiplier round
+
+  /// A fresh Bayes tree of every entry at `values` (one full elimination); nothing pending.
+  graph::ISAM2Result build(const graph::Values& values);
+  /// Queues entry `i` to be added at the next update (and its old slot, if any, removed).
+  void queue_add(size_t i) { pending_add_.push_back(i); }
+  void queue_remove(size_t slot) { pending_remove_.push_back(slot); }
+  /// A fresh tree from the current estimate at the next update when re-added factors left
+  /// many empty slots in the ISAM2 graph.
+  void compact_if_sparse();
+  /// One ISAM2 update with the queued changes; totals accumulate in `totals`.
+  graph::ISAM2Result update(bool force_relinearize, UpdateTotals& totals);
+
+  /// The soft cost (and the worst violation) of the ISAM2 graph at its estimate, in slot order.
+  double soft_cost(double* violation = nullptr) const;
+
+  /// The estimate and the constraint state, to return to when a replan's result is dropped.
+  struct Snapshot {
+    graph::Values values;
+    ConstraintState::Snapshot constraints;
+  };
+  Snapshot snapshot() const { return {isam->estimate(), constraints.snapshot()}; }
+  /// A fresh tree at the snapshot; false when it cannot be built.
+  bool restore(const Snapshot& s);
+
+ private:
+  std::vector<size_t> pending_add_;     // entries to add
+  std::vector<size_t> pending_remove_;  // ISAM2 slots to empty
+  graph::Values pending_values_;        // only when the tree is (re)built
+};
+
+}  // namespace kinograph::planning
