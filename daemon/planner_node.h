@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "daemon/message_convert.h"
+#include "kinograph/lcm/message_convert.h"
 #include "kinograph/planning/batch/batch_planner.h"
 #include "kinograph/planning/incremental/incremental_planner.h"
 #include "kinograph/planning/io/scene.h"
@@ -33,6 +33,13 @@ class Subscription;
 }  // namespace lcm
 
 namespace kinograph::daemon {
+
+// The node takes and answers messages in the LCM conversion's types.
+using messages::Check;
+using messages::GoalRequest;
+using messages::MeasuredState;
+using messages::ObstacleUpdate;
+using messages::RobotIdentity;
 
 /// Options of a PlannerNode, with defaults for a robot on the local LCM network.
 struct PlannerNodeOptions {

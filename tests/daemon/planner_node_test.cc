@@ -257,7 +257,7 @@ class ReplanFixture : public NodeFixture {
     return p;
   }
   static planning::Validation check(const planning::Problem& problem, const plan_t& msg) {
-    return planning::validate(problem, plan_from_message(msg));
+    return planning::validate(problem, messages::plan_from_message(msg));
   }
   // Where the tip of the arm is at step k of a plan.
   Eigen::Vector3d tip_at(const plan_t& plan, int k) const {
