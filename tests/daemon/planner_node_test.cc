@@ -494,6 +494,30 @@ TEST_F(ReplanFixture, BatchModeWarmStartsObstacleReplans) {
   EXPECT_EQ(node_->counters().incremental, 0);
 }
 
+// The node's batch solves are in the formulation of PlannerNodeOptions::planner. The plan tells:
+// condensed torques are RNEA of the trajectory (no dynamics residual), the DFG's are its own τ
+// variables, which meet the equations of motion to the solver's tolerance only.
+TEST_F(ReplanFixture, BatchSolvesAreCondensedByDefault) {
+  PlannerNodeOptions options;
+  options.incremental = false;
+  start_reach(options);
+  const plan_t p = plan_goal(1, kGoal, 1);
+  ASSERT_EQ(p.status, plan_t::SUCCESS) << describe(p);
+  EXPECT_LT(p.max_dynamics_residual, 1e-9);
+}
+
+TEST_F(ReplanFixture, BatchSolvesAreInTheDfgFormulationWhenAsked) {
+  PlannerNodeOptions options;
+  options.incremental = false;
+  options.planner.formulation = planning::Formulation::kDynamicFactorGraph;
+  start_reach(options);
+  const plan_t p = plan_goal(1, kGoal, 1);
+  ASSERT_EQ(p.status, plan_t::SUCCESS) << describe(p);
+  EXPECT_EQ(p.method, "batch");
+  EXPECT_GT(p.max_dynamics_residual, 1e-9);
+  EXPECT_TRUE(check(problem_with(kGoal), p).valid);
+}
+
 // An obstacle with a NaN coordinate is rejected (a status says why) and triggers no replan.
 TEST_F(ReplanFixture, NaNObstacleIsRejectedWithoutReplanning) {
   start_reach();
