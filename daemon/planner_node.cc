@@ -75,7 +75,7 @@ PlannerNode::PlannerNode(planning::Scene scene, PlannerNodeOptions options, lcm:
     throw std::runtime_error(
         "LCM could not start on \"" +
         (options_.lcm_url.empty() ? std::string("default URL") : options_.lcm_url) +
-        "\" (for udpm a multicast route is needed, see DESIGN.md)");
+        "\" (for udpm a multicast route is needed, see docs/network.md)");
   }
   next_obstacle_id_ = static_cast<int>(scene_.problem.obstacles.size());
   for (const auto& o : scene_.problem.obstacles) {

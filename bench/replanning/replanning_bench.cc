@@ -1,4 +1,4 @@
-// Replanning benchmark of the paper's Table II on this machine (issue 6): for each iiwa problem
+// Replanning benchmark of the paper's Table II on this machine: for each iiwa problem
 // of tasks 1 and 2 (robots/scenes/iiwa_desk.yaml, iiwa_min_torque.yaml; first goals from the
 // seeded goal sampler, as bench/planning), plan once, change the goal to a nearby seeded random
 // goal and replan with DFGP-L (batch, straight line), DFGP-W (batch, warm start from the first
@@ -135,8 +135,8 @@ void replan_all(Row& row, const Problem& first_problem, const Problem& changed,
   if (st.fell_back) ++row.inc.fell_back;
   if (inc.success() && !st.fell_back) ++row.inc.incremental_ok;
   if (!stiff) return;
-  // The same replan with the other penalty cap and without fallback: the issue's warning about
-  // Gauss–Newton on a stiff graph (μ up to the batch's 1e7), measured against a moderate cap.
+  // The same replan with the other penalty cap and without fallback: whether Gauss–Newton on a
+  // stiff graph (μ up to the batch's 1e7) blows up, measured against a moderate cap.
   planning::IncrementalPlannerOptions so = io;
   so.max_penalty = alt_penalty(io);
   so.fallback = false;
