@@ -211,8 +211,8 @@ int run(int argc, char** argv) {
                    "[--log-level warn|info|debug|trace] [--tol 1e-2] [--final-tol 1e-4] "
                    "[--relinearize-threshold X (instead of relinearizing all)] [--no-polish] "
                    "[--polish-objective] [--max-penalty 1e4] [--max-force-ratio 0.1] "
-                   "[--stop-rise 0.25] "
-                   "[--no-linearize-at-evaluation] [--stop-tol 1e-2] [--lambda-initial 1e-2] "
+                   "[--stop-rise 0.5] "
+                   "[--no-linearize-at-evaluation] [--stop-tol 5e-2] [--lambda-initial 1e-2] "
                    "[--lambda-decrease 100] [--lambda-min 1e-7] [--limit-epsilon X] [--only I]\n";
       return 1;
     }
