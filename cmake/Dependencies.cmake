@@ -1,4 +1,4 @@
-# Third-party targets, found the ways that work on Debian 12 (see shared/reference/platform.md §2).
+# Third-party targets, found the ways that work on Debian 12 (docs/build.md says why).
 find_package(PkgConfig REQUIRED)
 find_package(Eigen3 3.3 REQUIRED NO_MODULE)
 find_package(urdfdom REQUIRED)

@@ -1,8 +1,9 @@
 // kinographd: the kinograph planner daemon for one robot on an LCM network.
 //   kinographd SCENE.yaml [--prefix IIWA] [--lcm-url URL] [--status-period 1.0]
-//              [--batch-only] [--max-goal-change RAD]
-// The scene gives the robot, default horizon and steps, start, fixed obstacles and objective
-// weights; goals, obstacle updates and measured states arrive over LCM.
+//              [--batch-only] [--max-goal-change RAD] [--formulation condensed|dfg]
+// The scene gives the robot, default horizon and steps, start, fixed obstacles, objective
+// weights and the batch formulation; goals, obstacle updates and measured states arrive over
+// LCM.
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
@@ -11,6 +12,7 @@
 #include <iostream>
 
 #include "daemon/planner_node.h"
+#include "kinograph/planning/io/scene.h"
 
 namespace {
 std::atomic<bool> g_stop{false};
@@ -38,6 +40,11 @@ int main(int argc, char** argv) {
   app.add_option("--max-goal-change", options.replanning.max_incremental_goal_change,
                  "plan joint goals that moved more than this (rad) from scratch (default: never)")
       ->check(CLI::PositiveNumber);
+  std::string formulation;  // empty: the scene's planner.formulation
+  app.add_option("--formulation", formulation,
+                 "batch formulation: condensed (tau = RNEA per step) or dfg (the paper's full "
+                 "dynamic factor graph); default: the scene's planner.formulation")
+      ->check(CLI::IsMember({"condensed", "dfg"}));
   CLI11_PARSE(app, argc, argv);
   options.replanning.use_incremental = !batch_only;
   spdlog::set_level(spdlog::level::from_str(level));
@@ -45,7 +52,13 @@ int main(int argc, char** argv) {
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   try {
-    kinograph::daemon::PlannerNode node(kinograph::planning::load_scene(scene_path), options);
+    kinograph::planning::Scene scene = kinograph::planning::load_scene(scene_path);
+    // Every batch solve of the node (first plans, fallbacks) is in this formulation.
+    const std::string name = formulation.empty() ? scene.planner.formulation : formulation;
+    options.replanning.incremental.batch.formulation = kinograph::planning::formulation_from_name(name).value();
+    spdlog::info("kinographd: batch formulation {}",
+                 kinograph::planning::to_string(options.replanning.incremental.batch.formulation));
+    kinograph::daemon::PlannerNode node(std::move(scene), options);
     node.run(g_stop);
     const auto c = node.counters();
     if (g_signal != 0) spdlog::info("kinographd: signal {} received", g_signal.load());

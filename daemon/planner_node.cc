@@ -43,7 +43,7 @@ PlannerNode::PlannerNode(planning::Scene scene, PlannerNodeOptions options, lcm:
     throw std::runtime_error(
         "LCM could not start on \"" +
         (options_.lcm_url.empty() ? std::string("default URL") : options_.lcm_url) +
-        "\" (for udpm a multicast route is needed, see DESIGN.md)");
+        "\" (for udpm a multicast route is needed, see docs/network.md)");
   }
   next_obstacle_id_ = static_cast<int>(scene_.problem.obstacles.size());
   for (const auto& o : scene_.problem.obstacles) {
@@ -93,8 +93,8 @@ void PlannerNode::answer_with_failure(int8_t status, const std::string& reason, 
     ++counters_.plans_published;
     ++counters_.failures;
   }
-  plan_t answer =
-      failure_message(status, reason, identity_.model_name, plan_id, goal_id, now_utime());
+  plan_t answer = messages::failure_message(status, reason, identity_.model_name, plan_id, goal_id,
+                                            now_utime());
   lcm_->publish(channel("PLAN"), &answer);
 }
 
@@ -105,7 +105,8 @@ void PlannerNode::on_goal(const lcm::ReceiveBuffer* rbuf, const std::string& cha
     return;
   }
   GoalRequest request;
-  if (Check c = goal_from_message(msg, *scene_.problem.model, identity_, request); !c.ok) {
+  if (Check c = messages::goal_from_message(msg, *scene_.problem.model, identity_, request);
+      !c.ok) {
     reject(channel + ": " + c.reason);
     // The sender named a goal: answer it, so no goal ever goes unanswered.
     if (msg.goal_id >= 0) answer_with_failure(plan_t::INVALID_GOAL, c.reason, msg.goal_id);
@@ -136,7 +137,7 @@ void PlannerNode::on_obstacles(const lcm::ReceiveBuffer* rbuf, const std::string
     return;
   }
   std::vector<ObstacleUpdate> updates;
-  if (Check c = obstacles_from_message(msg, updates); !c.ok) {
+  if (Check c = messages::obstacles_from_message(msg, updates); !c.ok) {
     reject(channel + ": " + c.reason);
     return;
   }
@@ -158,7 +159,7 @@ void PlannerNode::on_state(const lcm::ReceiveBuffer* rbuf, const std::string& ch
     return;
   }
   MeasuredState state;
-  if (Check c = state_from_message(msg, *scene_.problem.model, identity_, state); !c.ok) {
+  if (Check c = messages::state_from_message(msg, *scene_.problem.model, identity_, state); !c.ok) {
     reject(channel + ": " + c.reason);
     return;
   }
@@ -255,11 +256,11 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan) {
   plan_t msg;
   if (threw) {
     spdlog::error("goal {}: planner error: {}", goal.goal_id, error);
-    msg = failure_message(plan_t::FAILED, "planner error: " + error, identity_.model_name, plan_id,
-                          goal.goal_id, now_utime());
+    msg = messages::failure_message(plan_t::FAILED, "planner error: " + error, identity_.model_name,
+                                    plan_id, goal.goal_id, now_utime());
   } else {
-    msg = plan_to_message(plan, *problem.model, identity_.model_name, plan_id, goal.goal_id,
-                          now_utime());
+    msg = messages::plan_to_message(plan, *problem.model, identity_.model_name, plan_id,
+                                    goal.goal_id, now_utime());
     msg.method = report.method;
     spdlog::info("goal {}: plan {} {} ({}, {} iterations, {:.1f} ms)", goal.goal_id, plan_id,
                  plan.success() ? "valid" : "INVALID", msg.method, plan.stats.iterations,

@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "daemon/message_convert.h"
+#include "kinograph/lcm/message_convert.h"
 #include "kinograph/planning/io/scene.h"
 #include "kinograph/planning/replanner.h"
 
@@ -28,6 +28,13 @@ class Subscription;
 }  // namespace lcm
 
 namespace kinograph::daemon {
+
+// The node takes and answers messages in the LCM conversion's types.
+using messages::Check;
+using messages::GoalRequest;
+using messages::MeasuredState;
+using messages::ObstacleUpdate;
+using messages::RobotIdentity;
 
 /// Options of a PlannerNode, with defaults for a robot on the local LCM network.
 struct PlannerNodeOptions {

@@ -16,7 +16,7 @@
 
 namespace kinograph::render {
 
-/// How a plan is drawn; defaults give the 5-frame 1600×400 strip of the issue.
+/// How a plan is drawn; defaults give a 5-frame 1600×400 strip.
 struct FrameOptions {
   int frames = 5;    ///< robot poses drawn, evenly spaced in time (must be ≥ 1)
   int width = 1600;  ///< whole picture, pixels

@@ -11,8 +11,8 @@
 #include <memory>
 #include <sstream>
 
-#include "daemon/message_convert.h"
 #include "kinograph/goal_t.hpp"
+#include "kinograph/lcm/message_convert.h"
 #include "kinograph/obstacle_list_t.hpp"
 #include "kinograph/planning/io/plan_json.h"
 #include "kinograph/planning/io/scene.h"
@@ -136,7 +136,7 @@ int finish(PlanWaiter& waiter, const Common& c, int64_t goal_id,
       scene.problem.obstacles.back().id = static_cast<int>(scene.problem.obstacles.size()) - 1;
     }
     if (plan->num_steps == 0) throw CommandFailure("plan has no trajectory to write", 2);
-    planning::write_plan(daemon::plan_from_message(*plan), scene, c.out);
+    planning::write_plan(messages::plan_from_message(*plan), scene, c.out);
     std::cout << "wrote " << c.out << "\n";
   }
   return plan->status == plan_t::SUCCESS ? 0 : 2;
@@ -241,8 +241,8 @@ const bool kSendObstacle = register_command([](CLI::App& root) {
     std::cout << "sent obstacle \"" << o.id << "\" on " << c->prefix << "_OBSTACLES\n";
     std::optional<std::pair<std::string, collision::Obstacle>> extra;
     if (!*remove) {
-      std::vector<daemon::ObstacleUpdate> updates;
-      if (daemon::obstacles_from_message(msg, updates).ok) {
+      std::vector<messages::ObstacleUpdate> updates;
+      if (messages::obstacles_from_message(msg, updates).ok) {
         collision::Obstacle obstacle;
         obstacle.shape = updates[0].shape;
         obstacle.pose = updates[0].pose;
@@ -321,7 +321,7 @@ const bool kLogPlans = register_command([](CLI::App& root) {
       if (msg.num_steps == 0) continue;
       const std::string path = *out_dir + "/plan_" + std::to_string(msg.goal_id) + "_" +
                                std::to_string(msg.plan_id) + ".json";
-      planning::write_plan(daemon::plan_from_message(msg), s, path);
+      planning::write_plan(messages::plan_from_message(msg), s, path);
       ++written;
     }
     std::cout << written << " plans written to " << *out_dir;

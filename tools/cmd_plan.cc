@@ -1,6 +1,7 @@
 // `kinograph plan SCENE.yaml --out plan.json [--init L|W --warm plan.json]
 // [--formulation condensed|dfg]`: plans a scene with the batch planner, prints a summary
-// (success, every validation figure, iterations, solve time, cost) and writes the plan file.
+// (formulation, success, every validation figure, iterations, solve time, cost) and writes the
+// plan file.
 // Exit status: 0 the plan validates, 2 it does not, 1 bad input (files, flags).
 #include <iostream>
 #include <memory>
@@ -11,6 +12,7 @@
 #include "kinograph/planning/io/plan_json.h"
 #include "kinograph/planning/io/scene.h"
 #include "tools/command_registry.h"
+#include "tools/formulation.h"
 
 namespace kinograph::tools {
 namespace {
@@ -34,14 +36,8 @@ void run_plan(const PlanArgs& args) {
   std::string init = args.init.empty() ? scene.planner.init : args.init;
   std::string warm = args.warm.empty() ? scene.planner.warm : args.warm;
   if (!args.warm.empty() && args.init.empty()) init = "W";
-  const std::string formulation =
-      args.formulation.empty() ? scene.planner.formulation : args.formulation;
-  if (formulation != "condensed") {
-    // The batch planner builds the condensed graph only; the full DFG factors exist
-    // (dfg_builder.h) but are not selectable in BatchPlannerOptions yet.
-    throw CommandFailure("formulation '" + formulation +
-                         "' is not available in the batch planner (use 'condensed')");
-  }
+  planning::BatchPlannerOptions options;
+  options.formulation = choose_formulation(scene, args.formulation);
   std::optional<planning::Plan> warm_plan;
   if (init == "W") {
     if (warm.empty()) throw CommandFailure("--init W needs --warm PLAN.json");
@@ -51,15 +47,13 @@ void run_plan(const PlanArgs& args) {
       throw CommandFailure(e.what());
     }
   }
-  const planning::BatchPlanner planner;
+  const planning::BatchPlanner planner(options);
   const planning::Plan plan = planner.plan(scene.problem, warm_plan ? &*warm_plan : nullptr);
-  try {
-    planning::write_plan(plan, scene, args.out);
-  } catch (const std::exception& e) {
-    throw CommandFailure(e.what());
-  }
+  const planning::Formulation used = planner.options().formulation;
+  write_plan_file(plan, scene, used, args.out);
   if (!args.quiet) {
     std::cout << "plan " << scene.problem.name << " (" << args.scene << ") -> " << args.out << "\n"
+              << "formulation: " << planning::to_string(used) << "\n"
               << planning::summarize(plan);
   }
   if (!plan.success()) {
@@ -80,10 +74,7 @@ const bool kRegistered = register_command([](CLI::App& root) {
                   "the scene's planner.init")
       ->check(CLI::IsMember({"L", "W"}));
   cmd->add_option("--warm", args->warm, "Plan file (JSON) to warm-start from (implies --init W)");
-  cmd->add_option(
-         "--formulation", args->formulation,
-         "condensed (tau = RNEA per step) or dfg; default: the scene's planner.formulation")
-      ->check(CLI::IsMember({"condensed", "dfg"}));
+  add_formulation_option(cmd, args->formulation);
   cmd->add_flag("--quiet,-q", args->quiet, "Print nothing; only the exit status tells");
   cmd->callback([args] { run_plan(*args); });
 });

@@ -1,8 +1,10 @@
-// `kinograph replan SCENE.yaml CHANGE.yaml [--out-before a.json] [--out-after b.json]`: plans
-// a scene, applies a change file (new goal, measured start, horizon, obstacles added, moved or
-// removed; robots/scenes/changes/) and replans incrementally (iDFGP), printing both plans and
-// what the replan did (ISAM2 updates, cliques re-eliminated, fallback). Exit status: 0 the
-// replan validates, 2 it (or the first plan) does not, 1 bad input (files, flags).
+// `kinograph replan SCENE.yaml CHANGE.yaml [--out-before a.json] [--out-after b.json]
+// [--formulation condensed|dfg]`: plans a scene, applies a change file (new goal, measured
+// start, horizon, obstacles added, moved or removed; robots/scenes/changes/) and replans
+// incrementally (iDFGP), printing both plans and what the replan did (ISAM2 updates, cliques
+// re-eliminated, fallback). The formulation is that of the batch solves (the first plan and any
+// fallback). Exit status: 0 the replan validates, 2 it (or the first plan) does not, 1 bad
+// input (files, flags).
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -13,6 +15,7 @@
 #include "kinograph/planning/io/scene.h"
 #include "kinograph/planning/replanner.h"
 #include "tools/command_registry.h"
+#include "tools/formulation.h"
 
 namespace kinograph::tools {
 namespace {
@@ -20,6 +23,7 @@ namespace {
 struct ReplanArgs {
   std::string scene, change;
   std::string out_before, out_after;
+  std::string formulation;  // empty: the scene's
   bool quiet = false;
 };
 
@@ -47,14 +51,19 @@ void run_replan(const ReplanArgs& args) {
   } catch (const std::exception& e) {
     throw CommandFailure(e.what());
   }
-  planning::Replanner planner;
+  // The formulation of every batch solve: the first plan and any fallback.
+  planning::ReplannerOptions options;
+  options.incremental.batch.formulation = choose_formulation(scene, args.formulation);
+  planning::Replanner planner(options);
+  const planning::Formulation used = planner.options().incremental.batch.formulation;
   const planning::Plan before = planner.plan(scene.problem, /*new_goal=*/true);
   if (!args.quiet) {
     std::cout << "plan " << scene.problem.name << " (" << args.scene << ")\n"
+              << "formulation: " << planning::to_string(used) << "\n"
               << planning::summarize(before);
   }
   try {
-    if (!args.out_before.empty()) planning::write_plan(before, scene, args.out_before);
+    if (!args.out_before.empty()) write_plan_file(before, scene, used, args.out_before);
   } catch (const std::exception& e) {
     throw CommandFailure(e.what());
   }
@@ -70,7 +79,7 @@ void run_replan(const ReplanArgs& args) {
   }
   try {
     if (!args.out_after.empty()) {
-      planning::write_plan(after, planning::apply_change(scene, change), args.out_after);
+      write_plan_file(after, planning::apply_change(scene, change), used, args.out_after);
     }
   } catch (const std::exception& e) {
     throw CommandFailure(e.what());
@@ -94,6 +103,7 @@ const bool kRegistered = register_command([](CLI::App& root) {
       ->required();
   cmd->add_option("--out-before", args->out_before, "Plan file (JSON) of the first plan");
   cmd->add_option("--out-after", args->out_after, "Plan file (JSON) of the replan");
+  add_formulation_option(cmd, args->formulation);
   cmd->add_flag("--quiet,-q", args->quiet, "Print nothing; only the exit status tells");
   cmd->callback([args] { run_replan(*args); });
 });

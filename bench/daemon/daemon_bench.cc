@@ -1,5 +1,5 @@
-// End-to-end latency of the planner daemon's node (issue: "the daemon answers an obstacle change
-// in X ms"): an in-process PlannerNode on a memq:// LCM, a client that publishes goal_t and
+// End-to-end latency of the planner daemon's node ("the daemon answers an obstacle change in
+// X ms"): an in-process PlannerNode on a memq:// LCM, a client that publishes goal_t and
 // obstacle_list_t and waits for the plan_t answering it. For each of N seeded problems on the
 // iiwa desk scene (robots/scenes/iiwa_desk.yaml) a fresh node receives, in order:
 //   1. a first goal (sampled as bench/replanning: payload above the desk),

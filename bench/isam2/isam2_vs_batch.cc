@@ -1,4 +1,4 @@
-// ISAM2 against a batch re-solve on a trajectory-shaped chain whose goal changes (issue 4).
+// ISAM2 against a batch re-solve on a trajectory-shaped chain whose goal changes.
 //
 // Per step t: four 5-vectors q_t, v_t, a_t, u_t (20 scalars). Between neighbouring steps a
 // constant-acceleration prior couples (q, v, a)_t with (q, v, a)_{t+1}; per step a linear

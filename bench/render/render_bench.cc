@@ -1,5 +1,5 @@
-// Renderer benchmark: a 5-frame iiwa strip at 1600×400 including PNG writing (issue 7 target:
-// under 0.5 s). Reports the cold first picture (context creation, shader JIT, mesh upload)
+// Renderer benchmark: a 5-frame iiwa strip at 1600×400 including PNG writing (target: under
+// 0.5 s). Reports the cold first picture (context creation, shader JIT, mesh upload)
 // separately from warm pictures, with medians over repeated runs. Prints JSON, then a Markdown
 // table.
 #include <algorithm>

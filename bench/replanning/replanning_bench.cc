@@ -1,4 +1,4 @@
-// Replanning benchmark of the paper's Table II on this machine (issue 6): for each iiwa problem
+// Replanning benchmark of the paper's Table II on this machine: for each iiwa problem
 // of tasks 1 and 2 (robots/scenes/iiwa_desk.yaml, iiwa_min_torque.yaml; first goals from the
 // seeded goal sampler, as bench/planning), plan once, change the goal to a nearby seeded random
 // goal and replan with DFGP-L (batch, straight line), DFGP-W (batch, warm start from the first

@@ -45,7 +45,7 @@ class ConvexShape {
 
 // Call once anywhere: it references an out-of-line btScalar function of Bullet, so a build
 // compiled for double but linked against the float libraries (or the reverse) fails to link
-// instead of crashing at run time (reference/platform.md §4).
+// instead of crashing at run time (docs/build.md).
 void bullet_precision_link_guard();
 
 }  // namespace kinograph::collision

@@ -53,7 +53,8 @@ TEST(PairDistance, SphereSphereSeparatedAndPenetrating) {
   expect_vec(r.point_on_b, {0, 0.1, 0}, kTol, "point on B");
 }
 
-// Sphere radius 0.5 against the box [-1,1]^3: platform.md §4's table, with sharp edges.
+// Sphere radius 0.5 against the box [-1,1]^3 with sharp edges: face, edge, corner and deep cases
+// against their exact distances.
 TEST(PairDistance, SphereBoxFaceEdgeCornerAndDeep) {
   const ConvexShape sphere(Shape::sphere(0.5)), box(Shape::box(2, 2, 2));
   struct Case {

@@ -257,7 +257,7 @@ class ReplanFixture : public NodeFixture {
     return p;
   }
   static planning::Validation check(const planning::Problem& problem, const plan_t& msg) {
-    return planning::validate(problem, plan_from_message(msg));
+    return planning::validate(problem, messages::plan_from_message(msg));
   }
   // Where the tip of the arm is at step k of a plan.
   Eigen::Vector3d tip_at(const plan_t& plan, int k) const {
@@ -492,6 +492,30 @@ TEST_F(ReplanFixture, BatchModeWarmStartsObstacleReplans) {
   const plan_t next = plan_goal(2, Eigen::Vector2d(1.1, 0.1), 3);
   EXPECT_EQ(next.method, "batch");
   EXPECT_EQ(node_->counters().incremental, 0);
+}
+
+// The node's batch solves are in the formulation of PlannerNodeOptions::replanning. The plan tells:
+// condensed torques are RNEA of the trajectory (no dynamics residual), the DFG's are its own τ
+// variables, which meet the equations of motion to the solver's tolerance only.
+TEST_F(ReplanFixture, BatchSolvesAreCondensedByDefault) {
+  PlannerNodeOptions options;
+  options.replanning.use_incremental = false;
+  start_reach(options);
+  const plan_t p = plan_goal(1, kGoal, 1);
+  ASSERT_EQ(p.status, plan_t::SUCCESS) << describe(p);
+  EXPECT_LT(p.max_dynamics_residual, 1e-9);
+}
+
+TEST_F(ReplanFixture, BatchSolvesAreInTheDfgFormulationWhenAsked) {
+  PlannerNodeOptions options;
+  options.replanning.use_incremental = false;
+  options.replanning.incremental.batch.formulation = planning::Formulation::kDynamicFactorGraph;
+  start_reach(options);
+  const plan_t p = plan_goal(1, kGoal, 1);
+  ASSERT_EQ(p.status, plan_t::SUCCESS) << describe(p);
+  EXPECT_EQ(p.method, "batch");
+  EXPECT_GT(p.max_dynamics_residual, 1e-9);
+  EXPECT_TRUE(check(problem_with(kGoal), p).valid);
 }
 
 // An obstacle with a NaN coordinate is rejected (a status says why) and triggers no replan.

@@ -13,7 +13,8 @@
 namespace kinograph::dynamics {
 namespace {
 
-// Spong's Acrobot: τ = M q̈ + C q̇ − τ_g + b q̇ (reference/robots-and-lcm.md §1).
+// Spong's Acrobot in Drake's convention (θ1 from the downward vertical, θ2 relative to link 1;
+// parameters in robots/README.md): τ = M q̈ + C q̇ − τ_g + b q̇.
 Eigen::Vector2d closed_form(const Eigen::Vector2d& q, const Eigen::Vector2d& qd,
                             const Eigen::Vector2d& qdd) {
   const double m1 = 1, m2 = 1, l1 = 1, lc1 = 0.5, lc2 = 1, Ic1 = 0.083, Ic2 = 0.33, b = 0.1,

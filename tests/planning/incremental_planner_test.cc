@@ -1,4 +1,4 @@
-// iDFGP (issue 6): incremental replans validate and agree with batch solves of the changed
+// iDFGP: incremental replans validate and agree with batch solves of the changed
 // problem; obstacle moves, removals and start updates behave as the problem says.
 #include "kinograph/planning/incremental/incremental_planner.h"
 

@@ -11,6 +11,7 @@
 #include "kinograph/collision/segment_checker.h"
 #include "kinograph/dynamics/data.h"
 #include "kinograph/dynamics/kinematics.h"
+#include "kinograph/planning/batch/batch_planner.h"
 
 namespace kinograph::planning {
 namespace {
@@ -520,6 +521,17 @@ TEST(ShippedScenes, MinTorqueSceneDiffersOnlyInItsWeight) {
   ASSERT_TRUE(desk.payload);
   EXPECT_EQ(desk.payload->mass, 2.0);
   EXPECT_EQ(desk.payload->offset, Eigen::Vector3d(0, 0, 0.05));
+}
+
+// planner.formulation names the batch planner's formulations as to_string() does; nothing else.
+TEST(PlannerSpec, FormulationNamesAreTheBatchPlannersOwn) {
+  EXPECT_EQ(formulation_from_name("condensed"), Formulation::kCondensed);
+  EXPECT_EQ(formulation_from_name("dfg"), Formulation::kDynamicFactorGraph);
+  for (Formulation f : {Formulation::kCondensed, Formulation::kDynamicFactorGraph}) {
+    EXPECT_EQ(formulation_from_name(to_string(f)), f);
+  }
+  EXPECT_FALSE(formulation_from_name("DFG"));
+  EXPECT_FALSE(formulation_from_name(""));
 }
 
 }  // namespace

@@ -211,6 +211,12 @@ std::unique_ptr<IncrementalTree> solve_incremental_graph(const Problem& problem,
                                            kMaxCarriedPenalty));
   const int n = problem.model->nq(), N = problem.steps;
   plan = plan_from_trajectory(problem, read_trajectory(pg.values, N, n));
+  if (batch.formulation == Formulation::kDynamicFactorGraph &&
+      pg.values.contains(batch.dfg.keys.torque_key(0, 0))) {
+    for (int k = 0; k <= N; ++k) {
+      plan.tau.row(k) = dfg_torques(pg.values, *problem.model, k, batch.dfg.keys).transpose();
+    }
+  }
   plan.stats.method = method;
   plan.stats.status = r.status;
   plan.stats.reason = r.reason;

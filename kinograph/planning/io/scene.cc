@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "kinograph/dynamics/payload.h"
+#include "kinograph/planning/batch/batch_planner.h"
 
 namespace kinograph::planning {
 namespace {
@@ -501,7 +502,7 @@ class SceneParser {
     r_.expect_map(node, "planner", {"formulation", "init", "warm"});
     if (node["formulation"]) {
       planner.formulation = r_.string(node["formulation"], "planner.formulation");
-      if (planner.formulation != "condensed" && planner.formulation != "dfg") {
+      if (!formulation_from_name(planner.formulation)) {
         r_.fail(node["formulation"], "planner.formulation", "must be 'condensed' or 'dfg'");
       }
     }
@@ -572,6 +573,13 @@ std::optional<collision::ShapeKind> shape_kind_from_name(const std::string& name
        {collision::ShapeKind::kSphere, collision::ShapeKind::kBox, collision::ShapeKind::kCylinder,
         collision::ShapeKind::kCapsule, collision::ShapeKind::kMesh}) {
     if (shape_kind_name(kind) == name) return kind;
+  }
+  return std::nullopt;
+}
+
+std::optional<Formulation> formulation_from_name(const std::string& name) {
+  for (Formulation f : {Formulation::kCondensed, Formulation::kDynamicFactorGraph}) {
+    if (to_string(f) == name) return f;
   }
   return std::nullopt;
 }

@@ -46,7 +46,9 @@ struct LimitOverride {
   std::optional<double> lower, upper, velocity, effort, acceleration;
 };
 
-/// Planner choices stored with a scene; the CLI's flags override them.
+enum class Formulation;  // kinograph/planning/batch/batch_planner.h
+
+/// Planner choices stored with a scene; the CLI's and kinographd's flags override them.
 struct PlannerSpec {
   std::string formulation = "condensed";  ///< "condensed" (τ = RNEA per step) or "dfg"
   std::string init = "L";                 ///< "L" straight line, "W" warm start from `warm`
@@ -84,6 +86,10 @@ std::string scene_to_yaml(const Scene& scene);
 std::string shape_kind_name(collision::ShapeKind kind);
 /// The shape kind a scene or plan file names; nullopt for a name that is none of them.
 std::optional<collision::ShapeKind> shape_kind_from_name(const std::string& name);
+
+/// The batch formulation a planner.formulation names ("condensed" or "dfg"); nullopt for a name
+/// that is neither.
+std::optional<Formulation> formulation_from_name(const std::string& name);
 
 /// Resolves a path named in a scene: absolute as is; else relative to `anchor_dir` if it
 /// exists there, else relative to the repository root. Empty optional when neither exists.

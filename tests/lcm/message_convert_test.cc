@@ -1,13 +1,13 @@
 // Checks of LCM messages from the network: every malformed field is rejected with a reason
 // that names it, and good messages convert exactly.
-#include "daemon/message_convert.h"
+#include "kinograph/lcm/message_convert.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <limits>
 
-namespace kinograph::daemon {
+namespace kinograph::messages {
 namespace {
 
 const dynamics::Model& rr() {
@@ -183,4 +183,4 @@ TEST(PlanMessage, RoundTripsTrajectoryAndMapsStatus) {
 }
 
 }  // namespace
-}  // namespace kinograph::daemon
+}  // namespace kinograph::messages

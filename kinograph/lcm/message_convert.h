@@ -17,7 +17,7 @@
 #include "kinograph/planning/problem.h"
 #include "kinograph/robot_state_t.hpp"
 
-namespace kinograph::daemon {
+namespace kinograph::messages {
 
 /// Outcome of checking one message: ok, or why it was rejected.
 struct Check {
@@ -79,4 +79,4 @@ plan_t failure_message(int8_t status, const std::string& reason, const std::stri
 /// The planner's view of a plan_t (trajectory only; validation figures as sent).
 planning::Plan plan_from_message(const plan_t& msg);
 
-}  // namespace kinograph::daemon
+}  // namespace kinograph::messages

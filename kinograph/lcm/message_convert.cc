@@ -1,11 +1,11 @@
-#include "daemon/message_convert.h"
+#include "kinograph/lcm/message_convert.h"
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <unordered_map>
 
-namespace kinograph::daemon {
+namespace kinograph::messages {
 namespace {
 
 std::string lower(std::string s) {
@@ -281,4 +281,4 @@ planning::Plan plan_from_message(const plan_t& msg) {
   return plan;
 }
 
-}  // namespace kinograph::daemon
+}  // namespace kinograph::messages
