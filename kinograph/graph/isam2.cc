@@ -7,6 +7,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <unordered_set>
+#include <utility>
 
 #include "kinograph/graph/ordering.h"
 
@@ -17,7 +18,60 @@ using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
 }
+
+// Slots of the variables that are not fixed, in slot order.
+std::vector<int> free_slots(const Values& values) {
+  std::vector<int> slots;
+  for (int s = 0; s < values.size(); ++s) {
+    if (!values.is_fixed_slot(s)) slots.push_back(s);
+  }
+  return slots;
+}
+
+// Up to this many active rows JᵀJ is formed coefficient by coefficient: the blocked product's
+// packing costs more than the product for a collision factor's one or two rows.
+constexpr int kLazyProductRows = 8;
+
+// Powell's dogleg point at `radius` between the steepest-descent step `sd` and the Gauss–Newton
+// step `gn` (norms given); returns whether the radius limited it.
+bool dogleg_point(const Eigen::VectorXd& gn, double gn_norm, const Eigen::VectorXd& sd,
+                  double sd_norm, double radius, Eigen::VectorXd& step) {
+  if (gn_norm <= radius) {
+    step = gn;
+    return false;
+  }
+  if (sd_norm >= radius) {
+    step = (radius / sd_norm) * sd;
+    return true;
+  }
+  // τ in [0, 1] with ‖sd + τ(gn − sd)‖ = radius.
+  const Eigen::VectorXd diff = gn - sd;
+  const double a = diff.squaredNorm();
+  const double b = 2 * sd.dot(diff);
+  const double c = sd_norm * sd_norm - radius * radius;
+  const double tau = (-b + std::sqrt(std::max(b * b - 4 * a * c, 0.0))) / (2 * a);
+  step = sd + tau * diff;
+  return true;
+}
 }  // namespace
+
+/// What one update() works on, passed from step to step.
+struct ISAM2::UpdateWork {
+  bool gauss_newton = true;  // options_.step is Gauss–Newton
+  bool evaluate = false;     // the nonlinear error is evaluated (safeguard or Dogleg)
+  std::vector<int> marked;   // free variables whose cliques must be re-eliminated
+  std::vector<int> touched;  // of those, the ones on removed or added factors
+  std::vector<int> to_linearize;  // factors to linearize at θ
+  bool full = false;              // rebuild the whole tree
+  std::vector<int> vars;          // variables of the affected top
+  std::vector<int> held;          // factors held by the detached cliques
+  std::vector<int> orphans;       // roots of the subtrees below the affected top
+  std::vector<int> factors;       // factors eliminated into the new cliques
+  std::vector<int> new_cliques;   // cliques built by this update
+  std::vector<int> changed;       // variables back-substitution changed (last trial)
+  double lambda = 0;              // damping of the last trial
+  bool accepted = true;           // the last trial did not raise the error
+};
 
 std::string to_string(ISAM2Status status) {
   switch (status) {
@@ -66,9 +120,8 @@ void ISAM2::sync_layout() {
   stamp_.resize(n, 0);
 }
 
-// Up to this many active rows JᵀJ is formed coefficient by coefficient: the blocked product's
-// packing costs more than the product for a collision factor's one or two rows.
-constexpr int kLazyProductRows = 8;
+// ---------------------------------------------------------------------------------------------
+// Linearizing one factor.
 
 bool ISAM2::evaluate_factor(int f, const Values& at, LinearizedFactor* out, double* error,
                             std::string* reason) {
@@ -85,49 +138,66 @@ bool ISAM2::evaluate_factor(int f, const Values& at, LinearizedFactor* out, doub
   if (r_.size() < rows) r_.resize(rows);
   auto r = r_.head(rows);
   r.setZero();
-  const auto non_finite = [&] {
-    if (reason != nullptr) {
-      *reason = "factor " + std::to_string(f) + " (" + factor.name() +
-                ") returned a non-finite residual or Jacobian";
-    }
-    return false;
-  };
   if (out == nullptr) {
     factor.whitened(ptrs_.data(), r, nullptr);
     *error = 0.5 * r.squaredNorm();
     return true;
   }
-  LinearizedFactor& lf = *out;
-  // The factor's free variables and their columns in J.
+  collect_free_columns(factor, slots, at);
+  const long version = factor.jacobian_version();
+  const bool kept = options_.reuse_constant_jacobians && version >= 0 &&
+                    out->jacobian_version == version && out->vars == free_vars_;
+  if (kept ? relinearize_kept_jacobian(factor, *out, error)
+           : linearize_fresh(factor, *out, error)) {
+    return true;
+  }
+  if (reason != nullptr) {
+    *reason = "factor " + std::to_string(f) + " (" + factor.name() +
+              ") returned a non-finite residual or Jacobian";
+  }
+  return false;
+}
+
+// The factor's free variables (free_vars_), their first columns among the free ones
+// (free_offsets_) and the stacked Jacobian's column of each free column (free_cols_).
+void ISAM2::collect_free_columns(const Factor& factor, const std::vector<int>& slots,
+                                 const Values& at) {
   free_vars_.clear();
   free_offsets_.clear();
   free_cols_.clear();
-  for (int i = 0; i < nk; ++i) {
+  for (size_t i = 0; i < slots.size(); ++i) {
     if (at.is_fixed_slot(slots[i])) continue;
     free_vars_.push_back(slots[i]);
     free_offsets_.push_back(static_cast<int>(free_cols_.size()));
     for (int c = 0; c < factor.dims()[i]; ++c) free_cols_.push_back(factor.block_offsets()[i] + c);
   }
-  const int off = static_cast<int>(free_cols_.size());
-  const long version = factor.jacobian_version();
-  if (options_.reuse_constant_jacobians && version >= 0 && lf.jacobian_version == version &&
-      lf.vars == free_vars_) {
-    // A linear factor whose Jacobian is unchanged since lf.H was formed: only r and Jᵀr are new.
-    factor.whitened(ptrs_.data(), r, nullptr);
-    if (!r.allFinite()) return non_finite();
-    lf.error = 0.5 * r.squaredNorm();
-    if (error != nullptr) *error = lf.error;
-    lf.g.noalias() = lf.J.transpose() * r;
-    lf.active = true;
-    ++jacobians_kept_;
-    return true;
-  }
-  Eigen::Ref<Eigen::MatrixXd> J = J_.topLeftCorner(rows, cols);
-  factor.whitened(ptrs_.data(), r, &J);
-  if (!r.allFinite() || !J.allFinite()) return non_finite();
+}
+
+// A linear factor whose Jacobian is unchanged since lf.H was formed: only r and Jᵀr are new.
+bool ISAM2::relinearize_kept_jacobian(const Factor& factor, LinearizedFactor& lf, double* error) {
+  auto r = r_.head(factor.residual_dim());
+  factor.whitened(ptrs_.data(), r, nullptr);
+  if (!r.allFinite()) return false;
   lf.error = 0.5 * r.squaredNorm();
   if (error != nullptr) *error = lf.error;
-  lf.jacobian_version = options_.reuse_constant_jacobians ? version : -1;
+  lf.g.noalias() = lf.J.transpose() * r;
+  lf.active = true;
+  ++jacobians_kept_;
+  return true;
+}
+
+// Residual, Jacobian and JᵀJ, Jᵀr over the free columns; a linear factor also keeps its
+// free-column Jacobian so the next linearization can skip JᵀJ.
+bool ISAM2::linearize_fresh(const Factor& factor, LinearizedFactor& lf, double* error) {
+  const int rows = factor.residual_dim();
+  auto r = r_.head(rows);
+  Eigen::Ref<Eigen::MatrixXd> J = J_.topLeftCorner(rows, factor.jacobian_cols());
+  factor.whitened(ptrs_.data(), r, &J);
+  if (!r.allFinite() || !J.allFinite()) return false;
+  lf.error = 0.5 * r.squaredNorm();
+  if (error != nullptr) *error = lf.error;
+  const int off = static_cast<int>(free_cols_.size());
+  lf.jacobian_version = options_.reuse_constant_jacobians ? factor.jacobian_version() : -1;
   if (lf.jacobian_version >= 0) {
     lf.J.resize(rows, off);
     for (int c = 0; c < off; ++c) lf.J.col(c) = J.col(free_cols_[c]);
@@ -137,15 +207,26 @@ bool ISAM2::evaluate_factor(int f, const Values& at, LinearizedFactor* out, doub
   const int active = compact_nonzero_rows(J, r);
   lf.vars = free_vars_;
   lf.offsets = free_offsets_;
+  form_normal_equations(J, active, lf);
+  lf.active = true;
+  return true;
+}
+
+// lf.H = JᵀJ and lf.g = Jᵀr over the first `active` rows (those not all zero) and the free
+// columns; r is the residual in r_.
+void ISAM2::form_normal_equations(Eigen::Ref<Eigen::MatrixXd> J, int active,
+                                  LinearizedFactor& lf) {
+  auto r = r_.head(J.rows());
+  const int off = static_cast<int>(free_cols_.size());
   const auto Ja = J.topRows(active);
   const auto ra = r.head(active);
   if (active == 0) {
     lf.H.setZero(off, off);
     lf.g.setZero(off);
-  } else if (off == cols && active <= kLazyProductRows) {
+  } else if (off == J.cols() && active <= kLazyProductRows) {
     lf.H.noalias() = Ja.transpose().lazyProduct(Ja);
     lf.g.noalias() = Ja.transpose() * ra;
-  } else if (off == cols) {
+  } else if (off == J.cols()) {
     lf.H.resize(off, off);
     jacobian_gram(Ja, lf.H, /*upper_only=*/false);
     lf.g.noalias() = Ja.transpose() * ra;
@@ -156,8 +237,6 @@ bool ISAM2::evaluate_factor(int f, const Values& at, LinearizedFactor* out, doub
     jacobian_gram(Jf, lf.H, /*upper_only=*/false);
     lf.g.noalias() = Jf.transpose() * ra;
   }
-  lf.active = true;
-  return true;
 }
 
 bool ISAM2::linearize_factor(int f, std::string* reason) {
@@ -215,16 +294,74 @@ double ISAM2::total_error() const {
   return sum;
 }
 
+// ---------------------------------------------------------------------------------------------
+// update() and its steps, in order.
+
 ISAM2Result ISAM2::update(const std::vector<FactorPtr>& new_factors,
                           const std::vector<size_t>& removed_factor_indices,
                           const Values& new_values, const ISAM2UpdateOptions& update_options) {
   const auto t_start = Clock::now();
   ISAM2Result res;
   const int kept_before = jacobians_kept_;
-  const bool gauss_newton = options_.step == ISAM2Step::kGaussNewton;
-  const bool evaluate = options_.safeguard || !gauss_newton;
+  validate_update(new_factors, removed_factor_indices, new_values);
+  ++update_count_;
+  UpdateWork work;
+  work.gauss_newton = options_.step == ISAM2Step::kGaussNewton;
+  work.evaluate = options_.safeguard || !work.gauss_newton;
 
-  // --- Validate everything before touching any state.
+  add_variables(new_values);
+  ++stamp_counter_;  // a new marking: mark() stamps variables with this counter
+  remove_factors(removed_factor_indices, work);
+  add_factors(new_factors, work, res);
+  work.touched = work.marked;
+  if (work.evaluate) res.error_before = total_error();
+  relinearize(update_options, work, res);
+  if (work.marked.empty() && !needs_full_) {  // nothing to re-eliminate
+    report_unchanged(work, res);
+    res.total_s = seconds_since(t_start);
+    return res;
+  }
+
+  const auto t_lin = Clock::now();
+  find_affected_top(work);
+  res.full_reelimination = work.full;
+  if (!linearize_queued(work, res)) {
+    res.total_s = seconds_since(t_start);
+    return res;
+  }
+  work.factors = factors_to_eliminate(work, res);
+  res.linearize_s = seconds_since(t_lin);
+  build_affected_top(update_options, work, res);
+  if (!eliminate_and_solve(work, res)) {
+    res.total_s = seconds_since(t_start);
+    return res;
+  }
+  needs_full_ = false;
+
+  if (work.gauss_newton) {
+    carry_damping(work, res);
+  } else {
+    const auto t_dl = Clock::now();
+    apply_dogleg(res);
+    res.solve_s += seconds_since(t_dl);
+  }
+  res.trust_radius = trust_radius_;
+  tree_.clear_fresh();
+  res.jacobians_kept = jacobians_kept_ - kept_before;
+  res.total_s = seconds_since(t_start);
+  spdlog::debug(
+      "ISAM2 update {}: {} vars re-eliminated in {} cliques ({}), {} relinearized, {} cliques "
+      "solved, error {:.6g} -> {:.6g}, lambda {:.3g}, {:.3f} ms",
+      update_count_, res.variables_reeliminated, res.cliques_reeliminated,
+      work.full ? "full" : "partial", res.variables_relinearized, res.cliques_solved,
+      res.error_before, res.error_after, res.lambda, 1e3 * res.total_s);
+  return res;
+}
+
+// Throws for inconsistent input before update() changes any state.
+void ISAM2::validate_update(const std::vector<FactorPtr>& new_factors,
+                            const std::vector<size_t>& removed_factor_indices,
+                            const Values& new_values) const {
   for (const Key& k : new_values.keys()) {
     if (theta_.contains(k)) {
       throw std::invalid_argument("ISAM2::update: variable " + k.to_string() + " already exists");
@@ -252,21 +389,20 @@ ISAM2Result ISAM2::update(const std::vector<FactorPtr>& new_factors,
       }
     }
   }
-  {
-    std::unordered_set<size_t> seen;
-    for (size_t idx : removed_factor_indices) {
-      if (idx >= graph_.size()) {
-        throw std::out_of_range("ISAM2::update: no factor with index " + std::to_string(idx));
-      }
-      if (!graph_[idx] || !seen.insert(idx).second) {
-        throw std::invalid_argument("ISAM2::update: factor " + std::to_string(idx) +
-                                    " is already removed");
-      }
+  std::unordered_set<size_t> seen;
+  for (size_t idx : removed_factor_indices) {
+    if (idx >= graph_.size()) {
+      throw std::out_of_range("ISAM2::update: no factor with index " + std::to_string(idx));
+    }
+    if (!graph_[idx] || !seen.insert(idx).second) {
+      throw std::invalid_argument("ISAM2::update: factor " + std::to_string(idx) +
+                                  " is already removed");
     }
   }
-  ++update_count_;
+}
 
-  // --- New variables.
+// New variables enter θ and the estimate at their initial values (δ = 0).
+void ISAM2::add_variables(const Values& new_values) {
   for (int s = 0; s < new_values.size(); ++s) {
     const Key k = new_values.key(s);
     theta_.insert(k, new_values.at_slot(s));
@@ -277,20 +413,21 @@ ISAM2Result ISAM2::update(const std::vector<FactorPtr>& new_factors,
     }
   }
   sync_layout();
+}
 
-  ++stamp_counter_;
-  std::vector<int> marked;
-  auto mark = [&](int s) {
-    if (stamp_[s] != stamp_counter_ && !theta_.is_fixed_slot(s)) {
-      stamp_[s] = stamp_counter_;
-      marked.push_back(s);
-    }
-  };
+// Marks a free variable once per update: its clique and the path to the root are re-eliminated.
+void ISAM2::mark(int slot, UpdateWork& work) {
+  if (stamp_[slot] != stamp_counter_ && !theta_.is_fixed_slot(slot)) {
+    stamp_[slot] = stamp_counter_;
+    work.marked.push_back(slot);
+  }
+}
 
-  // --- Removed and added factors: their variables are touched.
+// Removed factors leave their slot empty; their variables are touched.
+void ISAM2::remove_factors(const std::vector<size_t>& removed_factor_indices, UpdateWork& work) {
   for (size_t idx : removed_factor_indices) {
     for (int s : factor_slots_[idx]) {
-      mark(s);
+      mark(s, work);
       auto& list = var_factors_[s];
       list.erase(std::remove(list.begin(), list.end(), static_cast<int>(idx)), list.end());
     }
@@ -301,7 +438,12 @@ ISAM2Result ISAM2::update(const std::vector<FactorPtr>& new_factors,
     factor_slots_[idx].clear();
     graph_.remove(idx);
   }
-  std::vector<int> to_linearize;
+}
+
+// Added factors are queued for linearization (and their error at the estimate taken, to judge
+// the step); their variables are touched.
+void ISAM2::add_factors(const std::vector<FactorPtr>& new_factors, UpdateWork& work,
+                        ISAM2Result& res) {
   for (const auto& f : new_factors) {
     const int idx = static_cast<int>(graph_.add(f));
     res.new_factor_indices.push_back(idx);
@@ -315,300 +457,313 @@ ISAM2Result ISAM2::update(const std::vector<FactorPtr>& new_factors,
       const int s = theta_.slot(k);
       factor_slots_[idx].push_back(s);
       var_factors_[s].push_back(idx);
-      mark(s);
+      mark(s, work);
     }
-    to_linearize.push_back(idx);
-    if (evaluate) factor_error_[idx] = factor_error_at_estimate(idx);
+    work.to_linearize.push_back(idx);
+    if (work.evaluate) factor_error_[idx] = factor_error_at_estimate(idx);
   }
-  const std::vector<int> touched = marked;
-  if (evaluate) res.error_before = total_error();
+}
 
-  // --- Relinearization: θ_j ← θ_j + δ_j for variables that moved past the threshold; every
-  // factor on them is relinearized and all their variables join the affected set.
-  ++factor_stamp_counter_;
-  for (int f : to_linearize) factor_stamp_[f] = factor_stamp_counter_;
-  // A damped (LM) or trust-region-limited step is taken in full: its variables are
-  // relinearized at the accepted point whatever the threshold, or the next update would
-  // re-solve the same linear system and stall below the threshold.
+// Variables whose δ moved past the threshold (checked every relinearize_skip-th update), and
+// every variable of the last damped step whatever its δ: a damped (LM) or trust-region-limited
+// step is taken in full, or the next update would re-solve the same system and stall.
+std::vector<int> ISAM2::variables_to_relinearize(const ISAM2UpdateOptions& update_options) const {
   std::vector<char> took_step(theta_.size(), 0);
   for (int s : damped_vars_) took_step[s] = 1;
   const bool check =
       update_options.force_relinearize || (update_count_ - 1) % options_.relinearize_skip == 0;
-  {
-    double threshold = options_.relinearize_threshold;
-    if (update_options.force_relinearize || (!gauss_newton && last_step_limited_)) threshold = 0;
-    for (int s = 0; s < theta_.size(); ++s) {
-      if (theta_.is_fixed_slot(s) || tree_.clique_of(s) < 0) continue;
-      if (!check && !took_step[s]) continue;
-      auto d = delta_.segment(theta_.offset(s), theta_.dim(s));
-      if (d.cwiseAbs().maxCoeff() <= (took_step[s] ? 0.0 : threshold)) continue;
-      ++res.variables_relinearized;
-      theta_.at_slot(s) += d;
-      d.setZero();
-      delta_gn_.segment(theta_.offset(s), theta_.dim(s)).setZero();
-      for (int f : var_factors_[s]) {
-        if (factor_stamp_[f] != factor_stamp_counter_) {
-          factor_stamp_[f] = factor_stamp_counter_;
-          to_linearize.push_back(f);
-        }
-        for (int s2 : factor_slots_[f]) mark(s2);
+  double threshold = options_.relinearize_threshold;
+  if (update_options.force_relinearize ||
+      (options_.step != ISAM2Step::kGaussNewton && last_step_limited_)) {
+    threshold = 0;
+  }
+  std::vector<int> chosen;
+  for (int s = 0; s < theta_.size(); ++s) {
+    if (theta_.is_fixed_slot(s) || tree_.clique_of(s) < 0) continue;
+    if (!check && !took_step[s]) continue;
+    const auto d = delta_.segment(theta_.offset(s), theta_.dim(s));
+    if (d.cwiseAbs().maxCoeff() <= (took_step[s] ? 0.0 : threshold)) continue;
+    chosen.push_back(s);
+  }
+  return chosen;
+}
+
+// θ_j ← θ_j + δ_j for the chosen variables; every factor on them is queued for linearization
+// and all their variables (and those of the last damped step) are marked.
+void ISAM2::relinearize(const ISAM2UpdateOptions& update_options, UpdateWork& work,
+                        ISAM2Result& res) {
+  ++factor_stamp_counter_;
+  for (int f : work.to_linearize) factor_stamp_[f] = factor_stamp_counter_;
+  const std::vector<int> chosen = variables_to_relinearize(update_options);
+  res.variables_relinearized = static_cast<int>(chosen.size());
+  for (int s : chosen) {
+    auto d = delta_.segment(theta_.offset(s), theta_.dim(s));
+    theta_.at_slot(s) += d;
+    d.setZero();
+    delta_gn_.segment(theta_.offset(s), theta_.dim(s)).setZero();
+    for (int f : var_factors_[s]) {
+      if (factor_stamp_[f] != factor_stamp_counter_) {
+        factor_stamp_[f] = factor_stamp_counter_;
+        work.to_linearize.push_back(f);
       }
+      for (int s2 : factor_slots_[f]) mark(s2, work);
     }
   }
-  for (int s : damped_vars_) mark(s);
+  for (int s : damped_vars_) mark(s, work);
   damped_vars_.clear();
+}
 
-  if (marked.empty() && !needs_full_) {
-    res.error_after = res.error_before;
-    res.error_evaluated = evaluate;
-    res.lambda = lambda_;
-    res.trust_radius = trust_radius_;
-    res.total_s = seconds_since(t_start);
-    return res;
-  }
+// An update that changed no factor on a free variable and relinearized nothing: the estimate
+// stands, with the carried λ and trust radius.
+void ISAM2::report_unchanged(const UpdateWork& work, ISAM2Result& res) const {
+  res.error_after = res.error_before;
+  res.error_evaluated = work.evaluate;
+  res.lambda = lambda_;
+  res.trust_radius = trust_radius_;
+}
 
-  // --- Which part of the tree to re-eliminate.
-  const auto t_lin = Clock::now();
-  bool full = needs_full_ || tree_.empty();
-  std::vector<int> vars, held, orphans;
-  int num_free = 0;
-  for (int s = 0; s < theta_.size(); ++s) num_free += theta_.is_fixed_slot(s) ? 0 : 1;
-  if (!full) {
-    tree_.detach(marked, &vars, &held, &orphans);
+// The part of the tree to re-eliminate: the cliques of the marked variables and their
+// ancestors (detached with their factors, leaving orphaned subtrees), or the whole tree when
+// that part is most of it or the tree must be rebuilt after a failure.
+void ISAM2::find_affected_top(UpdateWork& work) {
+  work.full = needs_full_ || tree_.empty();
+  const int num_free = static_cast<int>(free_slots(theta_).size());
+  if (!work.full) {
+    tree_.detach(work.marked, &work.vars, &work.held, &work.orphans);
     ++stamp_counter_;
-    for (int s : vars) stamp_[s] = stamp_counter_;
-    for (int s : marked) {
+    for (int s : work.vars) stamp_[s] = stamp_counter_;
+    for (int s : work.marked) {  // marked variables new to the tree
       if (stamp_[s] != stamp_counter_) {
         stamp_[s] = stamp_counter_;
-        vars.push_back(s);
+        work.vars.push_back(s);
       }
     }
-    if (vars.size() > options_.full_reelimination_fraction * num_free) full = true;
+    if (work.vars.size() > options_.full_reelimination_fraction * num_free) work.full = true;
   }
-  if (full) {
+  if (work.full) {
     tree_.clear();
-    vars.clear();
-    orphans.clear();
-    for (int s = 0; s < theta_.size(); ++s) {
-      if (!theta_.is_fixed_slot(s)) vars.push_back(s);
-    }
-    if (needs_full_) {  // after a failure, rebuild every linearization
-      to_linearize.clear();
-      for (size_t f = 0; f < graph_.size(); ++f) {
-        if (graph_[f]) to_linearize.push_back(static_cast<int>(f));
-      }
-    }
+    work.vars = free_slots(theta_);
+    work.orphans.clear();
+    if (needs_full_) work.to_linearize = active_factors();  // rebuild every linearization
   }
-  res.full_reelimination = full;
+}
 
+std::vector<int> ISAM2::active_factors() const {
+  std::vector<int> factors;
+  for (size_t f = 0; f < graph_.size(); ++f) {
+    if (graph_[f]) factors.push_back(static_cast<int>(f));
+  }
+  return factors;
+}
+
+// Linearizes the queued factors at θ; false (the result says which factor) if one is not finite.
+bool ISAM2::linearize_queued(const UpdateWork& work, ISAM2Result& res) {
   const int reused_before = factors_reused_;
-  for (int f : to_linearize) {
+  for (int f : work.to_linearize) {
     std::string reason;
     if (!linearize_factor(f, &reason)) {
-      res.status = ISAM2Status::kNonFinite;
-      res.reason = reason;
-      tree_.clear();
-      needs_full_ = true;
-      res.total_s = seconds_since(t_start);
-      return res;
+      fail(res, ISAM2Status::kNonFinite, reason);
+      return false;
     }
   }
-  res.factors_linearized = static_cast<int>(to_linearize.size());
+  res.factors_linearized = static_cast<int>(work.to_linearize.size());
   res.factors_reused = factors_reused_ - reused_before;
+  return true;
+}
+
+// A failed update leaves no usable tree: the next one rebuilds it and every linearization.
+void ISAM2::fail(ISAM2Result& res, ISAM2Status status, std::string reason) {
+  res.status = status;
+  res.reason = std::move(reason);
+  tree_.clear();
+  needs_full_ = true;
+}
+
+// Factors eliminated into the new cliques (those with a free variable): every one after a full
+// re-elimination, else those the detached cliques held and the new ones.
+std::vector<int> ISAM2::factors_to_eliminate(const UpdateWork& work,
+                                             const ISAM2Result& res) const {
   std::vector<int> factors;
-  if (full) {
+  if (work.full) {
     for (size_t f = 0; f < graph_.size(); ++f) {
       if (graph_[f] && !linearized_[f].vars.empty()) factors.push_back(static_cast<int>(f));
     }
-  } else {
-    for (int f : held) {
-      if (linearized_[f].active && !linearized_[f].vars.empty()) factors.push_back(f);
-    }
-    for (int idx : res.new_factor_indices) {
-      if (!linearized_[idx].vars.empty()) factors.push_back(idx);
-    }
+    return factors;
   }
-  res.linearize_s = seconds_since(t_lin);
+  for (int f : work.held) {
+    if (linearized_[f].active && !linearized_[f].vars.empty()) factors.push_back(f);
+  }
+  for (int idx : res.new_factor_indices) {
+    if (!linearized_[idx].vars.empty()) factors.push_back(idx);
+  }
+  return factors;
+}
 
-  // --- Constrained ordering (touched variables last) and symbolic elimination.
+// Constrained ordering of the affected top and symbolic elimination into new cliques.
+void ISAM2::build_affected_top(const ISAM2UpdateOptions& update_options, UpdateWork& work,
+                               ISAM2Result& res) {
   const auto t_elim = Clock::now();
-  const int m = static_cast<int>(vars.size());
-  std::vector<int> local(theta_.size(), -1);
-  for (int i = 0; i < m; ++i) local[vars[i]] = i;
+  const int m = static_cast<int>(work.vars.size());
+  std::vector<int> local(theta_.size(), -1);  // slot → position in work.vars
+  for (int i = 0; i < m; ++i) local[work.vars[i]] = i;
+  const std::vector<std::vector<int>> incidence = elimination_incidence(work, local);
+  const std::vector<int> groups = ordering_groups(update_options, work, local);
+  const std::vector<int> order = compute_ordering(m, incidence, OrderingMethod::kColamd, groups);
+  work.new_cliques = tree_.build(work.vars, order, work.factors, linearized_, work.orphans);
+  res.eliminate_s = seconds_since(t_elim);
+  res.variables_reeliminated = m;
+  res.cliques_reeliminated = static_cast<int>(work.new_cliques.size());
+}
+
+// Rows of the affected top's variables (positions in work.vars): one per factor and one per
+// orphan's separator (its cached marginal factor).
+std::vector<std::vector<int>> ISAM2::elimination_incidence(const UpdateWork& work,
+                                                           const std::vector<int>& local) const {
   std::vector<std::vector<int>> incidence;
-  incidence.reserve(factors.size() + orphans.size());
-  for (int f : factors) {
+  incidence.reserve(work.factors.size() + work.orphans.size());
+  for (int f : work.factors) {
     auto& row = incidence.emplace_back();
     for (int s : linearized_[f].vars) row.push_back(local[s]);
   }
-  for (int o : orphans) {
+  for (int o : work.orphans) {
     auto& row = incidence.emplace_back();
     for (int s : tree_.clique(o).separator) row.push_back(local[s]);
   }
+  return incidence;
+}
+
+// Ordering groups of the affected top's variables: 1 (eliminated last) for the constrained_last
+// keys and, while they are few enough, the touched variables; empty when none is constrained.
+std::vector<int> ISAM2::ordering_groups(const ISAM2UpdateOptions& update_options,
+                                        const UpdateWork& work,
+                                        const std::vector<int>& local) const {
+  const int m = static_cast<int>(work.vars.size());
   std::vector<int> groups(m, 0);
   bool constrained = false;
-  int touched_here = 0;
-  for (int s : touched) touched_here += local[s] >= 0 ? 1 : 0;
-  if (touched_here <= options_.constrain_touched_fraction * m) {
-    for (int s : touched) {
-      if (local[s] >= 0) {
-        groups[local[s]] = 1;
-        constrained = true;
-      }
-    }
-  }
-  for (const Key& k : update_options.constrained_last) {
-    const int s = theta_.find(k);
+  const auto last = [&](int s) {
     if (s >= 0 && local[s] >= 0) {
       groups[local[s]] = 1;
       constrained = true;
     }
+  };
+  int touched_here = 0;
+  for (int s : work.touched) touched_here += local[s] >= 0 ? 1 : 0;
+  if (touched_here <= options_.constrain_touched_fraction * m) {
+    for (int s : work.touched) last(s);
   }
-  const std::vector<int> order = compute_ordering(m, incidence, OrderingMethod::kColamd,
-                                                  constrained ? groups : std::vector<int>{});
-  const std::vector<int> new_cliques = tree_.build(vars, order, factors, linearized_, orphans);
-  res.eliminate_s = seconds_since(t_elim);
-  res.variables_reeliminated = m;
-  res.cliques_reeliminated = static_cast<int>(new_cliques.size());
+  for (const Key& k : update_options.constrained_last) last(theta_.find(k));
+  return constrained ? groups : std::vector<int>{};
+}
 
-  // --- Numeric elimination and back-substitution; with the safeguard, damp and retry while
-  // the error rises.
+// Numeric elimination and back-substitution; with the safeguard, Gauss–Newton retries with
+// Marquardt damping (λ growing) while the error rises. False when a clique is singular.
+bool ISAM2::eliminate_and_solve(UpdateWork& work, ISAM2Result& res) {
   Eigen::VectorXd diag_H, damping;
-  double lambda = gauss_newton && options_.safeguard ? lambda_ : 0;
-  std::vector<int> changed;
-  bool accepted = true;
+  work.lambda = work.gauss_newton && options_.safeguard ? lambda_ : 0;
+  work.accepted = true;
   for (;;) {
     ++res.trials;
     const Eigen::VectorXd* damping_ptr = nullptr;
-    if (lambda > 0) {
-      if (diag_H.size() == 0) {
-        diag_H.setZero(theta_.total_dim());
-        for (int s : vars) {
-          for (int f : var_factors_[s]) {
-            const LinearizedFactor& lf = linearized_[f];
-            for (size_t i = 0; i < lf.vars.size(); ++i) {
-              if (lf.vars[i] != s) continue;
-              diag_H.segment(theta_.offset(s), theta_.dim(s)) +=
-                  lf.H.diagonal().segment(lf.offsets[i], theta_.dim(s));
-            }
-          }
-        }
-        diag_H = diag_H.cwiseMax(options_.min_diagonal);
-      }
-      damping = lambda * diag_H;
+    if (work.lambda > 0) {
+      if (diag_H.size() == 0) diag_H = damping_diagonal(work.vars);
+      damping = work.lambda * diag_H;
       damping_ptr = &damping;
     }
-    int bad_slot = -1;
-    const auto t_factor = Clock::now();
-    const bool factored = tree_.factorize(new_cliques, linearized_, damping_ptr, &bad_slot);
-    res.eliminate_s += seconds_since(t_factor);
-    if (!factored) {  // J is rank deficient: damping would only hide it
-      res.status = ISAM2Status::kSingular;
-      res.reason = "the information block of " + theta_.key(bad_slot).to_string() +
-                   " is not positive definite (too few factors on it?)";
-      tree_.clear();
-      needs_full_ = true;
-      res.total_s = seconds_since(t_start);
-      return res;
-    }
-    const auto t_solve = Clock::now();
-    changed.clear();
-    res.cliques_solved = tree_.back_substitute(options_.wildfire_threshold, delta_gn_, &changed);
-    if (gauss_newton) {
-      for (int s : changed) {
-        delta_.segment(theta_.offset(s), theta_.dim(s)) =
-            delta_gn_.segment(theta_.offset(s), theta_.dim(s));
-      }
-      refresh_estimate(changed);
-    }
-    res.solve_s += seconds_since(t_solve);
-    if (!gauss_newton || !evaluate) break;
+    if (!factorize_and_solve(work, damping_ptr, res)) return false;
+    // Past here the error is evaluated with Gauss–Newton only with the safeguard on.
+    if (!work.gauss_newton || !work.evaluate) return true;
     res.error_after = total_error();
     const double slack =
         options_.error_rise_tolerance * std::max(std::abs(res.error_before), 1e-300);
-    if (res.error_after <= res.error_before + slack) break;
-    if (!options_.safeguard) {
-      accepted = false;
-      break;
-    }
-    const double next = lambda == 0 ? options_.lambda_initial : lambda * options_.lambda_factor;
+    if (res.error_after <= res.error_before + slack) return true;
+    const double next =
+        work.lambda == 0 ? options_.lambda_initial : work.lambda * options_.lambda_factor;
     if (next > options_.lambda_max) {
-      accepted = false;
-      break;
+      work.accepted = false;
+      return true;
     }
-    lambda = next;
+    work.lambda = next;
   }
-  needs_full_ = false;
-
-  if (gauss_newton) {
-    res.lambda = lambda;
-    if (accepted) {
-      lambda_ = lambda / options_.lambda_decrease;
-      if (lambda_ < options_.lambda_min) lambda_ = 0;
-    } else {
-      lambda_ = lambda;
-    }
-    if (lambda > 0) damped_vars_ = vars;  // the tree holds a damped system for these
-    res.error_increased = !accepted;
-    res.error_evaluated = evaluate;
-  } else {
-    const auto t_dl = Clock::now();
-    apply_dogleg(res, 0);
-    res.solve_s += seconds_since(t_dl);
-  }
-  res.trust_radius = trust_radius_;
-  tree_.clear_fresh();
-  res.jacobians_kept = jacobians_kept_ - kept_before;
-  res.total_s = seconds_since(t_start);
-  spdlog::debug(
-      "ISAM2 update {}: {} vars re-eliminated in {} cliques ({}), {} relinearized, {} cliques "
-      "solved, error {:.6g} -> {:.6g}, lambda {:.3g}, {:.3f} ms",
-      update_count_, res.variables_reeliminated, res.cliques_reeliminated,
-      full ? "full" : "partial", res.variables_relinearized, res.cliques_solved, res.error_before,
-      res.error_after, res.lambda, 1e3 * res.total_s);
-  return res;
 }
 
-void ISAM2::apply_dogleg(ISAM2Result& res, double) {
-  // Powell's dogleg on the linear model ½‖Rδ − d‖² held by the Bayes tree, about θ.
+// diag(H) of the affected top's variables, floored at min_diagonal (zero elsewhere).
+Eigen::VectorXd ISAM2::damping_diagonal(const std::vector<int>& vars) const {
+  Eigen::VectorXd diag_H;
+  diag_H.setZero(theta_.total_dim());
+  for (int s : vars) {
+    for (int f : var_factors_[s]) {
+      const LinearizedFactor& lf = linearized_[f];
+      for (size_t i = 0; i < lf.vars.size(); ++i) {
+        if (lf.vars[i] != s) continue;
+        diag_H.segment(theta_.offset(s), theta_.dim(s)) +=
+            lf.H.diagonal().segment(lf.offsets[i], theta_.dim(s));
+      }
+    }
+  }
+  return diag_H.cwiseMax(options_.min_diagonal);
+}
+
+// One trial: factorizes the new cliques (damped if given) and back-substitutes δ; Gauss–Newton
+// takes it as the step. False (the result says where) when a clique is not positive definite.
+bool ISAM2::factorize_and_solve(UpdateWork& work, const Eigen::VectorXd* damping,
+                                ISAM2Result& res) {
+  int bad_slot = -1;
+  const auto t_factor = Clock::now();
+  const bool factored = tree_.factorize(work.new_cliques, linearized_, damping, &bad_slot);
+  res.eliminate_s += seconds_since(t_factor);
+  if (!factored) {  // J is rank deficient: damping would only hide it
+    fail(res, ISAM2Status::kSingular,
+         "the information block of " + theta_.key(bad_slot).to_string() +
+             " is not positive definite (too few factors on it?)");
+    return false;
+  }
+  const auto t_solve = Clock::now();
+  work.changed.clear();
+  res.cliques_solved = tree_.back_substitute(options_.wildfire_threshold, delta_gn_, &work.changed);
+  if (work.gauss_newton) {
+    for (int s : work.changed) {
+      delta_.segment(theta_.offset(s), theta_.dim(s)) =
+          delta_gn_.segment(theta_.offset(s), theta_.dim(s));
+    }
+    refresh_estimate(work.changed);
+  }
+  res.solve_s += seconds_since(t_solve);
+  return true;
+}
+
+// After a Gauss–Newton update: λ for the next one (shrunk after an accepted trial, kept after a
+// failed search) and the damped variables, whose step is taken in full at the next update.
+void ISAM2::carry_damping(const UpdateWork& work, ISAM2Result& res) {
+  res.lambda = work.lambda;
+  if (work.accepted) {
+    lambda_ = work.lambda / options_.lambda_decrease;
+    if (lambda_ < options_.lambda_min) lambda_ = 0;
+  } else {
+    lambda_ = work.lambda;
+  }
+  if (work.lambda > 0) damped_vars_ = work.vars;  // the tree holds a damped system for these
+  res.error_increased = !work.accepted;
+  res.error_evaluated = work.evaluate;
+}
+
+// Powell's dogleg on the linear model ½‖Rδ − d‖² held by the Bayes tree, about θ: shrinks the
+// trust region and retries while the error rises.
+void ISAM2::apply_dogleg(ISAM2Result& res) {
   double error_theta = 0;
   for (size_t f = 0; f < graph_.size(); ++f) {
     if (graph_[f]) error_theta += linearized_[f].error;
   }
-  Eigen::VectorXd s(delta_.size());
-  tree_.gradient(s);
-  const double s2 = s.squaredNorm();
-  const double Rs2 = tree_.r_norm_squared(s);
-  const Eigen::VectorXd sd =
-      Rs2 > 0 ? Eigen::VectorXd((s2 / Rs2) * s) : Eigen::VectorXd::Zero(s.size());
+  const Eigen::VectorXd sd = cauchy_point();
   const Eigen::VectorXd& gn = delta_gn_;
   const double gn_norm = gn.norm();
   const double sd_norm = sd.norm();
   const double model_zero = tree_.model_cost(Eigen::VectorXd::Zero(delta_.size()));
-  std::vector<int> all;
-  for (int v = 0; v < theta_.size(); ++v) {
-    if (!theta_.is_fixed_slot(v)) all.push_back(v);
-  }
+  const std::vector<int> all = free_slots(theta_);
   const double slack = options_.error_rise_tolerance * std::max(std::abs(res.error_before), 1e-300);
   Eigen::VectorXd step(delta_.size());
   for (int trial = 0;; ++trial) {
     ++res.trials;
-    const double radius = trust_radius_;
-    bool limited = true;
-    if (gn_norm <= radius) {
-      step = gn;
-      limited = false;
-    } else if (sd_norm >= radius) {
-      step = (radius / sd_norm) * sd;
-    } else {
-      // τ in [0, 1] with ‖sd + τ(gn − sd)‖ = radius.
-      const Eigen::VectorXd diff = gn - sd;
-      const double a = diff.squaredNorm();
-      const double b = 2 * sd.dot(diff);
-      const double c = sd_norm * sd_norm - radius * radius;
-      const double tau = (-b + std::sqrt(std::max(b * b - 4 * a * c, 0.0))) / (2 * a);
-      step = sd + tau * diff;
-    }
+    const bool limited = dogleg_point(gn, gn_norm, sd, sd_norm, trust_radius_, step);
     delta_ = step;
     refresh_estimate(all);
     res.error_after = total_error();
@@ -637,18 +792,25 @@ void ISAM2::apply_dogleg(ISAM2Result& res, double) {
   res.error_evaluated = true;
 }
 
+// Minimizer of the tree's linear model along the steepest-descent direction (zero where the
+// gradient is).
+Eigen::VectorXd ISAM2::cauchy_point() const {
+  Eigen::VectorXd s(delta_.size());
+  tree_.gradient(s);
+  const double s2 = s.squaredNorm();
+  const double Rs2 = tree_.r_norm_squared(s);
+  return Rs2 > 0 ? Eigen::VectorXd((s2 / Rs2) * s) : Eigen::VectorXd::Zero(s.size());
+}
+
 std::string ISAM2::check_invariants() const {
-  std::vector<int> vars, factors;
-  for (int s = 0; s < theta_.size(); ++s) {
-    if (!theta_.is_fixed_slot(s)) vars.push_back(s);
-  }
+  std::vector<int> factors;
   for (size_t f = 0; f < graph_.size(); ++f) {
     if (!graph_[f]) continue;
     bool has_free = false;
     for (int s : factor_slots_[f]) has_free |= !theta_.is_fixed_slot(s);
     if (has_free) factors.push_back(static_cast<int>(f));
   }
-  return tree_.check_invariants(vars, factors);
+  return tree_.check_invariants(free_slots(theta_), factors);
 }
 
 }  // namespace kinograph::graph

@@ -25,60 +25,66 @@ enum class ISAM2Step {
 
 /// Options of ISAM2 (fixed for its lifetime). Defaults suit planning problems in SI units.
 struct ISAM2Options {
-  /// A variable is relinearized when max|δ_j| exceeds this (GTSAM's default 0.1).
+  /// A variable is relinearized when max|δ_j| over its components exceeds this (units of the
+  /// variable; GTSAM's default). Larger: fewer relinearizations, an estimate further from a
+  /// Gauss–Newton iterate.
   double relinearize_threshold = 0.1;
-  /// Check relinearization only every k-th update (1 = every update).
+  /// Check relinearization only every k-th update (1 = every update), to save the
+  /// re-elimination it causes when updates come faster than the estimate moves.
   int relinearize_skip = 1;
-  /// Back-substitution stops descending where a variable changes by less than this (max-abs);
-  /// 0 gives the exact solution.
+  /// Back-substitution stops descending where a variable changes by less than this (max-abs,
+  /// units of the variable); 0 gives the exact solution, larger visits fewer cliques.
   double wildfire_threshold = 1e-7;
-  /// Re-eliminate everything when the affected top holds more than this fraction of the
+  /// Re-eliminate everything when the affected top holds more than this fraction of the free
   /// variables (cheaper than detaching and reattaching most of the tree).
   double full_reelimination_fraction = 0.6;
-  /// Order the touched variables last (near the root, so the next change to them re-eliminates
-  /// little) only while they are at most this fraction of the variables re-eliminated. When a
-  /// change touches most of a chain (an obstacle near every state), forcing them last makes the
-  /// untouched ones (e.g. every accelerations of a trajectory) go first and fill one giant
-  /// clique: measured 434-dim root clique, 30 ms instead of 0.4 ms per factorization on the iiwa
-  /// desk (bench/replanning). Explicit constrained_last keys are always honoured.
+  /// Order the variables touched by changed factors last (near the root, so the next change to
+  /// them re-eliminates little) only while they are at most this fraction of the variables
+  /// re-eliminated: forcing most of a chain last makes the rest go first and fill one giant
+  /// clique. Explicit constrained_last keys are always honoured.
   double constrain_touched_fraction = 0.3;
+  /// How the linear solution becomes a new estimate (see ISAM2Step).
   ISAM2Step step = ISAM2Step::kGaussNewton;
 
   /// While the safeguard (or Dogleg) evaluates the error at a new estimate, also linearize
-  /// there: a variable that is then relinearized at that estimate reuses it instead of
-  /// evaluating its factors a second time. The Jacobians cost little beside the residuals of
-  /// collision and kinematic factors; a rejected step wastes them.
+  /// there, so a variable relinearized at that estimate reuses it instead of evaluating its
+  /// factors again. Pays off where Jacobians cost little beside the residuals; a rejected step
+  /// wastes them. Changes the work only, never the iterates.
   bool linearize_at_evaluation = true;
   /// Keep a linear factor's JᵀJ between linearizations while its Jacobian is unchanged
-  /// (Factor::jacobian_version; only Jᵀr is formed again). Measured (bench/replanning): the GP
-  /// priors and collocations of a trajectory are most of the JᵀJ work of an update.
+  /// (Factor::jacobian_version), forming only Jᵀr again. Changes the work only, never the
+  /// iterates.
   bool reuse_constant_jacobians = true;
 
-  /// Safeguard: evaluate the nonlinear error after each update (incrementally: only factors on
-  /// variables that moved); with Gauss–Newton, if it rose, re-eliminate the affected top with
-  /// Marquardt damping λ·diag(H) (λ grows by lambda_factor) until it no longer rises. A damped
-  /// step is taken in full: its variables are relinearized at the next update whatever the
-  /// threshold, so progress never stalls below it. Without the safeguard the error is not
-  /// evaluated (error_evaluated is false).
+  /// Gauss–Newton only (Dogleg always evaluates the error): evaluate the nonlinear error after
+  /// each update (incrementally: only factors on variables that moved) and, if it rose,
+  /// re-eliminate the affected top with Marquardt damping λ·diag(H) until it no longer rises.
+  /// A damped step is taken in full: its variables are relinearized at the next update whatever
+  /// the threshold, so progress never stalls below it. Off: the error is not evaluated.
   bool safeguard = true;
-  double lambda_initial = 1e-2;  ///< first damping after a rejected step (paper's λ₀)
-  double lambda_factor = 10;     ///< λ grows by this after a rejection
-  /// λ shrinks by this after an accepted update. Marquardt damping λ·diag(H) suppresses the
-  /// smooth, low-curvature modes of a trajectory chain, so while λ lingers each update bends
-  /// only part of the trajectory: measured on the iiwa goal changes (bench/replanning), 100
-  /// takes a median of 3 updates where 10 took 6, with a lower objective; 1e6 (back to plain
-  /// Gauss–Newton at once) overshoots into newly active constraints: a median of 40 on task 1,
-  /// the planner's update cap.
+  // The safeguard's λ (dimensionless: it scales diag(H)), carried from update to update.
+  /// First λ after a rejected undamped trial.
+  double lambda_initial = 1e-2;
+  /// λ grows by this factor after each further rejected trial (> 1).
+  double lambda_factor = 10;
+  /// λ shrinks by this factor after an accepted update (≥ 1): lingering damping suppresses the
+  /// smooth, low-curvature modes of a chain, dropping it at once can overshoot.
   double lambda_decrease = 100;
-  double lambda_min = 1e-7;    ///< below this λ drops to 0 (plain Gauss–Newton again)
-  double lambda_max = 1e12;    ///< give up (flag the increase) beyond this
-  double min_diagonal = 1e-6;  ///< clamp of diag(H) in the damping (keeps it positive)
-  /// Relative slack before a rise counts (rounding, wildfire approximation).
+  /// Below this the carried λ drops to 0 (plain Gauss–Newton again).
+  double lambda_min = 1e-7;
+  /// Give up (keep the last trial, flag error_increased) when λ would exceed this.
+  double lambda_max = 1e12;
+  /// Floor of diag(H) in the damping (units of H), so a direction of no curvature is damped.
+  double min_diagonal = 1e-6;
+  /// Rise of the error, relative to error_before, that still counts as no rise (rounding,
+  /// wildfire approximation); for the safeguard and Dogleg alike.
   double error_rise_tolerance = 1e-9;
 
-  /// Dogleg: initial trust radius (‖δ‖₂), its floor (give up below it) and trials per update.
+  /// Dogleg: initial trust radius on ‖δ‖₂ (units of the stacked variables).
   double trust_radius_initial = 1.0;
+  /// Dogleg: floor of the trust radius; an update gives up (flags the increase) below it.
   double trust_radius_min = 1e-12;
+  /// Dogleg: most steps tried within one update before giving up (flags the increase).
   int max_dogleg_trials = 40;
 };
 
@@ -103,27 +109,31 @@ std::string to_string(ISAM2Status status);
 
 /// What an update did and what it cost.
 struct ISAM2Result {
-  ISAM2Status status = ISAM2Status::kOk;
-  std::string reason;
+  ISAM2Status status = ISAM2Status::kOk;   ///< whether an estimate was computed
+  std::string reason;                      ///< what went wrong (empty when ok)
   std::vector<size_t> new_factor_indices;  ///< index of each added factor, for later removal
-  /// True when the returned estimate's error exceeds error_before (safeguard off, or it could
-  /// not find a decreasing step). Never silently worse.
+  /// True when the returned estimate's error exceeds error_before: the safeguard reached
+  /// lambda_max, or Dogleg its radius floor or trial limit. Set only when error_evaluated.
   bool error_increased = false;
-  double error_before = 0;  ///< new graph's error at the previous estimate (if evaluated)
-  double error_after = 0;   ///< error at the new estimate (if evaluated)
-  bool error_evaluated = false;
-  bool full_reelimination = false;
-  int variables_reeliminated = 0;
-  int cliques_reeliminated = 0;  ///< cliques built by this update
-  int variables_relinearized = 0;
+  double error_before = 0;        ///< new graph's error at the previous estimate (if evaluated)
+  double error_after = 0;         ///< error at the new estimate (if evaluated)
+  bool error_evaluated = false;   ///< error_before/after hold the error (safeguard or Dogleg)
+  bool full_reelimination = false;  ///< the whole tree was rebuilt (not only the affected top)
+  int variables_reeliminated = 0;   ///< variables of the re-eliminated part of the tree
+  int cliques_reeliminated = 0;     ///< cliques built by this update
+  int variables_relinearized = 0;   ///< variables whose linearization point moved
   int factors_linearized = 0;  ///< new factors plus those touching relinearized variables
   int factors_reused = 0;      ///< of those, linearizations kept from the error evaluation
   int jacobians_kept = 0;      ///< evaluations of linear factors that kept JᵀJ (all trials)
   int cliques_solved = 0;      ///< cliques back-substituted (last trial)
-  int trials = 0;              ///< numeric eliminations (GN) or dogleg steps tried
-  double lambda = 0;           ///< damping of the accepted GN trial
-  double trust_radius = 0;     ///< Dogleg radius after the update
-  double linearize_s = 0, eliminate_s = 0, solve_s = 0, total_s = 0;
+  /// Numeric eliminations (Gauss–Newton); with Dogleg, one plus the dogleg steps tried.
+  int trials = 0;
+  double lambda = 0;           ///< λ of the GN trial taken (the carried λ if nothing changed)
+  double trust_radius = 0;     ///< Dogleg's trust radius after the update
+  double linearize_s = 0;      ///< wall time choosing the affected top and linearizing [s]
+  double eliminate_s = 0;      ///< wall time ordering, symbolic and numeric elimination [s]
+  double solve_s = 0;          ///< wall time back-substituting and evaluating the error [s]
+  double total_s = 0;          ///< wall time of the whole update [s]
 
   bool ok() const { return status == ISAM2Status::kOk; }
 };
@@ -163,17 +173,55 @@ class ISAM2 {
   std::string check_invariants() const;
 
  private:
-  struct Linearization;
+  struct UpdateWork;  // what one update() works on, passed from step to step
+
+  // Steps of update(), in order (isam2.cc).
+  void validate_update(const std::vector<FactorPtr>& new_factors,
+                       const std::vector<size_t>& removed_factor_indices,
+                       const Values& new_values) const;
+  void add_variables(const Values& new_values);
+  void remove_factors(const std::vector<size_t>& removed_factor_indices, UpdateWork& work);
+  void add_factors(const std::vector<FactorPtr>& new_factors, UpdateWork& work,
+                   ISAM2Result& result);
+  std::vector<int> variables_to_relinearize(const ISAM2UpdateOptions& options) const;
+  void relinearize(const ISAM2UpdateOptions& options, UpdateWork& work, ISAM2Result& result);
+  void report_unchanged(const UpdateWork& work, ISAM2Result& result) const;
+  void find_affected_top(UpdateWork& work);
+  bool linearize_queued(const UpdateWork& work, ISAM2Result& result);
+  std::vector<int> factors_to_eliminate(const UpdateWork& work, const ISAM2Result& result) const;
+  void build_affected_top(const ISAM2UpdateOptions& options, UpdateWork& work,
+                          ISAM2Result& result);
+  bool eliminate_and_solve(UpdateWork& work, ISAM2Result& result);
+  bool factorize_and_solve(UpdateWork& work, const Eigen::VectorXd* damping,
+                           ISAM2Result& result);
+  void carry_damping(const UpdateWork& work, ISAM2Result& result);
+  void apply_dogleg(ISAM2Result& result);
+
+  // Helpers of the steps.
+  void mark(int slot, UpdateWork& work);
+  void fail(ISAM2Result& result, ISAM2Status status, std::string reason);
+  std::vector<int> active_factors() const;
+  std::vector<std::vector<int>> elimination_incidence(const UpdateWork& work,
+                                                      const std::vector<int>& local) const;
+  std::vector<int> ordering_groups(const ISAM2UpdateOptions& options, const UpdateWork& work,
+                                   const std::vector<int>& local) const;
+  Eigen::VectorXd damping_diagonal(const std::vector<int>& vars) const;
+  Eigen::VectorXd cauchy_point() const;
+
+  // Linearizing one factor, and the error at the estimate.
   /// Error of factor f at `at` and, with `out`, its linearization there (false when the
   /// residual or Jacobian is not finite).
   bool evaluate_factor(int f, const Values& at, LinearizedFactor* out, double* error,
                        std::string* reason);
+  void collect_free_columns(const Factor& factor, const std::vector<int>& slots, const Values& at);
+  bool relinearize_kept_jacobian(const Factor& factor, LinearizedFactor& lf, double* error);
+  bool linearize_fresh(const Factor& factor, LinearizedFactor& lf, double* error);
+  void form_normal_equations(Eigen::Ref<Eigen::MatrixXd> J, int active, LinearizedFactor& lf);
   bool linearize_factor(int f, std::string* reason);
   double factor_error_at_estimate(int f);
   void refresh_estimate(const std::vector<int>& changed_vars);
   void sync_layout();
   double total_error() const;
-  void apply_dogleg(ISAM2Result& result, double error_theta);
 
   ISAM2Options options_;
   FactorGraph graph_;

@@ -1,6 +1,7 @@
 #pragma once
 // Batch Levenberg–Marquardt on the sparse normal equations with CHOLMOD: the DFGP solver.
 #include <memory>
+#include <string>
 
 #include "kinograph/graph/factor_graph.h"
 #include "kinograph/graph/optimization_result.h"
@@ -21,24 +22,36 @@ enum class Damping {
 /// Options of LevenbergMarquardt; defaults as the paper (λ₀ = 0.01, 200 iterations, relative
 /// decrease 1e-5).
 struct LevenbergMarquardtOptions {
-  double lambda_initial = 0.01;  ///< λ₀
-  double lambda_max = 1e12;      ///< give up (no decrease / singular) when λ exceeds this
-  double lambda_min = 1e-15;     ///< λ never drops below this
+  /// λ₀: damping of the first trial (the factor on D).
+  double lambda_initial = 0.01;
+  /// Give up (no decrease, or singular) once λ exceeds this after a rejected trial.
+  double lambda_max = 1e12;
+  /// Floor of λ after accepted steps.
+  double lambda_min = 1e-15;
+  /// The matrix D that λ scales in (H + λD) δ = −g.
   Damping damping = Damping::kDiagonal;
-  double min_diagonal = 1e-6;  ///< clamp of diag(H) for kDiagonal (keeps H + λD definite)
+  /// Lower clamp of diag(H) in D for kDiagonal (keeps H + λD definite on empty columns).
+  double min_diagonal = 1e-6;
+  /// Upper clamp of diag(H) in D for kDiagonal.
   double max_diagonal = 1e32;
-  int max_iterations = 200;          ///< linearizations
-  double relative_error_tol = 1e-5;  ///< converged when (e_old − e_new)/e_old < this after a step
-  double absolute_error_tol = 0;     ///< converged when e ≤ this
-  double step_tol = 1e-14;           ///< converged when ‖δ‖ ≤ step_tol·(‖x‖ + step_tol)
+  /// Maximum number of linearizations per solve (each starts an iteration of one or more trials).
+  int max_iterations = 200;
+  /// Converged when an accepted step lowers the cost by less than this fraction of it.
+  double relative_error_tol = 1e-5;
+  /// Converged when the cost ½Σ‖r‖² is at or below this (same units as the cost).
+  double absolute_error_tol = 0;
+  /// Converged when the step ‖δ‖₂ ≤ step_tol·(‖x‖₂ + step_tol) (relative, dimensionless).
+  double step_tol = 1e-14;
+  /// Elimination order of the variables, which sets the fill of the Cholesky factor.
   OrderingMethod ordering = OrderingMethod::kAmd;
+  /// Supernodal or simplicial CHOLMOD factorization (kAuto: CHOLMOD decides).
   Factorization factorization = Factorization::kAuto;
-  /// Evaluate a trial step's error together with its Jacobians (into a second set of normal
-  /// equations): an accepted step is then not evaluated again to linearize there. A rejected
-  /// step wastes the Jacobians.
+  /// Take Jacobians at every trial point, so an accepted step is not linearized a second time.
   bool linearize_at_evaluation = true;
-  bool record_history = true;   ///< fill OptimizationResult::history
-  bool log_iterations = false;  ///< spdlog debug line per trial
+  /// Fill OptimizationResult::history, one entry per trial.
+  bool record_history = true;
+  /// Log an spdlog debug line per trial and one at the end.
+  bool log_iterations = false;
 };
 
 /// Levenberg–Marquardt with Nielsen's λ update (λ shrinks by up to 3× after good steps, grows
@@ -65,6 +78,26 @@ class LevenbergMarquardt {
   const SparseCholesky* cholesky() const { return cholesky_.get(); }
 
  private:
+  struct Solve;  // one optimize() call's state
+  struct Trial;  // what one trial step did
+
+  // The steps of optimize(); those returning bool return true once the solve has ended (status
+  // and reason set by finish()).
+  void prepare(const FactorGraph& graph, const Values& values, Solve& s);
+  bool start(const FactorGraph& graph, const Values& values, Solve& s);
+  void update_damping(Solve& s) const;
+  bool run_trial(const FactorGraph& graph, Values& values, Solve& s);
+  Trial try_step(const FactorGraph& graph, Values& values, Solve& s, IterationStats& stats);
+  bool factorize_damped(Solve& s, IterationStats& stats);
+  void evaluate_step(const FactorGraph& graph, Values& values, Solve& s, IterationStats& stats,
+                     Trial& trial);
+  void accept_step(Solve& s, double predicted, double new_error, bool at_rounding,
+                   Trial& trial) const;
+  void record(Solve& s, const IterationStats& stats) const;
+  bool next_iteration(const FactorGraph& graph, const Values& values, Solve& s, const Trial& trial);
+  bool increase_lambda(const Values& values, Solve& s, bool factored) const;
+  void finish(Solve& s, SolverStatus status, std::string reason) const;
+
   LevenbergMarquardtOptions options_;
   std::unique_ptr<NormalEquations> equations_;
   std::unique_ptr<NormalEquations> candidate_;  // linearized at the trial step

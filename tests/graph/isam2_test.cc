@@ -10,6 +10,7 @@
 #include <map>
 #include <random>
 #include <set>
+#include <utility>
 
 #include "kinograph/graph/levenberg_marquardt.h"
 #include "kinograph/graph/linear_factor.h"
@@ -20,11 +21,11 @@ namespace {
 
 Key X(uint32_t i) { return Key('x', 0, i); }
 
-// Minimizer of Σ‖W_f (A_f x − b_f)‖² over all (linear) factors of the graph, by dense QR of the
-// stacked whitened system: independent of the Bayes tree and of CHOLMOD.
-// With `at` given: the Gauss–Newton step of the graph linearized there (dense QR).
-Eigen::VectorXd dense_solve(const FactorGraph& graph, const Values& layout,
-                            const Values* at = nullptr) {
+// The whitened Jacobian A and right-hand side b = −r of every factor of the graph stacked
+// (dense, columns in the layout's order), linearized at `at` (linear factors at 0 without it).
+std::pair<Eigen::MatrixXd, Eigen::VectorXd> stacked_system(const FactorGraph& graph,
+                                                           const Values& layout,
+                                                           const Values* at) {
   std::vector<std::pair<Eigen::MatrixXd, Eigen::VectorXd>> rows;
   int m = 0;
   Values zero = layout;
@@ -51,7 +52,27 @@ Eigen::VectorXd dense_solve(const FactorGraph& graph, const Values& layout,
     b.segment(r0, J.rows()) = rhs;
     r0 += static_cast<int>(J.rows());
   }
+  return {A, b};
+}
+
+// Minimizer of Σ‖W_f (A_f x − b_f)‖² over all (linear) factors of the graph, by dense QR of the
+// stacked whitened system: independent of the Bayes tree and of CHOLMOD.
+// With `at` given: the Gauss–Newton step of the graph linearized there (dense QR).
+Eigen::VectorXd dense_solve(const FactorGraph& graph, const Values& layout,
+                            const Values* at = nullptr) {
+  const auto [A, b] = stacked_system(graph, layout, at);
   return A.colPivHouseholderQr().solve(b);
+}
+
+// The Marquardt step −(H + λD)⁻¹Jᵀr of the graph linearized at `at`, H = JᵀJ, D = diag(H)
+// floored at `min_diagonal` (λ = 0: the Gauss–Newton step), by a dense LDLᵀ.
+Eigen::VectorXd dense_damped_step(const FactorGraph& graph, const Values& at, double lambda,
+                                  double min_diagonal) {
+  const auto [A, b] = stacked_system(graph, at, &at);
+  const Eigen::MatrixXd H = A.transpose() * A;
+  Eigen::MatrixXd damped = H;
+  damped.diagonal() += lambda * H.diagonal().cwiseMax(min_diagonal);
+  return damped.ldlt().solve(A.transpose() * b);
 }
 
 // A random linear factor on the given variables.
@@ -223,55 +244,20 @@ TEST(ISAM2, ChangingTheLastFactorReeliminatesOnlyThePathToTheRoot) {
   }
 }
 
-TEST(ISAM2, ChangeAtTheLeavesFallsBackToFullReelimination) {
-  // With the goal's end eliminated last, the start prior sits at the bottom: changing it
-  // affects the whole path to the root, so the update re-eliminates everything from scratch.
-  const int n = 40;
-  Chain chain = make_chain(n, Eigen::Vector2d(3, 1));
-  ISAM2Options opt;
-  opt.wildfire_threshold = 0;
-  opt.relinearize_threshold = 1e9;
-  ISAM2 isam(opt);
-  ISAM2UpdateOptions first;
-  first.constrained_last = {X(n - 1)};
-  auto res = isam.update(chain.factors, {}, chain.values, first);
-  ASSERT_TRUE(res.ok());
-  res =
-      isam.update({std::make_shared<PriorFactor>(X(0), Eigen::Vector2d(1, -1), isotropic(2, 0.1))},
-                  {res.new_factor_indices[0]});
-  ASSERT_TRUE(res.ok());
-  EXPECT_TRUE(res.full_reelimination);
-  EXPECT_EQ(res.variables_reeliminated, n);
-  EXPECT_EQ(isam.check_invariants(), "");
-  const Eigen::VectorXd expected = dense_solve(isam.graph(), isam.estimate());
-  EXPECT_LT((isam.estimate().vector() - expected).cwiseAbs().maxCoeff(), 1e-9);
-}
-
-TEST(ISAM2, WildfireStopsWhereTheChangeDiesOut) {
-  // Strong priors on every variable damp a goal change quickly along the chain, so with a
-  // wildfire threshold the back-substitution visits only a few cliques yet stays accurate.
-  const int n = 80;
-  Chain chain = make_chain(n, Eigen::Vector2d(1, 1));
-  for (int i = 1; i < n; ++i) {
-    chain.factors.push_back(
-        std::make_shared<PriorFactor>(X(i), Eigen::Vector2d(0.1 * i, 0), isotropic(2, 0.2)));
-  }
-  ISAM2Options opt;
-  opt.wildfire_threshold = 1e-6;
-  opt.relinearize_threshold = 1e9;
-  ISAM2 isam(opt);
-  ISAM2UpdateOptions first;
-  first.constrained_last = {X(n - 1)};
-  auto res = isam.update(chain.factors, {}, chain.values, first);
-  ASSERT_TRUE(res.ok());
-  const int total = isam.bayes_tree().num_cliques();
-  res = isam.update(
-      {std::make_shared<PriorFactor>(X(n - 1), Eigen::Vector2d(2, 0), isotropic(2, 0.1))},
-      {res.new_factor_indices[chain.goal_index]});
-  ASSERT_TRUE(res.ok());
-  EXPECT_LT(res.cliques_solved, total / 2);
-  const Eigen::VectorXd expected = dense_solve(isam.graph(), isam.estimate());
-  EXPECT_LT((isam.estimate().vector() - expected).cwiseAbs().maxCoeff(), 1e-5);
+TEST(ISAM2, ConstrainedLastKeysAreEliminatedAtTheRoot) {
+  // A variable in the middle of a chain is eliminated in the root clique only when asked.
+  const int n = 30;
+  const Chain chain = make_chain(n, Eigen::Vector2d(3, 1));
+  auto in_root = [&](const ISAM2UpdateOptions& uo) {
+    ISAM2 isam;
+    EXPECT_TRUE(isam.update(chain.factors, {}, chain.values, uo).ok());
+    const BayesTree& tree = isam.bayes_tree();
+    return tree.clique(tree.clique_of(isam.estimate().slot(X(n / 3)))).parent < 0;
+  };
+  ISAM2UpdateOptions middle_last;
+  middle_last.constrained_last = {X(n / 3)};
+  EXPECT_TRUE(in_root(middle_last));
+  EXPECT_FALSE(in_root(ISAM2UpdateOptions()));
 }
 
 // Range between two 2-D points: e = ‖x_i − x_j‖ − d (nonlinear).
@@ -541,24 +527,34 @@ TEST(ISAM2, SafeguardedGaussNewtonMakesProgressOnAStiffProblem) {
   EXPECT_LT((isam.estimate().vector() - optimum.vector()).cwiseAbs().maxCoeff(), 1e-5);
 }
 
+// From a trust radius of 100 the stiff problem's first update rejects two dogleg steps (the
+// Gauss–Newton step, then one of a quarter of its length) and accepts the third.
+ISAM2Options wide_dogleg() {
+  ISAM2Options opt;
+  opt.trust_radius_initial = 100;
+  return opt;
+}
+
 TEST(ISAM2, DoglegNeverRisesSilentlyAndConvergesOnAStiffProblem) {
   const Stiff s = make_stiff(15);
   FactorGraph reference;
   for (const auto& f : s.factors) reference.add(f);
-  ISAM2Options opt;
+  ISAM2Options opt = wide_dogleg();
   opt.step = ISAM2Step::kDogleg;
   ISAM2 isam(opt);
   auto res = isam.update(s.factors, {}, s.initial);
   ASSERT_TRUE(res.ok()) << res.reason;
-  int retried = res.trials > 1 ? 1 : 0;  // updates whose first dogleg step was rejected
+  // Updates whose first dogleg step was rejected (trials: one elimination, then the steps).
+  int retried = res.trials > 2 ? 1 : 0;
   for (int it = 0; it < 300 && res.error_after > 0; ++it) {
     if (!res.error_increased) {
       EXPECT_LE(res.error_after, res.error_before * (1 + 1e-9));
     }
     EXPECT_NEAR(isam.error(), res.error_after, 1e-8 * std::max(1.0, res.error_after));
+    EXPECT_EQ(res.lambda, 0);  // no Marquardt damping with Dogleg
     res = isam.update();
     ASSERT_TRUE(res.ok()) << res.reason;
-    retried += res.trials > 1 ? 1 : 0;
+    retried += res.trials > 2 ? 1 : 0;
   }
   EXPECT_GT(retried, 0);  // the trust region really shrank within an update
   // Below the relinearization threshold the estimate is θ + δ; relinearizing closes the gap.
@@ -736,6 +732,218 @@ TEST(ISAM2, ChangeTouchingMostVariablesKeepsCliquesSmall) {
   run(1.0, &largest, &error);  // always ordering the touched variables last
   EXPECT_GT(largest, 40);
   EXPECT_LT(error, 1e-9);
+}
+
+// Every update below relinearizes every variable, so it is one step of the whole graph from the
+// last estimate: the dense Marquardt step with the λ the result reports (Gauss–Newton at λ = 0).
+// λ follows the options exactly: λ₀ after a rejected undamped trial, ×lambda_factor per further
+// rejection, ÷lambda_decrease after an accepted update, 0 once below lambda_min; D is diag(H)
+// floored at min_diagonal (above most of the stiff problem's diagonal).
+TEST(ISAM2, ForcedUpdatesAreDenseMarquardtStepsOnTheConfiguredSchedule) {
+  const Stiff s = make_stiff(15);
+  ISAM2Options opt;
+  opt.wildfire_threshold = 0;
+  opt.lambda_initial = 0.5;
+  opt.lambda_factor = 3;
+  opt.lambda_decrease = 2;
+  opt.lambda_min = 0.05;
+  opt.min_diagonal = 1e3;
+  ISAM2 isam(opt);
+  ISAM2UpdateOptions force;
+  force.force_relinearize = true;
+  double carried = 0;  // λ the next update starts from
+  int from_initial = 0, grown = 0, dropped = 0, damped = 0;
+  for (int it = 0; it < 30; ++it) {
+    const Eigen::VectorXd before = it == 0 ? s.initial.vector() : isam.estimate().vector();
+    const auto res =
+        it == 0 ? isam.update(s.factors, {}, s.initial, force) : isam.update({}, {}, {}, force);
+    ASSERT_TRUE(res.ok()) << res.reason;
+    ASSERT_FALSE(res.error_increased) << "update " << it;
+    ASSERT_TRUE(res.full_reelimination);
+    double expected = carried;  // λ of each trial in turn, as the safeguard forms it
+    for (int t = 1; t < res.trials; ++t) {
+      from_initial += expected == 0 ? 1 : 0;
+      grown += expected == 0 ? 0 : 1;
+      expected = expected == 0 ? opt.lambda_initial : expected * opt.lambda_factor;
+    }
+    ASSERT_EQ(res.lambda, expected) << "update " << it;
+    const Values& theta = isam.linearization_point();
+    ASSERT_EQ(theta.vector(), before) << "update " << it;  // relinearized at the last estimate
+    const Eigen::VectorXd step =
+        dense_damped_step(isam.graph(), theta, res.lambda, opt.min_diagonal);
+    EXPECT_LT((isam.estimate().vector() - theta.vector() - step).cwiseAbs().maxCoeff(),
+              1e-9 * std::max(1.0, step.norm()))
+        << "update " << it;
+    damped += res.lambda > 0 ? 1 : 0;
+    carried = res.lambda / opt.lambda_decrease;
+    if (carried < opt.lambda_min) {
+      dropped += carried > 0 ? 1 : 0;
+      carried = 0;
+    }
+  }
+  // Every branch of the schedule ran.
+  EXPECT_GT(from_initial, 0);
+  EXPECT_GT(grown, 0);
+  EXPECT_GT(dropped, 0);
+  EXPECT_GT(damped, dropped);  // some damping was carried into the next update
+}
+
+TEST(ISAM2, ErrorRiseToleranceLetsARiseWithinItPass) {
+  // The stiff problem's first Gauss–Newton step raises the error a hundredfold and more: by
+  // default the safeguard damps it; with a tolerance above that rise it is accepted undamped.
+  const Stiff s = make_stiff(15);
+  ISAM2Options lax;
+  lax.error_rise_tolerance = 1e6;
+  ISAM2 strict_isam, lax_isam(lax);
+  const auto strict = strict_isam.update(s.factors, {}, s.initial);
+  const auto loose = lax_isam.update(s.factors, {}, s.initial);
+  ASSERT_TRUE(strict.ok() && loose.ok());
+  EXPECT_GT(strict.trials, 1);
+  EXPECT_LE(strict.error_after, strict.error_before);
+  EXPECT_EQ(loose.trials, 1);
+  EXPECT_EQ(loose.lambda, 0);
+  EXPECT_GT(loose.error_after, 100 * loose.error_before);
+  EXPECT_FALSE(loose.error_increased);  // within the tolerance a rise does not count
+}
+
+TEST(ISAM2, WildfireThresholdBoundsTheBackSubstitution) {
+  // A goal change on a chain with priors dies out along it (to exactly zero change within
+  // about 40 steps): the higher the threshold, the fewer cliques back-substitution visits and
+  // the larger the error it leaves.
+  const int n = 80;
+  int total = 0;  // cliques of the tree
+  auto run = [&](double wildfire, int* solved, double* error) {
+    Chain chain = make_chain(n, Eigen::Vector2d(1, 1));
+    for (int i = 1; i < n; ++i) {
+      chain.factors.push_back(
+          std::make_shared<PriorFactor>(X(i), Eigen::Vector2d(0.1 * i, 0), isotropic(2, 1.0)));
+    }
+    ISAM2Options opt;
+    opt.wildfire_threshold = wildfire;
+    opt.relinearize_threshold = 1e9;
+    ISAM2 isam(opt);
+    ISAM2UpdateOptions first;
+    first.constrained_last = {X(n - 1)};
+    auto res = isam.update(chain.factors, {}, chain.values, first);
+    ASSERT_TRUE(res.ok());
+    res = isam.update(
+        {std::make_shared<PriorFactor>(X(n - 1), Eigen::Vector2d(2, 0), isotropic(2, 0.1))},
+        {res.new_factor_indices[chain.goal_index]});
+    ASSERT_TRUE(res.ok());
+    *solved = res.cliques_solved;
+    total = isam.bayes_tree().num_cliques();
+    *error = (isam.estimate().vector() - dense_solve(isam.graph(), isam.estimate()))
+                 .cwiseAbs()
+                 .maxCoeff();
+  };
+  int exact = 0, by_default = 0, coarse = 0;
+  double exact_error = 0, default_error = 0, coarse_error = 0;
+  run(0, &exact, &exact_error);
+  EXPECT_LT(exact_error, 1e-12);
+  run(ISAM2Options().wildfire_threshold, &by_default, &default_error);
+  EXPECT_LT(by_default, exact);
+  EXPECT_LT(by_default, total / 2);
+  EXPECT_LT(default_error, 1e-6);
+  EXPECT_GT(default_error, exact_error);
+  run(1e-2, &coarse, &coarse_error);
+  EXPECT_LT(coarse, by_default);
+  EXPECT_LT(coarse_error, 1e-1);
+  EXPECT_GT(coarse_error, default_error);
+}
+
+TEST(ISAM2, FullReeliminationFractionDecidesWhenTheTreeIsRebuilt) {
+  // With the goal's end eliminated last, the start prior sits at the bottom: changing it affects
+  // the whole path to the root (by default: re-eliminated from scratch), while a goal change
+  // affects only the root (by default: in place).
+  const int n = 40;
+  auto run = [&](double fraction, bool change_start) {
+    Chain chain = make_chain(n, Eigen::Vector2d(3, 1));
+    ISAM2Options opt;
+    opt.wildfire_threshold = 0;
+    opt.relinearize_threshold = 1e9;
+    opt.full_reelimination_fraction = fraction;
+    ISAM2 isam(opt);
+    ISAM2UpdateOptions first;
+    first.constrained_last = {X(n - 1)};
+    auto res = isam.update(chain.factors, {}, chain.values, first);
+    EXPECT_TRUE(res.ok());
+    const int var = change_start ? 0 : n - 1;
+    const size_t old = res.new_factor_indices[change_start ? 0 : chain.goal_index];
+    res = isam.update(
+        {std::make_shared<PriorFactor>(X(var), Eigen::Vector2d(1, -1), isotropic(2, 0.1))}, {old});
+    EXPECT_TRUE(res.ok());
+    EXPECT_EQ(isam.check_invariants(), "");
+    const Eigen::VectorXd expected = dense_solve(isam.graph(), isam.estimate());
+    EXPECT_LT((isam.estimate().vector() - expected).cwiseAbs().maxCoeff(), 1e-9);
+    return res;
+  };
+  const double by_default = ISAM2Options().full_reelimination_fraction;
+  ISAM2Result res = run(by_default, /*change_start=*/true);
+  EXPECT_TRUE(res.full_reelimination);
+  EXPECT_EQ(res.variables_reeliminated, n);
+  res = run(1.0, /*change_start=*/true);  // never rebuild: the affected top is the whole tree
+  EXPECT_FALSE(res.full_reelimination);
+  EXPECT_EQ(res.variables_reeliminated, n);
+  EXPECT_FALSE(run(by_default, /*change_start=*/false).full_reelimination);
+  EXPECT_TRUE(run(0.0, /*change_start=*/false).full_reelimination);  // always rebuild
+}
+
+// Runs Dogleg with `opt` on the stiff problem for `updates` updates, `check(it, result, step)`
+// after each with the step it took (change of the estimate, ‖·‖₂).
+void run_dogleg(ISAM2Options opt, int updates,
+                const std::function<void(int, const ISAM2Result&, double)>& check) {
+  const Stiff s = make_stiff(15);
+  opt.step = ISAM2Step::kDogleg;
+  ISAM2 isam(opt);
+  for (int it = 0; it < updates; ++it) {
+    const Eigen::VectorXd before = it == 0 ? s.initial.vector() : isam.estimate().vector();
+    const auto res = it == 0 ? isam.update(s.factors, {}, s.initial) : isam.update();
+    ASSERT_TRUE(res.ok()) << res.reason;
+    check(it, res, (isam.estimate().vector() - before).norm());
+  }
+}
+
+TEST(ISAM2, DoglegFirstStepStaysInsideTheInitialTrustRadius) {
+  ISAM2Options opt;
+  opt.trust_radius_initial = 1e-2;
+  run_dogleg(opt, 1, [&](int, const ISAM2Result& res, double step) {
+    EXPECT_EQ(res.lambda, 0);  // no Marquardt damping with Dogleg
+    EXPECT_GT(step, 0);
+    EXPECT_LE(step, opt.trust_radius_initial * (1 + 1e-12));
+  });
+  // The default radius lets the same first step go much further.
+  run_dogleg(ISAM2Options(), 1, [&](int, const ISAM2Result&, double step) {
+    EXPECT_GT(step, 10 * opt.trust_radius_initial);
+  });
+}
+
+TEST(ISAM2, DoglegGivesUpAtTheTrustRadiusFloor) {
+  // A floor between the second and third radius ends the first update after two steps,
+  // flagged, with the radius at the floor.
+  int default_trials = 0;
+  run_dogleg(wide_dogleg(), 1, [&](int, const ISAM2Result& res, double) {
+    EXPECT_FALSE(res.error_increased);
+    default_trials = res.trials;
+  });
+  EXPECT_EQ(default_trials, 4);  // one elimination, three dogleg steps
+  ISAM2Options opt = wide_dogleg();
+  opt.trust_radius_min = 2;
+  run_dogleg(opt, 1, [&](int, const ISAM2Result& res, double) {
+    EXPECT_EQ(res.trials, 3);
+    EXPECT_TRUE(res.error_increased);
+    EXPECT_EQ(res.trust_radius, opt.trust_radius_min);
+  });
+}
+
+TEST(ISAM2, DoglegTriesAtMostMaxTrialsPerUpdate) {
+  ISAM2Options opt = wide_dogleg();
+  opt.max_dogleg_trials = 2;
+  run_dogleg(opt, 10, [&](int it, const ISAM2Result& res, double) {
+    EXPECT_LE(res.trials, 1 + opt.max_dogleg_trials) << "update " << it;
+    if (it == 0) {
+      EXPECT_TRUE(res.error_increased);  // its third step was not tried
+    }
+  });
 }
 
 }  // namespace

@@ -1,14 +1,18 @@
 // Solver behaviour on nonlinear problems: orderings and factorizations agree, structure is reused
-// across solves after changing targets, fixed variables stay, statistics are consistent.
+// across solves after changing targets, fixed variables stay, statistics are consistent, LM's
+// iterates are pinned, and the LevenbergMarquardtOptions fields no other test covers take effect.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <numeric>
 #include <random>
+#include <string>
 
 #include "kinograph/graph/levenberg_marquardt.h"
 #include "kinograph/graph/linear_factor.h"
 #include "kinograph/graph/normal_equations.h"
 #include "kinograph/graph/ordering.h"
+#include "kinograph/graph/prior_factor.h"
 #include "tests/graph/problems.h"
 
 namespace kinograph::graph {
@@ -168,6 +172,227 @@ TEST(Solver, LinearizingTrialStepsChangesNothingButTheWork) {
   Values v = problems::curve_fit().start;
   const OptimizationResult r = LevenbergMarquardt().optimize(problems::curve_fit().graph, v);
   EXPECT_GT(r.trials, r.iterations);  // some steps were rejected
+}
+
+TEST(Solver, LevenbergMarquardtIteratesArePinned) {
+  // Exact on purpose: the guard for LM's arithmetic, where any reordering of its floating-point
+  // operations moves the last bits. Re-record only for an intended change of the algorithm.
+  const auto p = problems::curve_fit();  // rejects three steps first: both branches run
+  for (bool linearize : {true, false}) {
+    LevenbergMarquardtOptions o;
+    o.linearize_at_evaluation = linearize;
+    Values v = p.start;
+    const OptimizationResult r = LevenbergMarquardt(o).optimize(p.graph, v);
+    std::string accepted;
+    for (const IterationStats& s : r.history) accepted += s.accepted ? 'A' : 'R';
+    EXPECT_EQ(r.status, SolverStatus::kConverged);
+    EXPECT_EQ(r.iterations, 8);
+    EXPECT_EQ(r.trials, 11);
+    EXPECT_EQ(accepted, "RRRAAAAAAAA");
+    EXPECT_EQ(r.final_error, 0x1.4bffb412f2267p+0);
+    EXPECT_EQ(r.lambda, 0x1.32d9ccb1ec24bp-12);
+    EXPECT_EQ(v.vector(), Eigen::Vector2d(0x1.3f160b151c445p-2, 0x1.0a2d5971557fp-4));
+  }
+  const auto chain = problems::chain(60);
+  Values v = chain.start;
+  const OptimizationResult r = LevenbergMarquardt().optimize(chain.graph, v);
+  EXPECT_EQ(r.iterations, 7);
+  EXPECT_EQ(r.trials, 7);
+  EXPECT_EQ(r.final_error, 0x1.5552aceacc7b2p+5);
+  EXPECT_EQ(r.lambda, 0x1.32da800a30412p-18);
+}
+
+// First trial step on ½((x − 1)/0.1)² from x = 0, where H = 100 and g = −100: the step
+// 100 / (100 + λ₀·D) shows which λ₀ and D the solver used.
+double first_step(const LevenbergMarquardtOptions& options) {
+  FactorGraph graph;
+  const Key x('x', 0, 0);
+  graph.emplace<PriorFactor>(x, Eigen::VectorXd::Ones(1), isotropic(1, 0.1));
+  Values v;
+  v.insert(x, Eigen::VectorXd::Zero(1));
+  return LevenbergMarquardt(options).optimize(graph, v).history.at(0).step_norm;
+}
+
+TEST(Solver, FirstStepUsesLambdaInitialAndTheDampingMatrix) {
+  const auto with = [](auto set) {
+    LevenbergMarquardtOptions o;
+    set(o);
+    return first_step(o);
+  };
+  EXPECT_NEAR(with([](auto&) {}), 100 / 101.0, 1e-14);  // λ₀ = 0.01, D = diag(H) = 100
+  EXPECT_NEAR(with([](auto& o) { o.lambda_initial = 1; }), 0.5, 1e-14);
+  EXPECT_NEAR(with([](auto& o) { o.damping = Damping::kIdentity; }), 100 / 100.01, 1e-14);
+  EXPECT_NEAR(with([](auto& o) { o.min_diagonal = 1e4; }), 0.5, 1e-14);         // D raised to 1e4
+  EXPECT_NEAR(with([](auto& o) { o.max_diagonal = 1; }), 100 / 100.01, 1e-14);  // D cut to 1
+}
+
+TEST(Solver, LambdaNeverDropsBelowLambdaMin) {
+  const auto p = problems::curve_fit();
+  const auto smallest_lambda = [&](const LevenbergMarquardtOptions& o) {
+    Values v = p.start;
+    const OptimizationResult r = LevenbergMarquardt(o).optimize(p.graph, v);
+    double smallest = r.lambda;
+    for (const IterationStats& s : r.history) smallest = std::min(smallest, s.lambda);
+    return smallest;
+  };
+  LevenbergMarquardtOptions o;
+  o.lambda_min = 1e-3;
+  ASSERT_LT(smallest_lambda({}), o.lambda_min);  // the default floor lets λ fall below it
+  EXPECT_EQ(smallest_lambda(o), o.lambda_min);
+}
+
+// e = x² − 4 with the Jacobian's sign flipped: every step goes uphill, so λ grows until it
+// exceeds lambda_max.
+class UphillFactor final : public Factor {
+ public:
+  explicit UphillFactor(Key key) : Factor({key}, {1}, 1) {}
+  void evaluate(const FactorValues& x, Eigen::Ref<Eigen::VectorXd> e,
+                const Jacobians* J) const override {
+    e[0] = x[0][0] * x[0][0] - 4;
+    if (J) J->block(0)(0, 0) = -2 * x[0][0];
+  }
+};
+
+TEST(Solver, LambdaMaxEndsTheSearchForADecrease) {
+  FactorGraph graph;
+  const Key x('x', 0, 0);
+  graph.emplace<UphillFactor>(x);
+  Values start;
+  start.insert(x, Eigen::VectorXd::Constant(1, 3.0));
+  LevenbergMarquardtOptions o;
+  o.lambda_max = 1;
+  Values v = start;
+  const OptimizationResult r = LevenbergMarquardt(o).optimize(graph, v);
+  EXPECT_EQ(r.status, SolverStatus::kNoDecrease);
+  EXPECT_EQ(r.trials, 4);  // λ = 0.01, 0.02, 0.08, 0.64; the next, 10.24, exceeds lambda_max
+  EXPECT_GT(r.lambda, o.lambda_max);
+  Values w = start;
+  EXPECT_EQ(LevenbergMarquardt().optimize(graph, w).trials, 10);  // up to 1e12
+}
+
+TEST(Solver, AbsoluteErrorTolStopsAtTheFirstPointBelowIt) {
+  const auto p = problems::curve_fit();  // cost 122 at the start, 1.30 at the optimum
+  LevenbergMarquardtOptions o;
+  o.absolute_error_tol = 50;
+  Values v = p.start;
+  const OptimizationResult r = LevenbergMarquardt(o).optimize(p.graph, v);
+  EXPECT_EQ(r.status, SolverStatus::kConverged);
+  EXPECT_EQ(r.reason, "error at or below the absolute tolerance");
+  EXPECT_LE(r.final_error, 50.0);
+  EXPECT_GT(r.final_error, 2.0);  // far from the optimum
+  o.absolute_error_tol = 1e3;     // above the start: no step at all
+  Values w = p.start;
+  const OptimizationResult at_start = LevenbergMarquardt(o).optimize(p.graph, w);
+  EXPECT_EQ(at_start.reason, "error at or below the absolute tolerance");
+  EXPECT_EQ(at_start.trials, 0);
+}
+
+TEST(Solver, StepTolStopsAtTheFirstStepBelowIt) {
+  const auto p = problems::curve_fit();
+  LevenbergMarquardtOptions o;
+  o.relative_error_tol = 0;  // only the step size ends the solve
+  o.step_tol = 1e-3;
+  Values v = p.start;
+  const OptimizationResult r = LevenbergMarquardt(o).optimize(p.graph, v);
+  EXPECT_EQ(r.reason, "step below the step tolerance");
+  const double bound = o.step_tol * (v.vector().norm() + o.step_tol);  // x is where it stopped
+  EXPECT_LE(r.history.back().step_norm, bound);
+  for (size_t i = 0; i + 1 < r.history.size(); ++i) EXPECT_GT(r.history[i].step_norm, bound);
+}
+
+TEST(Solver, OrderingDecidesTheFill) {
+  // A hub tied to every leaf, inserted first: the natural order eliminates it first and fills
+  // L completely; the fill-reducing orderings eliminate it last.
+  FactorGraph graph;
+  Values start;
+  const Key hub('h', 0, 0);
+  start.insert(hub, Eigen::Vector2d(0.1, 0.2));
+  graph.emplace<PriorFactor>(hub, Eigen::Vector2d::Zero(), isotropic(2, 1.0));
+  const int leaves = 30;
+  const Eigen::MatrixXd I = Eigen::MatrixXd::Identity(2, 2);
+  for (int k = 0; k < leaves; ++k) {
+    const Key leaf('l', 0, k);
+    start.insert(leaf, Eigen::Vector2d(0.1 * k, -0.05 * k));
+    graph.emplace<LinearFactor>(std::vector<Key>{hub, leaf}, std::vector<Eigen::MatrixXd>{I, -I},
+                                Eigen::Vector2d(0.01 * k, 0.3), isotropic(2, 0.5));
+  }
+  const auto factor_nnz = [&](OrderingMethod ordering) {
+    LevenbergMarquardtOptions o;
+    o.ordering = ordering;
+    LevenbergMarquardt lm(o);
+    Values v = start;
+    EXPECT_TRUE(lm.optimize(graph, v).converged()) << to_string(ordering);
+    return lm.cholesky()->factor_nnz();
+  };
+  const int n = 2 * (leaves + 1);
+  EXPECT_EQ(factor_nnz(OrderingMethod::kNatural), n * (n + 1) / 2);  // dense
+  for (auto ordering : {OrderingMethod::kAmd, OrderingMethod::kColamd, OrderingMethod::kMetis}) {
+    EXPECT_LT(factor_nnz(ordering), 8 * (leaves + 1)) << to_string(ordering);
+  }
+}
+
+// e = exp(m·t + c) − y, counting evaluations with and without Jacobians.
+class CountingExpFactor final : public Factor {
+ public:
+  CountingExpFactor(Key key, double t, double y, int* with_jacobian, int* without_jacobian)
+      : Factor({key}, {2}, 1),
+        t_(t),
+        y_(y),
+        with_jacobian_(with_jacobian),
+        without_jacobian_(without_jacobian) {}
+  void evaluate(const FactorValues& x, Eigen::Ref<Eigen::VectorXd> e,
+                const Jacobians* J) const override {
+    const double f = std::exp(x[0][0] * t_ + x[0][1]);
+    e[0] = f - y_;
+    if (J) {
+      J->block(0) << f * t_, f;
+      ++*with_jacobian_;
+    } else {
+      ++*without_jacobian_;
+    }
+  }
+
+ private:
+  double t_, y_;
+  int *with_jacobian_, *without_jacobian_;
+};
+
+TEST(Solver, LinearizeAtEvaluationTakesJacobiansAtEveryTrialInsteadOfAfterAcceptance) {
+  const int samples = 10;
+  for (bool linearize : {true, false}) {
+    int with_jacobian = 0, without_jacobian = 0;
+    FactorGraph graph;
+    const Key key('m', 0, 0);
+    for (int i = 0; i < samples; ++i) {
+      const double t = 0.5 * i;
+      graph.emplace<CountingExpFactor>(key, t, std::exp(0.3 * t + 0.1) + 0.1 * std::sin(i),
+                                       &with_jacobian, &without_jacobian);
+    }
+    Values v;
+    v.insert(key, Eigen::Vector2d::Zero());
+    LevenbergMarquardtOptions o;
+    o.linearize_at_evaluation = linearize;
+    const OptimizationResult r = LevenbergMarquardt(o).optimize(graph, v);
+    ASSERT_TRUE(r.converged()) << r.reason;
+    ASSERT_GT(r.trials, r.iterations);  // rejected trials make the two counts differ
+    if (linearize) {                    // the start, then every trial point with its Jacobian
+      EXPECT_EQ(with_jacobian, samples * (1 + r.trials));
+      EXPECT_EQ(without_jacobian, 0);
+    } else {  // every trial point's cost, and Jacobians only where a step was accepted
+      EXPECT_EQ(with_jacobian, samples * r.iterations);
+      EXPECT_EQ(without_jacobian, samples * r.trials);
+    }
+  }
+}
+
+TEST(Solver, RecordHistoryOffLeavesTheHistoryEmpty) {
+  const auto p = problems::chain(20);
+  LevenbergMarquardtOptions o;
+  o.record_history = false;
+  Values v = p.start;
+  const OptimizationResult r = LevenbergMarquardt(o).optimize(p.graph, v);
+  ASSERT_GT(r.trials, 0);
+  EXPECT_TRUE(r.history.empty());
 }
 
 TEST(Solver, CompactNonzeroRowsKeepsTheInformation) {

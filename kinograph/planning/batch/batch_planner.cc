@@ -26,6 +26,21 @@ Plan failed_plan(const Problem& problem, const std::string& status, const std::s
 
 std::string to_string(Formulation f) { return f == Formulation::kCondensed ? "condensed" : "dfg"; }
 
+Plan solved_plan(const Problem& problem, const PlanningGraph& pg, const OuterLoopResult& r,
+                 const std::string& method, const BatchPlannerOptions& options) {
+  Plan plan = plan_from_values(problem, pg.values, options.dfg.keys);
+  plan.stats.method = method;
+  plan.stats.status = r.status;
+  plan.stats.reason = r.reason;
+  plan.stats.iterations = r.iterations;
+  plan.stats.outer_iterations = r.outer_iterations;
+  plan.stats.linear_solves = r.linear_solves;
+  plan.stats.max_constraint_violation = r.worst.violation;
+  plan.stats.cost = soft_cost(pg.entries, pg.values);
+  plan.validation = validate(problem, plan, options.validation);
+  return plan;
+}
+
 OuterLoopOptions outer_loop_options(const BatchPlannerOptions& options) {
   OuterLoopOptions loop = options.outer_loop;
   if (options.formulation == Formulation::kDynamicFactorGraph) {
@@ -132,7 +147,6 @@ Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init, const s
                          BatchSolution* solution) const {
   const auto t0 = std::chrono::steady_clock::now();
   if (solution != nullptr) *solution = BatchSolution();  // empty unless the solve runs
-  const int n = problem.model->nq(), N = problem.steps;
   PlanningGraph pg;
   std::vector<DfgConstraintStep> dfg_steps;
   try {
@@ -151,23 +165,7 @@ Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init, const s
   AugmentedLagrangian al(pg.constraints(false), state, options_.augmented_lagrangian);
   const OuterLoopResult r = solve_outer_loop(pg.graph, pg.values, al, loop, problem.name);
 
-  // The plan: trajectory from the values; τ from inverse dynamics in the condensed formulation
-  // (which eliminates it, so it equals RNEA exactly), the DFG's own τ variables otherwise (so
-  // the validator's dynamics residual checks the DFG's equations of motion).
-  Plan plan = plan_from_trajectory(problem, read_trajectory(pg.values, N, n));
-  for (const DfgConstraintStep& s : dfg_steps) {
-    plan.tau.row(s.step) =
-        dfg_torques(pg.values, *problem.model, s.step, options_.dfg.keys).transpose();
-  }
-  plan.stats.method = method;
-  plan.stats.status = r.status;
-  plan.stats.reason = r.reason;
-  plan.stats.iterations = r.iterations;
-  plan.stats.outer_iterations = r.outer_iterations;
-  plan.stats.linear_solves = r.linear_solves;
-  plan.stats.max_constraint_violation = r.worst.violation;
-  plan.stats.cost = soft_cost(pg.entries, pg.values);
-  plan.validation = validate(problem, plan, options_.validation);
+  Plan plan = solved_plan(problem, pg, r, method, options_);
   plan.stats.solve_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (solution != nullptr) {

@@ -62,6 +62,11 @@ struct BatchSolution {
   ConstraintState constraints;
 };
 
+/// The plan at the end of an outer loop on `pg` (plan_from_values), with its stats from `r`
+/// and `method`, its soft cost, and its validation.
+Plan solved_plan(const Problem& problem, const PlanningGraph& pg, const OuterLoopResult& r,
+                 const std::string& method, const BatchPlannerOptions& options);
+
 /// The outer loop's options for the configured formulation (the DFG's tighter tolerances).
 OuterLoopOptions outer_loop_options(const BatchPlannerOptions& options);
 

@@ -269,6 +269,22 @@ std::vector<DfgConstraintStep> use_dfg_dynamics(PlanningGraph& pg, const Problem
   return out;
 }
 
+Plan plan_from_values(const Problem& problem, const graph::Values& values, const DfgKeys& keys) {
+  Plan plan =
+      plan_from_trajectory(problem, read_trajectory(values, problem.steps, problem.model->nq()));
+  read_dfg_torques(plan, values, *problem.model, keys);
+  return plan;
+}
+
+void read_dfg_torques(Plan& plan, const graph::Values& values, const dynamics::Model& model,
+                      const DfgKeys& keys) {
+  for (int k = 0; k < plan.tau.rows(); ++k) {
+    if (values.contains(keys.torque_key(0, k))) {
+      plan.tau.row(k) = dfg_torques(values, model, k, keys).transpose();
+    }
+  }
+}
+
 Eigen::VectorXd dfg_torques(const graph::Values& values, const dynamics::Model& model, int step,
                             const DfgKeys& keys) {
   const int n = model.nq();

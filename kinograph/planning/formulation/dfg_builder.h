@@ -161,6 +161,16 @@ std::vector<DfgConstraintStep> use_dfg_dynamics(PlanningGraph& pg, const Problem
                                                 const GraphOptions& graph_options = {},
                                                 const DfgOptions& options = {});
 
+/// The plan of a solved graph's values: states, step times, and τ from inverse dynamics
+/// (exact for the condensed formulation, which eliminates τ) except at the steps that hold the
+/// DFG's own τ variables (named by `keys`), whose torques are read back so that the validator
+/// checks the DFG's equations of motion. Stats and validation are left empty.
+Plan plan_from_values(const Problem& problem, const graph::Values& values,
+                      const DfgKeys& keys = {});
+/// Overwrites plan.tau at the steps whose DFG τ variables `values` holds with those torques.
+void read_dfg_torques(Plan& plan, const graph::Values& values, const dynamics::Model& model,
+                      const DfgKeys& keys = {});
+
 /// The torques of `step` read back from the graph (nq entries).
 Eigen::VectorXd dfg_torques(const graph::Values& values, const dynamics::Model& model, int step,
                             const DfgKeys& keys = {});

@@ -209,23 +209,7 @@ std::unique_ptr<IncrementalTree> solve_incremental_graph(const Problem& problem,
   tree->entries = pg.entries;
   tree->constraints.set_penalty(std::clamp(al.penalty(), batch.augmented_lagrangian.initial_penalty,
                                            kMaxCarriedPenalty));
-  const int n = problem.model->nq(), N = problem.steps;
-  plan = plan_from_trajectory(problem, read_trajectory(pg.values, N, n));
-  if (batch.formulation == Formulation::kDynamicFactorGraph &&
-      pg.values.contains(batch.dfg.keys.torque_key(0, 0))) {
-    for (int k = 0; k <= N; ++k) {
-      plan.tau.row(k) = dfg_torques(pg.values, *problem.model, k, batch.dfg.keys).transpose();
-    }
-  }
-  plan.stats.method = method;
-  plan.stats.status = r.status;
-  plan.stats.reason = r.reason;
-  plan.stats.iterations = r.iterations;
-  plan.stats.outer_iterations = r.outer_iterations;
-  plan.stats.linear_solves = r.linear_solves;
-  plan.stats.max_constraint_violation = r.worst.violation;
-  plan.stats.cost = soft_cost(pg.entries, pg.values);
-  plan.validation = validate(problem, plan, batch.validation);
+  plan = solved_plan(problem, pg, r, method, batch);
   finish_tree(*tree, pg.values, problem);
   return tree;
 }

@@ -100,13 +100,7 @@ Plan IncrementalPlanner::make_plan(bool with_stats) const {
     tr.qd.row(0) = qd0.transpose();
   }
   Plan plan = plan_from_trajectory(problem_, tr);
-  // The DFG's own torques, so that the validator checks its equations of motion.
-  if (options_.batch.formulation == Formulation::kDynamicFactorGraph &&
-      values.contains(options_.batch.dfg.keys.torque_key(0, 0))) {
-    for (int k = 0; k <= N; ++k) {
-      plan.tau.row(k) = dfg_torques(values, *problem_.model, k, options_.batch.dfg.keys).transpose();
-    }
-  }
+  read_dfg_torques(plan, values, *problem_.model, options_.batch.dfg.keys);
   plan.stats.method = "incremental";
   // Without stats this is the stopping rule's check, which needs only the verdict.
   plan.validation = validate(problem_, plan, options_.batch.validation, !with_stats);

@@ -617,44 +617,10 @@ Scene load_scene(const std::string& path) {
   return parse_scene(text.str(), path);
 }
 
-std::string scene_to_yaml(const Scene& scene) {
-  const Problem& p = scene.problem;
-  YAML::Emitter out;
-  out.SetDoublePrecision(17);
-  out << YAML::BeginMap;
-  out << YAML::Key << "name" << YAML::Value << p.name;
-  out << YAML::Key << "robot" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "urdf" << YAML::Value << scene.urdf_path;
-  if (scene.payload) {
-    const PayloadSpec& pl = *scene.payload;
-    out << YAML::Key << "payload" << YAML::Value << YAML::BeginMap;
-    out << YAML::Key << "frame" << YAML::Value << pl.frame;
-    out << YAML::Key << "mass" << YAML::Value << pl.mass;
-    out << YAML::Key << "size" << YAML::Value;
-    emit_vector(out, pl.size);
-    out << YAML::Key << "offset" << YAML::Value;
-    emit_vector(out, pl.offset);
-    out << YAML::EndMap;
-  }
-  out << YAML::EndMap;
-  out << YAML::Key << "horizon" << YAML::Value << p.horizon;
-  out << YAML::Key << "steps" << YAML::Value << p.steps;
-  out << YAML::Key << "start" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "q" << YAML::Value;
-  emit_vector(out, p.start_q);
-  out << YAML::Key << "qd" << YAML::Value;
-  emit_vector(out, p.start_qd);
-  out << YAML::EndMap;
-  out << YAML::Key << "goal" << YAML::Value << YAML::BeginMap;
-  if (p.goal.kind == Goal::Kind::kJoint) {
-    out << YAML::Key << "q" << YAML::Value;
-    emit_vector(out, p.goal.q);
-  } else {
-    out << YAML::Key << "frame" << YAML::Value << p.goal.frame;
-    emit_pose(out, p.goal.pose);
-    out << YAML::Key << "position_only" << YAML::Value << p.goal.position_only;
-  }
-  out << YAML::EndMap;
+namespace {
+
+// The limits section: every overridden limit of every joint.
+void emit_limits(YAML::Emitter& out, const Scene& scene) {
   if (!scene.limits.empty()) {
     out << YAML::Key << "limits" << YAML::Value << YAML::BeginMap;
     for (const auto& [joint, o] : scene.limits) {
@@ -671,6 +637,11 @@ std::string scene_to_yaml(const Scene& scene) {
     }
     out << YAML::EndMap;
   }
+}
+
+// The obstacles section, in the problem's order, named as in the file.
+void emit_obstacles(YAML::Emitter& out, const Scene& scene) {
+  const Problem& p = scene.problem;
   if (!p.obstacles.empty()) {
     out << YAML::Key << "obstacles" << YAML::Value << YAML::BeginSeq;
     for (std::size_t i = 0; i < p.obstacles.size(); ++i) {
@@ -713,6 +684,50 @@ std::string scene_to_yaml(const Scene& scene) {
     }
     out << YAML::EndSeq;
   }
+}
+
+}  // namespace
+
+std::string scene_to_yaml(const Scene& scene) {
+  const Problem& p = scene.problem;
+  YAML::Emitter out;
+  out.SetDoublePrecision(17);
+  out << YAML::BeginMap;
+  out << YAML::Key << "name" << YAML::Value << p.name;
+  out << YAML::Key << "robot" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "urdf" << YAML::Value << scene.urdf_path;
+  if (scene.payload) {
+    const PayloadSpec& pl = *scene.payload;
+    out << YAML::Key << "payload" << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "frame" << YAML::Value << pl.frame;
+    out << YAML::Key << "mass" << YAML::Value << pl.mass;
+    out << YAML::Key << "size" << YAML::Value;
+    emit_vector(out, pl.size);
+    out << YAML::Key << "offset" << YAML::Value;
+    emit_vector(out, pl.offset);
+    out << YAML::EndMap;
+  }
+  out << YAML::EndMap;
+  out << YAML::Key << "horizon" << YAML::Value << p.horizon;
+  out << YAML::Key << "steps" << YAML::Value << p.steps;
+  out << YAML::Key << "start" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "q" << YAML::Value;
+  emit_vector(out, p.start_q);
+  out << YAML::Key << "qd" << YAML::Value;
+  emit_vector(out, p.start_qd);
+  out << YAML::EndMap;
+  out << YAML::Key << "goal" << YAML::Value << YAML::BeginMap;
+  if (p.goal.kind == Goal::Kind::kJoint) {
+    out << YAML::Key << "q" << YAML::Value;
+    emit_vector(out, p.goal.q);
+  } else {
+    out << YAML::Key << "frame" << YAML::Value << p.goal.frame;
+    emit_pose(out, p.goal.pose);
+    out << YAML::Key << "position_only" << YAML::Value << p.goal.position_only;
+  }
+  out << YAML::EndMap;
+  emit_limits(out, scene);
+  emit_obstacles(out, scene);
   if (!p.task_constraints.empty()) {
     out << YAML::Key << "task_constraints" << YAML::Value << YAML::BeginSeq;
     for (const TaskConstraint& t : p.task_constraints) {
