@@ -69,7 +69,7 @@ struct ISAM2Options {
   double lambda_factor = 10;
   /// λ shrinks by this factor after an accepted update (≥ 1): lingering damping suppresses the
   /// smooth, low-curvature modes of a chain, dropping it at once can overshoot.
-  double lambda_decrease = 100;
+  double lambda_decrease = 10;
   /// Below this the carried λ drops to 0 (plain Gauss–Newton again).
   double lambda_min = 1e-7;
   /// Give up (keep the last trial, flag error_increased) when λ would exceed this.

@@ -77,6 +77,9 @@ void add_counts(SolveStats& to, const SolveStats& from) {
 graph::ISAM2Options default_incremental_isam2() {
   graph::ISAM2Options o;
   o.relinearize_threshold = 0.01;
+  // Marquardt damping lingers less: while it lasts it stiffens the smooth modes of the
+  // trajectory, and each update then bends only part of it.
+  o.lambda_decrease = 100;
   return o;
 }
 

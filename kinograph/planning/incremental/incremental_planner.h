@@ -26,8 +26,9 @@
 
 namespace kinograph::planning {
 
-/// The ISAM2 settings of the incremental planner: relinearization below ISAM2's general
-/// threshold, since trajectory variables move by less than that in a replan.
+/// The ISAM2 settings of the incremental planner: a relinearization threshold below ISAM2's
+/// general one (trajectory variables move by less than that in a replan) and damping that
+/// fades fast.
 graph::ISAM2Options default_incremental_isam2();
 
 /// Options of IncrementalPlanner.
