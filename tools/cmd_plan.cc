@@ -58,7 +58,7 @@ void run_plan(const PlanArgs& args) {
   }
   if (!plan.success()) {
     throw CommandFailure(
-        "the plan of '" + args.scene + "' does not validate (" + plan.stats.status + ")", 2);
+        "the plan of '" + args.scene + "' does not validate (" + planning::to_string(plan.stats.status) + ")", 2);
   }
 }
 

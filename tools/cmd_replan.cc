@@ -69,7 +69,7 @@ void run_replan(const ReplanArgs& args) {
   }
   if (!before.success()) {
     throw CommandFailure("the plan of '" + args.scene + "' does not validate (" +
-                             before.stats.status + "); nothing to replan",
+                             planning::to_string(before.stats.status) + "); nothing to replan",
                          2);
   }
   const planning::Plan after = planner.replan(change.change);
@@ -86,7 +86,7 @@ void run_replan(const ReplanArgs& args) {
   }
   if (!after.success()) {
     throw CommandFailure(
-        "the replan after '" + args.change + "' does not validate (" + after.stats.status + ")", 2);
+        "the replan after '" + args.change + "' does not validate (" + planning::to_string(after.stats.status) + ")", 2);
   }
 }
 

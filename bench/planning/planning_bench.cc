@@ -80,7 +80,7 @@ json failures_of(const std::vector<Run>& runs) {
     if (runs[i].plan.success()) continue;
     const Plan& p = runs[i].plan;
     out.push_back({{"goal", i},
-                   {"status", p.stats.status},
+                   {"status", to_string(p.stats.status)},
                    {"first_failure",
                     p.validation.failures.empty() ? std::string() : p.validation.failures[0]}});
   }
@@ -117,7 +117,7 @@ int run(int argc, char** argv) {
     s["max_unactuated_torque"] = p.validation.max_unactuated_torque;
     s["max_elbow_torque"] = p.tau.col(1).cwiseAbs().maxCoeff();
     s["goal_error"] = p.validation.goal_error;
-    s["status"] = p.stats.status;
+    s["status"] = to_string(p.stats.status);
     s["failures"] = p.validation.failures;
     result["acrobot"] = s;
     std::cerr << "acrobot: " << s.dump() << "\n";

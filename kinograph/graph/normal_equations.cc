@@ -6,68 +6,35 @@
 
 namespace kinograph::graph {
 
-NormalEquations::NormalEquations(const FactorGraph& graph, const Values& values,
-                                 OrderingMethod ordering)
-    : graph_id_(graph.structure_id()), layout_id_(values.layout_id()) {
-  // Free variables in slot order ("natural" index), and their factors' incidence.
-  std::vector<int> natural_of_slot(values.size(), -1);
-  std::vector<int> slot_of_natural;
-  for (int s = 0; s < values.size(); ++s) {
-    if (!values.is_fixed_slot(s)) {
-      natural_of_slot[s] = static_cast<int>(slot_of_natural.size());
-      slot_of_natural.push_back(s);
-    }
-  }
-  const int num_free = static_cast<int>(slot_of_natural.size());
-  std::vector<std::vector<int>> factor_vars;
-  std::vector<std::vector<int>> factor_slots;
-  factor_vars.reserve(graph.num_factors());
-  int max_rows = 0, max_cols = 0, max_keys = 0;
-  for (size_t fi = 0; fi < graph.size(); ++fi) {
-    const auto& f = graph[fi];
-    if (!f) continue;
-    std::vector<int> vars, slots;
-    for (size_t k = 0; k < f->keys().size(); ++k) {
-      const Key key = f->keys()[k];
-      const int s = values.find(key);
-      if (s < 0) {
-        throw std::invalid_argument("factor " + std::to_string(fi) + " (" + f->name() + ") uses " +
-                                    key.to_string() + ", which is not in Values");
-      }
-      if (values.dim(s) != f->dims()[k]) {
-        throw std::invalid_argument("factor " + std::to_string(fi) + " (" + f->name() +
-                                    ") expects " + key.to_string() + " of dimension " +
-                                    std::to_string(f->dims()[k]) + ", Values has " +
-                                    std::to_string(values.dim(s)));
-      }
-      slots.push_back(s);
-      if (natural_of_slot[s] >= 0) vars.push_back(natural_of_slot[s]);
-    }
-    factor_vars.push_back(std::move(vars));
-    factor_slots.push_back(std::move(slots));
-    max_rows = std::max(max_rows, f->residual_dim());
-    max_cols = std::max(max_cols, f->jacobian_cols());
-    max_keys = std::max(max_keys, static_cast<int>(f->keys().size()));
-  }
+namespace {
 
-  // Elimination order and scalar columns.
-  const std::vector<int> order = compute_ordering(num_free, factor_vars, ordering);
-  std::vector<int> pos_of_natural(num_free);
-  var_slot_.resize(num_free);
-  var_col_.resize(num_free);
-  var_value_offset_.resize(num_free);
-  var_dim_.resize(num_free);
-  for (int k = 0; k < num_free; ++k) {
-    pos_of_natural[order[k]] = k;
-    const int s = slot_of_natural[order[k]];
-    var_slot_[k] = s;
-    var_col_[k] = n_;
-    var_value_offset_[k] = values.offset(s);
-    var_dim_[k] = values.dim(s);
-    n_ += var_dim_[k];
-  }
+// How messages name a factor: "factor 3 (Name)".
+std::string factor_label(size_t index, const Factor& f) {
+  return "factor " + std::to_string(index) + " (" + f.name() + ")";
+}
 
-  // Block pattern: for each block column b, the block rows a ≤ b coupled to it (always b).
+// The Values slot of the factor's k-th key; throws if the key is missing or has another
+// dimension.
+int checked_slot(const Values& values, const Factor& f, size_t fi, size_t k) {
+  const Key key = f.keys()[k];
+  const int s = values.find(key);
+  if (s < 0) {
+    throw std::invalid_argument(factor_label(fi, f) + " uses " + key.to_string() +
+                                ", which is not in Values");
+  }
+  if (values.dim(s) != f.dims()[k]) {
+    throw std::invalid_argument(factor_label(fi, f) + " expects " + key.to_string() +
+                                " of dimension " + std::to_string(f.dims()[k]) + ", Values has " +
+                                std::to_string(values.dim(s)));
+  }
+  return s;
+}
+
+// Block pattern: for each block column b, the block rows a ≤ b coupled to it (always b),
+// unsorted and with repeats.
+std::vector<std::vector<int>> coupled_block_rows(const std::vector<std::vector<int>>& factor_vars,
+                                                 const std::vector<int>& pos_of_natural) {
+  const int num_free = static_cast<int>(pos_of_natural.size());
   std::vector<std::vector<int>> block_rows(num_free);
   for (int b = 0; b < num_free; ++b) block_rows[b].push_back(b);
   for (const auto& vars : factor_vars) {
@@ -78,7 +45,105 @@ NormalEquations::NormalEquations(const FactorGraph& graph, const Values& values,
       }
     }
   }
-  // Offset of each block row inside its block column (the same for every scalar column).
+  return block_rows;
+}
+
+// Sets the reason a factor's `what` is not finite; returns false for the caller to return.
+bool non_finite(int slot, const Factor& f, const char* what, std::string* reason) {
+  if (reason) *reason = factor_label(static_cast<size_t>(slot), f) + " has a non-finite " + what;
+  return false;
+}
+
+}  // namespace
+
+// Free variables in slot order ("natural" index) and, per factor, the slots of its keys.
+struct NormalEquations::Incidence {
+  std::vector<int> natural_of_slot;  // −1 for a fixed slot
+  std::vector<int> slot_of_natural;
+  std::vector<std::vector<int>> factor_vars;     // per factor: natural indices of its free keys
+  std::vector<std::vector<int>> factor_slots;    // per factor: the slot of every key
+  int max_rows = 0, max_cols = 0, max_keys = 0;  // the largest factor, for the workspaces
+};
+
+struct NormalEquations::BlockPattern {
+  std::vector<std::vector<int>> rows;    // per block column: sorted block rows a ≤ b
+  std::vector<std::vector<int>> within;  // per block column: each row's first scalar offset
+};
+
+NormalEquations::NormalEquations(const FactorGraph& graph, const Values& values,
+                                 OrderingMethod ordering)
+    : graph_id_(graph.structure_id()), layout_id_(values.layout_id()) {
+  const Incidence inc = incidence(graph, values);
+  const int num_free = static_cast<int>(inc.slot_of_natural.size());
+  const std::vector<int> order = compute_ordering(num_free, inc.factor_vars, ordering);
+  const std::vector<int> pos_of_natural = assign_columns(order, inc, values);
+  BlockPattern pattern;
+  pattern.rows = coupled_block_rows(inc.factor_vars, pos_of_natural);
+  pattern.within = lay_out_columns(pattern.rows);
+  allocate_storage();
+  index_factors(graph, values, inc, pos_of_natural, pattern);
+  size_workspaces(inc);
+}
+
+NormalEquations::Incidence NormalEquations::incidence(const FactorGraph& graph,
+                                                      const Values& values) {
+  Incidence inc;
+  inc.natural_of_slot.assign(values.size(), -1);
+  for (int s = 0; s < values.size(); ++s) {
+    if (!values.is_fixed_slot(s)) {
+      inc.natural_of_slot[s] = static_cast<int>(inc.slot_of_natural.size());
+      inc.slot_of_natural.push_back(s);
+    }
+  }
+  inc.factor_vars.reserve(graph.num_factors());
+  for (size_t fi = 0; fi < graph.size(); ++fi) {
+    if (graph[fi]) add_factor_keys(fi, *graph[fi], values, inc);
+  }
+  return inc;
+}
+
+// Checks and records one factor's keys (fi is its graph slot, for messages).
+void NormalEquations::add_factor_keys(size_t fi, const Factor& f, const Values& values,
+                                      Incidence& inc) {
+  std::vector<int> vars, slots;
+  for (size_t k = 0; k < f.keys().size(); ++k) {
+    const int s = checked_slot(values, f, fi, k);
+    slots.push_back(s);
+    if (inc.natural_of_slot[s] >= 0) vars.push_back(inc.natural_of_slot[s]);
+  }
+  inc.factor_vars.push_back(std::move(vars));
+  inc.factor_slots.push_back(std::move(slots));
+  inc.max_rows = std::max(inc.max_rows, f.residual_dim());
+  inc.max_cols = std::max(inc.max_cols, f.jacobian_cols());
+  inc.max_keys = std::max(inc.max_keys, static_cast<int>(f.keys().size()));
+}
+
+// Elimination order and scalar columns; returns each natural variable's position in the order.
+std::vector<int> NormalEquations::assign_columns(const std::vector<int>& order,
+                                                 const Incidence& inc, const Values& values) {
+  const int num_free = static_cast<int>(inc.slot_of_natural.size());
+  std::vector<int> pos_of_natural(num_free);
+  var_slot_.resize(num_free);
+  var_col_.resize(num_free);
+  var_value_offset_.resize(num_free);
+  var_dim_.resize(num_free);
+  for (int k = 0; k < num_free; ++k) {
+    pos_of_natural[order[k]] = k;
+    const int s = inc.slot_of_natural[order[k]];
+    var_slot_[k] = s;
+    var_col_[k] = n_;
+    var_value_offset_[k] = values.offset(s);
+    var_dim_[k] = values.dim(s);
+    n_ += var_dim_[k];
+  }
+  return pos_of_natural;
+}
+
+// Sorts each block column's rows, fills col_ptr_ and row_idx_, and returns the offset of each
+// block row inside its block column (the same for every scalar column).
+std::vector<std::vector<int>> NormalEquations::lay_out_columns(
+    std::vector<std::vector<int>>& block_rows) {
+  const int num_free = static_cast<int>(block_rows.size());
   std::vector<std::vector<int>> block_within(num_free);
   col_ptr_.assign(n_ + 1, 0);
   for (int b = 0; b < num_free; ++b) {
@@ -100,46 +165,72 @@ NormalEquations::NormalEquations(const FactorGraph& graph, const Values& values,
       }
     }
   }
+  return block_within;
+}
+
+// Diagonal positions, and H and g zeroed, for the laid-out pattern.
+void NormalEquations::allocate_storage() {
   diag_pos_.resize(n_);
   for (int c = 0; c < n_; ++c) diag_pos_[c] = col_ptr_[c + 1] - 1;
   h_.assign(row_idx_.size(), 0.0);
   g_.setZero(n_);
+}
 
-  // Per factor: where its keys live in Values and H, and the upper blocks of H it touches.
+// Per factor: where its keys live in Values and H, and the upper blocks of H it touches.
+void NormalEquations::index_factors(const FactorGraph& graph, const Values& values,
+                                    const Incidence& inc, const std::vector<int>& pos_of_natural,
+                                    const BlockPattern& pattern) {
   size_t fi_dense = 0;
   for (size_t fi = 0; fi < graph.size(); ++fi) {
-    const auto& f = graph[fi];
-    if (!f) continue;
-    const auto& slots = factor_slots[fi_dense++];
+    if (!graph[fi]) continue;
+    const auto& slots = inc.factor_slots[fi_dense++];
     FactorInfo info{static_cast<int>(fi), static_cast<int>(key_col_.size()),
                     static_cast<int>(pairs_.size()), 0};
-    std::vector<int> pos(slots.size(), -1);
-    for (size_t k = 0; k < slots.size(); ++k) {
-      key_value_offset_.push_back(values.offset(slots[k]));
-      const int nat = natural_of_slot[slots[k]];
-      pos[k] = nat < 0 ? -1 : pos_of_natural[nat];
-      key_col_.push_back(nat < 0 ? -1 : var_col_[pos[k]]);
-    }
-    for (size_t i = 0; i < slots.size(); ++i) {
-      for (size_t j = 0; j < slots.size(); ++j) {
-        if (pos[i] < 0 || pos[j] < 0 || pos[i] > pos[j]) continue;
-        const int a = pos[i], b = pos[j];
-        const auto& rows = block_rows[b];
-        const auto it = std::lower_bound(rows.begin(), rows.end(), a);
-        pairs_.push_back(Pair{static_cast<int>(i), static_cast<int>(j), var_col_[b],
-                              block_within[b][it - rows.begin()], a == b});
-        ++info.num_pairs;
-      }
-    }
+    const std::vector<int> pos = place_keys(slots, values, inc, pos_of_natural);
+    add_pairs(pos, pattern, info);
     factors_.push_back(info);
   }
+}
 
+// Appends a factor's keys to key_value_offset_ and key_col_; returns each key's elimination
+// position (−1 if fixed).
+std::vector<int> NormalEquations::place_keys(const std::vector<int>& slots, const Values& values,
+                                             const Incidence& inc,
+                                             const std::vector<int>& pos_of_natural) {
+  std::vector<int> pos(slots.size(), -1);
+  for (size_t k = 0; k < slots.size(); ++k) {
+    key_value_offset_.push_back(values.offset(slots[k]));
+    const int nat = inc.natural_of_slot[slots[k]];
+    pos[k] = nat < 0 ? -1 : pos_of_natural[nat];
+    key_col_.push_back(nat < 0 ? -1 : var_col_[pos[k]]);
+  }
+  return pos;
+}
+
+// Appends the upper blocks of H between a factor's free keys, located in the pattern.
+void NormalEquations::add_pairs(const std::vector<int>& pos, const BlockPattern& pattern,
+                                FactorInfo& info) {
+  for (size_t i = 0; i < pos.size(); ++i) {
+    for (size_t j = 0; j < pos.size(); ++j) {
+      if (pos[i] < 0 || pos[j] < 0 || pos[i] > pos[j]) continue;
+      const int a = pos[i], b = pos[j];
+      const auto& rows = pattern.rows[b];
+      const auto it = std::lower_bound(rows.begin(), rows.end(), a);
+      pairs_.push_back(Pair{static_cast<int>(i), static_cast<int>(j), var_col_[b],
+                            pattern.within[b][it - rows.begin()], a == b});
+      ++info.num_pairs;
+    }
+  }
+}
+
+// Linear caches and the per-factor workspaces, sized for the largest factor.
+void NormalEquations::size_workspaces(const Incidence& inc) {
   linear_.assign(factors_.size(), LinearCache());
-  r_.setZero(max_rows);
-  J_.setZero(max_rows, max_cols);
-  JtJ_.setZero(max_cols, max_cols);
-  Jtr_.setZero(max_cols);
-  x_ptrs_.resize(max_keys);
+  r_.setZero(inc.max_rows);
+  J_.setZero(inc.max_rows, inc.max_cols);
+  JtJ_.setZero(inc.max_cols, inc.max_cols);
+  Jtr_.setZero(inc.max_cols);
+  x_ptrs_.resize(inc.max_keys);
 }
 
 template <bool kWithJacobian>
@@ -160,89 +251,116 @@ bool NormalEquations::run(const FactorGraph& graph, const Values& values, double
     const int m = f.residual_dim();
     const int nk = static_cast<int>(f.keys().size());
     for (int k = 0; k < nk; ++k) x_ptrs_[k] = base + key_value_offset_[info.first_key + k];
-    auto r = r_.head(m);
+    Segment r = r_.head(m);
     r.setZero();
-    if constexpr (!kWithJacobian) {
-      f.whitened(x_ptrs_.data(), r, nullptr);
-      if (!r.allFinite()) {
-        if (reason) {
-          *reason = "factor " + std::to_string(info.slot) + " (" + f.name() +
-                    ") has a non-finite residual";
-        }
-        return false;
-      }
-      total += 0.5 * r.squaredNorm();
-      continue;
+    bool ok;
+    if constexpr (kWithJacobian) {
+      ok = linearize_factor(fi, f, r, &total, reason);
     } else {
-      const int nc = f.jacobian_cols();
-      // A linear factor whose Jacobian is unchanged keeps J and JᵀJ: only r and Jᵀr are new.
-      const long version = f.jacobian_version();
-      LinearCache* cache = version >= 0 && info.num_pairs > 0 ? &linear_[fi] : nullptr;
-      const bool kept = cache != nullptr && cache->version == version;
-      Eigen::Ref<Eigen::MatrixXd> J = J_.topLeftCorner(m, nc);
-      f.whitened(x_ptrs_.data(), r, kept ? nullptr : &J);
-      const bool r_ok = r.allFinite();
-      if (!r_ok || (!kept && !J.allFinite())) {
-        if (reason) {
-          *reason = "factor " + std::to_string(info.slot) + " (" + f.name() +
-                    ") has a non-finite " + (r_ok ? "Jacobian" : "residual");
-        }
-        return false;
-      }
-      total += 0.5 * r.squaredNorm();
-      if (info.num_pairs == 0) continue;
-      auto Jtr = Jtr_.head(nc);
-      const double* jtj = nullptr;
-      Eigen::Index stride = 0;
-      if (kept) {
-        Jtr.noalias() = cache->J.transpose() * r;
-        jtj = cache->JtJ.data();
-        stride = cache->JtJ.outerStride();
-      } else {
-        if (cache != nullptr) cache->J = J;  // before the compaction reorders its rows
-        const int active = compact_nonzero_rows(J, r);
-        if (active == 0) continue;  // e.g. a collision factor with every pair clear
-        const auto Ja = J.topRows(active);
-        auto JtJ = JtJ_.topLeftCorner(nc, nc);
-        jacobian_gram(Ja, JtJ, /*upper_only=*/true);  // only upper blocks are scattered
-        Jtr.noalias() = Ja.transpose() * r.head(active);
-        jtj = JtJ.data();
-        stride = JtJ.outerStride();
-        if (cache != nullptr) {
-          cache->JtJ = JtJ;
-          cache->version = version;
-        }
-      }
-      const auto& offsets = f.block_offsets();
-      const auto& dims = f.dims();
-      for (int k = 0; k < nk; ++k) {
-        const int col = key_col_[info.first_key + k];
-        if (col >= 0) g_.segment(col, dims[k]) += Jtr.segment(offsets[k], dims[k]);
-      }
-      double* h = h_.data();
-      for (int p = info.first_pair; p < info.first_pair + info.num_pairs; ++p) {
-        const Pair& pair = pairs_[p];
-        const int ro = offsets[pair.row_key], co = offsets[pair.col_key];
-        const int dr = dims[pair.row_key], dc = dims[pair.col_key];
-        if (ro <= co) {  // the block lies in JᵀJ's upper triangle
-          for (int k = 0; k < dc; ++k) {
-            double* dst = h + col_ptr_[pair.first_col + k] + pair.within;
-            const double* src = jtj + (co + k) * stride + ro;
-            const int rows = pair.diagonal ? k + 1 : dr;
-            for (int i = 0; i < rows; ++i) dst[i] += src[i];
-          }
-        } else {  // below the diagonal of JᵀJ: read the mirrored entries from the upper triangle
-          for (int k = 0; k < dc; ++k) {
-            double* dst = h + col_ptr_[pair.first_col + k] + pair.within;
-            const double* src = jtj + ro * stride + co + k;
-            for (int i = 0; i < dr; ++i) dst[i] += src[i * stride];
-          }
-        }
-      }
+      ok = add_error(info, f, r, &total, reason);
     }
+    if (!ok) return false;
   }
   *error = total;
   return true;
+}
+
+// Adds one factor's ½‖r‖² to total; false with a reason if r is not finite.
+bool NormalEquations::add_error(const FactorInfo& info, const Factor& f, Segment r, double* total,
+                                std::string* reason) const {
+  f.whitened(x_ptrs_.data(), r, nullptr);
+  if (!r.allFinite()) return non_finite(info.slot, f, "residual", reason);
+  *total += 0.5 * r.squaredNorm();
+  return true;
+}
+
+// Adds one factor's ½‖r‖² to total and its Jᵀr and JᵀJ to g and H; false with a reason if r
+// or J is not finite.
+bool NormalEquations::linearize_factor(size_t fi, const Factor& f, Segment r, double* total,
+                                       std::string* reason) {
+  const FactorInfo& info = factors_[fi];
+  const int nc = f.jacobian_cols();
+  // A linear factor whose Jacobian is unchanged keeps J and JᵀJ: only r and Jᵀr are new.
+  const long version = f.jacobian_version();
+  LinearCache* cache = version >= 0 && info.num_pairs > 0 ? &linear_[fi] : nullptr;
+  const bool kept = cache != nullptr && cache->version == version;
+  Eigen::Ref<Eigen::MatrixXd> J = J_.topLeftCorner(r.size(), nc);
+  f.whitened(x_ptrs_.data(), r, kept ? nullptr : &J);
+  const bool r_ok = r.allFinite();
+  if (!r_ok || (!kept && !J.allFinite())) {
+    return non_finite(info.slot, f, r_ok ? "Jacobian" : "residual", reason);
+  }
+  *total += 0.5 * r.squaredNorm();
+  if (info.num_pairs == 0) return true;
+  Segment Jtr = Jtr_.head(nc);
+  const Gram jtj = kept ? cached_gram(*cache, r, Jtr) : fresh_gram(J, r, cache, version, Jtr);
+  if (jtj.data == nullptr) return true;
+  scatter_gradient(f, info, Jtr);
+  scatter_hessian(f, info, jtj);
+  return true;
+}
+
+// A kept linear factor: Jᵀr from its cached J, JᵀJ as cached.
+NormalEquations::Gram NormalEquations::cached_gram(const LinearCache& cache, const Segment& r,
+                                                   Segment Jtr) {
+  Jtr.noalias() = cache.J.transpose() * r;
+  return {cache.JtJ.data(), cache.JtJ.outerStride()};
+}
+
+// JᵀJ and Jᵀr over J's nonzero rows, kept in `cache` (if any) for a linear factor.
+NormalEquations::Gram NormalEquations::fresh_gram(Eigen::Ref<Eigen::MatrixXd> J, Segment r,
+                                                  LinearCache* cache, long version, Segment Jtr) {
+  const Eigen::Index nc = J.cols();
+  if (cache != nullptr) cache->J = J;  // before the compaction reorders its rows
+  const int active = compact_nonzero_rows(J, r);
+  if (active == 0) return {};  // e.g. a collision factor with every pair clear
+  const auto Ja = J.topRows(active);
+  auto JtJ = JtJ_.topLeftCorner(nc, nc);
+  jacobian_gram(Ja, JtJ, /*upper_only=*/true);  // only upper blocks are scattered
+  Jtr.noalias() = Ja.transpose() * r.head(active);
+  if (cache != nullptr) {
+    cache->JtJ = JtJ;
+    cache->version = version;
+  }
+  return {JtJ.data(), JtJ.outerStride()};
+}
+
+// g += Jᵀr on the factor's free keys.
+void NormalEquations::scatter_gradient(const Factor& f, const FactorInfo& info,
+                                       const Segment& Jtr) {
+  const auto& offsets = f.block_offsets();
+  const auto& dims = f.dims();
+  const int nk = static_cast<int>(f.keys().size());
+  for (int k = 0; k < nk; ++k) {
+    const int col = key_col_[info.first_key + k];
+    if (col >= 0) g_.segment(col, dims[k]) += Jtr.segment(offsets[k], dims[k]);
+  }
+}
+
+// H += the factor's upper blocks of JᵀJ, each at its precomputed place in the pattern.
+void NormalEquations::scatter_hessian(const Factor& f, const FactorInfo& info, const Gram& jtj) {
+  const auto& offsets = f.block_offsets();
+  const auto& dims = f.dims();
+  double* h = h_.data();
+  for (int p = info.first_pair; p < info.first_pair + info.num_pairs; ++p) {
+    const Pair& pair = pairs_[p];
+    const int ro = offsets[pair.row_key], co = offsets[pair.col_key];
+    const int dr = dims[pair.row_key], dc = dims[pair.col_key];
+    if (ro <= co) {  // the block lies in JᵀJ's upper triangle
+      for (int k = 0; k < dc; ++k) {
+        double* dst = h + col_ptr_[pair.first_col + k] + pair.within;
+        const double* src = jtj.data + (co + k) * jtj.stride + ro;
+        const int rows = pair.diagonal ? k + 1 : dr;
+        for (int i = 0; i < rows; ++i) dst[i] += src[i];
+      }
+    } else {  // below the diagonal of JᵀJ: read the mirrored entries from the upper triangle
+      for (int k = 0; k < dc; ++k) {
+        double* dst = h + col_ptr_[pair.first_col + k] + pair.within;
+        const double* src = jtj.data + ro * jtj.stride + co + k;
+        for (int i = 0; i < dr; ++i) dst[i] += src[i * jtj.stride];
+      }
+    }
+  }
 }
 
 bool NormalEquations::linearize(const FactorGraph& graph, const Values& values, double* error,

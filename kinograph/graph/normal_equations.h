@@ -71,9 +71,45 @@ class NormalEquations {
     int first_pair;  // into pairs_
     int num_pairs;
   };
+  // A linear factor's whitened J and JᵀJ (upper triangle), kept under its
+  // Factor::jacobian_version (−1: none yet).
+  struct LinearCache {
+    long version = -1;
+    Eigen::MatrixXd J, JtJ;
+  };
+  struct Incidence;     // the free variables and each factor's keys, while building
+  struct BlockPattern;  // per block column: its block rows and their offsets in the column
+  struct Gram {         // a factor's JᵀJ (upper triangle) as the scatter reads it
+    const double* data = nullptr;  // nullptr: no active row, nothing to scatter
+    Eigen::Index stride = 0;
+  };
+  using Segment = Eigen::VectorBlock<Eigen::VectorXd>;  // a head of r_ or Jtr_
 
+  // Construction, in the constructor's order.
+  static Incidence incidence(const FactorGraph& graph, const Values& values);
+  static void add_factor_keys(size_t fi, const Factor& f, const Values& values, Incidence& inc);
+  std::vector<int> assign_columns(const std::vector<int>& order, const Incidence& inc,
+                                  const Values& values);
+  std::vector<std::vector<int>> lay_out_columns(std::vector<std::vector<int>>& block_rows);
+  void allocate_storage();
+  void index_factors(const FactorGraph& graph, const Values& values, const Incidence& inc,
+                     const std::vector<int>& pos_of_natural, const BlockPattern& pattern);
+  std::vector<int> place_keys(const std::vector<int>& slots, const Values& values,
+                              const Incidence& inc, const std::vector<int>& pos_of_natural);
+  void add_pairs(const std::vector<int>& pos, const BlockPattern& pattern, FactorInfo& info);
+  void size_workspaces(const Incidence& inc);
+
+  // Evaluation: run() loops over the factors, the rest handle one factor.
   template <bool kWithJacobian>
   bool run(const FactorGraph& graph, const Values& values, double* error, std::string* reason);
+  bool add_error(const FactorInfo& info, const Factor& f, Segment r, double* total,
+                 std::string* reason) const;
+  bool linearize_factor(size_t fi, const Factor& f, Segment r, double* total, std::string* reason);
+  static Gram cached_gram(const LinearCache& cache, const Segment& r, Segment Jtr);
+  Gram fresh_gram(Eigen::Ref<Eigen::MatrixXd> J, Segment r, LinearCache* cache, long version,
+                  Segment Jtr);
+  void scatter_gradient(const Factor& f, const FactorInfo& info, const Segment& Jtr);
+  void scatter_hessian(const Factor& f, const FactorInfo& info, const Gram& jtj);
 
   uint64_t graph_id_ = 0;
   uint64_t layout_id_ = 0;
@@ -89,13 +125,7 @@ class NormalEquations {
   std::vector<int> key_value_offset_;  // per factor key: offset into Values::vector()
   std::vector<int> key_col_;           // per factor key: first column of H, −1 if fixed
   std::vector<Pair> pairs_;
-  // A linear factor's whitened J and JᵀJ (upper triangle), kept under its
-  // Factor::jacobian_version (−1: none yet); one per entry of factors_.
-  struct LinearCache {
-    long version = -1;
-    Eigen::MatrixXd J, JtJ;
-  };
-  std::vector<LinearCache> linear_;
+  std::vector<LinearCache> linear_;  // one per entry of factors_
   // Workspaces sized for the largest factor.
   Eigen::VectorXd r_;
   Eigen::MatrixXd J_, JtJ_;

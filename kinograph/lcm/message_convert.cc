@@ -188,7 +188,7 @@ plan_t plan_to_message(const planning::Plan& plan, const dynamics::Model& model,
   msg.robot = robot;
   if (plan.success()) {
     msg.status = plan_t::SUCCESS;
-  } else if (plan.stats.status == "invalid_problem") {
+  } else if (plan.stats.status == planning::PlanStatus::kInvalidProblem) {
     msg.status = plan_t::INVALID_GOAL;
   } else if (plan.q.rows() == 0) {
     msg.status = plan_t::FAILED;
@@ -198,7 +198,7 @@ plan_t plan_to_message(const planning::Plan& plan, const dynamics::Model& model,
   if (!plan.success()) {
     std::string why = plan.stats.reason;
     for (const auto& f : plan.validation.failures) why += (why.empty() ? "" : "; ") + f;
-    msg.status_message = why.empty() ? plan.stats.status : why;
+    msg.status_message = why.empty() ? planning::to_string(plan.stats.status) : why;
   }
   msg.method = plan.stats.method;
   msg.num_joints = model.nq();
@@ -270,7 +270,11 @@ planning::Plan plan_from_message(const plan_t& msg) {
   plan.qdd = matrix(msg.qdd);
   plan.tau = matrix(msg.tau);
   plan.stats.method = msg.method;
-  plan.stats.status = msg.status == plan_t::SUCCESS ? "converged" : msg.status_message;
+  plan.stats.status = msg.status == plan_t::SUCCESS         ? planning::PlanStatus::kConverged
+                      : msg.status == plan_t::INVALID_GOAL  ? planning::PlanStatus::kInvalidProblem
+                      : msg.status == plan_t::NOT_CONVERGED ? planning::PlanStatus::kInfeasible
+                                                            : planning::PlanStatus::kFailed;
+  if (msg.status != plan_t::SUCCESS) plan.stats.reason = msg.status_message;
   plan.stats.solve_time_s = msg.solve_time_s;
   plan.stats.iterations = msg.iterations;
   plan.stats.cost = msg.cost;

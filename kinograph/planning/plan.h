@@ -2,16 +2,37 @@
 // A planned trajectory: states, accelerations and torques at every step, with how it was
 // solved and whether it validates.
 #include <Eigen/Core>
+#include <iosfwd>
 #include <limits>
 #include <string>
 #include <vector>
 
 namespace kinograph::planning {
 
+/// How the solve of a plan ended (whether the plan is a success is validation's verdict).
+enum class PlanStatus {
+  kConverged,       ///< the constraints hold at the solver's final tolerance
+  kInfeasible,      ///< constraints still violated at the iteration limit
+  kNonFinite,       ///< a factor returned NaN or inf
+  kSingular,        ///< a linear system was singular
+  kMaxUpdates,      ///< incremental: the update limit was reached
+  kMaxRounds,       ///< incremental: the multiplier-round limit was reached
+  kInvalidProblem,  ///< refused before any solve; the reason says why
+  kNoPlan,          ///< a replan asked of a planner without a plan
+  kFailed,          ///< no solve result (e.g. a failure read back from a message)
+};
+
+/// "converged", "infeasible", "non_finite", "singular", "max_updates", "max_rounds",
+/// "invalid_problem", "no_plan", "failed" (the names plan files use).
+std::string to_string(PlanStatus status);
+/// The status of a name of to_string(); throws std::invalid_argument for any other.
+PlanStatus plan_status_from_string(const std::string& name);
+std::ostream& operator<<(std::ostream& os, PlanStatus status);
+
 /// How a plan was solved.
 struct SolveStats {
   std::string method;        ///< "batch-L", "batch-W", "incremental"
-  std::string status;        ///< "converged", "max_iterations", "invalid_problem", ...
+  PlanStatus status = PlanStatus::kConverged;
   std::string reason;        ///< one line explaining a non-converged status
   int iterations = 0;        ///< LM linearizations over all inner solves
   int outer_iterations = 0;  ///< augmented-Lagrangian outer iterations
@@ -51,5 +72,9 @@ struct Plan {
   /// A plan succeeds only if it validates.
   bool success() const { return validation.valid; }
 };
+
+/// A plan without trajectory that failed before or in its solve: `status` and `reason` in its
+/// stats and its validation's one failure.
+Plan failed_plan(const std::string& method, PlanStatus status, const std::string& reason);
 
 }  // namespace kinograph::planning

@@ -85,22 +85,14 @@ Plan Replanner::plan(const Problem& problem, bool new_goal) {
 Plan Replanner::replan(const ProblemChange& change) {
   if (!incremental_.has_plan() && !last_valid_) {
     report_ = ReplanReport();
-    Plan p;
-    p.stats.status = "no_plan";
-    p.stats.reason = "replan needs a plan first";
-    p.validation.failures.push_back("no_plan: replan needs a plan first");
-    return p;
+    return failed_plan("incremental", PlanStatus::kNoPlan, "replan needs a plan first");
   }
   const Problem& current = incremental_.has_plan() ? incremental_.problem() : last_problem_;
   Problem next;
   std::set<int> changed;
   if (const std::string error = apply_change(current, change, next, changed); !error.empty()) {
     report_ = ReplanReport();
-    Plan p;
-    p.stats.status = "invalid_problem";
-    p.stats.reason = error;
-    p.validation.failures.push_back("invalid_problem: " + error);
-    return p;
+    return failed_plan("incremental", PlanStatus::kInvalidProblem, error);
   }
   return plan(next, change.goal.has_value());
 }
@@ -148,7 +140,7 @@ Plan Replanner::incremental_path(const Problem& problem, bool new_goal) {
   Plan plan = incremental_.replan(change_between(incremental_.problem(), problem, new_goal));
   report_.statistics = incremental_.last_stats();
   report_.method = "incremental";
-  const bool refused = plan.stats.status == "invalid_problem";
+  const bool refused = plan.stats.status == PlanStatus::kInvalidProblem;
   // A refused change left the planner as it was: it can still replan. Any other failure leaves
   // it at a trajectory that did not validate, a poor start for the next change.
   ready_ = plan.success() || (refused && ready_);
@@ -169,7 +161,8 @@ Plan Replanner::recover(const Problem& problem, Plan failed, const Plan& previou
   if (options_.fallback) {
     report_.fell_back = true;
     report_.fallback_reason =
-        plan.validation.failures.empty() ? plan.stats.status : plan.validation.failures.front();
+        plan.validation.failures.empty() ? to_string(plan.stats.status)
+                                     : plan.validation.failures.front();
     spdlog::info("incremental replan did not validate ({}); falling back to a batch solve",
                  report_.fallback_reason);
     const double spent = plan.stats.solve_time_s;

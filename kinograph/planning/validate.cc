@@ -20,6 +20,8 @@ std::string fmt(const char* what, double value, double threshold) {
   return os.str();
 }
 
+void add_failure(Validation& v, std::string why) { v.failures.push_back(std::move(why)); }
+
 // How far x leaves [lo, hi] (0 inside).
 double excess(double x, double lo, double hi) { return std::max({0.0, lo - x, x - hi}); }
 
@@ -33,39 +35,40 @@ Eigen::VectorXd hermite(const Plan& plan, int k, double s, double dt) {
       .transpose();
 }
 
-}  // namespace
-
-Validation validate(const Problem& problem, const Plan& plan,
-                    const ValidationThresholds& thresholds, bool verdict_only) {
-  Validation v;
-  auto fail = [&v](std::string why) { v.failures.push_back(std::move(why)); };
+// The trajectory's shape and numbers; false (with the failure) when nothing else can be checked.
+bool check_shape(const Problem& problem, const Plan& plan, Validation& v) {
   if (!problem.model) {
-    fail("problem has no robot model");
-    return v;
+    add_failure(v, "problem has no robot model");
+    return false;
   }
   const dynamics::Model& model = *problem.model;
   const int n = model.nq(), N = problem.steps, rows = N + 1;
   if (N <= 0 || !(problem.horizon > 0)) {
-    fail("problem has no steps or a non-positive horizon");
-    return v;
+    add_failure(v, "problem has no steps or a non-positive horizon");
+    return false;
   }
   if (plan.q.rows() != rows || plan.qd.rows() != rows || plan.qdd.rows() != rows ||
       plan.tau.rows() != rows || plan.q.cols() != n || plan.qd.cols() != n ||
       plan.qdd.cols() != n || plan.tau.cols() != n) {
     std::ostringstream os;
     os << "plan has the wrong shape: expected " << rows << " x " << n << " for q, qd, qdd, tau";
-    fail(os.str());
-    return v;
+    add_failure(v, os.str());
+    return false;
   }
   if (!plan.q.allFinite() || !plan.qd.allFinite() || !plan.qdd.allFinite() ||
       !plan.tau.allFinite()) {
-    fail("plan holds NaN or infinite values");
-    return v;
+    add_failure(v, "plan holds NaN or infinite values");
+    return false;
   }
-  const double dt = problem.dt();
-  dynamics::Data data(model);
+  return true;
+}
 
-  // Physics: inverse dynamics and the trapezoid integration residuals.
+// Physics: inverse dynamics, the trapezoid integration residuals and every limit.
+void check_physics(const Problem& problem, const Plan& plan, const ValidationThresholds& thresholds,
+                   dynamics::Data& data, Validation& v) {
+  const dynamics::Model& model = *problem.model;
+  const int n = model.nq(), N = problem.steps, rows = N + 1;
+  const double dt = problem.dt();
   for (int k = 0; k < rows; ++k) {
     const Eigen::VectorXd q = plan.q.row(k).transpose(), qd = plan.qd.row(k).transpose(),
                           qdd = plan.qdd.row(k).transpose();
@@ -98,26 +101,34 @@ Validation validate(const Problem& problem, const Plan& plan,
     }
   }
   if (v.max_dynamics_residual > thresholds.dynamics)
-    fail(fmt("dynamics residual |tau - ID| (N·m)", v.max_dynamics_residual, thresholds.dynamics));
+    add_failure(
+        v, fmt("dynamics residual |tau - ID| (N·m)", v.max_dynamics_residual, thresholds.dynamics));
   if (v.max_position_consistency > thresholds.position_consistency)
-    fail(fmt("position consistency (rad)", v.max_position_consistency,
-             thresholds.position_consistency));
+    add_failure(v, fmt("position consistency (rad)", v.max_position_consistency,
+                       thresholds.position_consistency));
   if (v.max_velocity_consistency > thresholds.velocity_consistency)
-    fail(fmt("velocity consistency (rad/s)", v.max_velocity_consistency,
-             thresholds.velocity_consistency));
+    add_failure(v, fmt("velocity consistency (rad/s)", v.max_velocity_consistency,
+                       thresholds.velocity_consistency));
   if (v.max_q_violation > thresholds.limit)
-    fail(fmt("joint position limit violation", v.max_q_violation, thresholds.limit));
+    add_failure(v, fmt("joint position limit violation", v.max_q_violation, thresholds.limit));
   if (v.max_qd_violation > thresholds.limit)
-    fail(fmt("joint velocity limit violation", v.max_qd_violation, thresholds.limit));
+    add_failure(v, fmt("joint velocity limit violation", v.max_qd_violation, thresholds.limit));
   if (v.max_qdd_violation > thresholds.limit)
-    fail(fmt("joint acceleration limit violation", v.max_qdd_violation, thresholds.limit));
+    add_failure(v,
+                fmt("joint acceleration limit violation", v.max_qdd_violation, thresholds.limit));
   if (v.max_tau_violation > thresholds.limit)
-    fail(fmt("effort limit violation (N·m)", v.max_tau_violation, thresholds.limit));
+    add_failure(v, fmt("effort limit violation (N·m)", v.max_tau_violation, thresholds.limit));
   if (v.max_unactuated_torque > thresholds.unactuated_torque)
-    fail(fmt("torque on an unactuated joint (N·m)", v.max_unactuated_torque,
-             thresholds.unactuated_torque));
+    add_failure(v, fmt("torque on an unactuated joint (N·m)", v.max_unactuated_torque,
+                       thresholds.unactuated_torque));
+}
 
-  // Start and goal (at rest).
+// The start state and the goal (at rest).
+void check_start_and_goal(const Problem& problem, const Plan& plan,
+                          const ValidationThresholds& thresholds, dynamics::Data& data,
+                          Validation& v) {
+  const dynamics::Model& model = *problem.model;
+  const int n = model.nq(), N = problem.steps;
   if (problem.start_q.size() == n) {
     v.start_error = (plan.q.row(0).transpose() - problem.start_q).cwiseAbs().maxCoeff();
   }
@@ -126,16 +137,16 @@ Validation validate(const Problem& problem, const Plan& plan,
                              (plan.qd.row(0).transpose() - problem.start_qd).cwiseAbs().maxCoeff());
   }
   if (v.start_error > thresholds.start)
-    fail(fmt("start state error", v.start_error, thresholds.start));
+    add_failure(v, fmt("start state error", v.start_error, thresholds.start));
   v.final_velocity =
       std::max(plan.qd.row(N).cwiseAbs().maxCoeff(), plan.qdd.row(N).cwiseAbs().maxCoeff());
   if (v.final_velocity > thresholds.final_velocity)
-    fail(fmt("final velocity/acceleration (goal is at rest)", v.final_velocity,
-             thresholds.final_velocity));
+    add_failure(v, fmt("final velocity/acceleration (goal is at rest)", v.final_velocity,
+                       thresholds.final_velocity));
   const Eigen::VectorXd q_final = plan.q.row(N).transpose();
   if (problem.goal.kind == Goal::Kind::kJoint) {
     if (problem.goal.q.size() != n) {
-      fail("joint goal has the wrong size");
+      add_failure(v, "joint goal has the wrong size");
     } else {
       v.goal_error = (q_final - problem.goal.q).cwiseAbs().maxCoeff();
     }
@@ -144,7 +155,7 @@ Validation validate(const Problem& problem, const Plan& plan,
     try {
       frame = model.frame_index(problem.goal.frame);
     } catch (const std::out_of_range&) {
-      fail("goal frame '" + problem.goal.frame + "' is not in the model");
+      add_failure(v, "goal frame '" + problem.goal.frame + "' is not in the model");
     }
     if (frame >= 0) {
       dynamics::forward_kinematics(model, data, q_final);
@@ -152,15 +163,20 @@ Validation validate(const Problem& problem, const Plan& plan,
       v.goal_error = problem.goal.position_only ? e.position : std::max(e.position, e.rotation);
     }
   }
-  if (v.goal_error > thresholds.goal) fail(fmt("goal error", v.goal_error, thresholds.goal));
+  if (v.goal_error > thresholds.goal)
+    add_failure(v, fmt("goal error", v.goal_error, thresholds.goal));
+}
 
-  // Task constraints at every step.
+// Task constraints at every step.
+void check_tasks(const Problem& problem, const Plan& plan, dynamics::Data& data, Validation& v) {
+  const dynamics::Model& model = *problem.model;
+  const int rows = problem.steps + 1;
   for (const TaskConstraint& task : problem.task_constraints) {
     int frame = -1;
     try {
       frame = model.frame_index(task.frame);
     } catch (const std::out_of_range&) {
-      fail("task-constraint frame '" + task.frame + "' is not in the model");
+      add_failure(v, "task-constraint frame '" + task.frame + "' is not in the model");
       continue;
     }
     double worst = 0;
@@ -172,51 +188,70 @@ Validation validate(const Problem& problem, const Plan& plan,
     }
     v.max_task_error = std::max(v.max_task_error, worst);
     if (worst > task.tolerance)
-      fail(fmt(("task constraint on '" + task.frame + "'").c_str(), worst, task.tolerance));
+      add_failure(v,
+                  fmt(("task constraint on '" + task.frame + "'").c_str(), worst, task.tolerance));
   }
+}
 
-  // Collision: every step and dense samples along the validator's Hermite interpolation. The
-  // only costly check; a caller that only needs the verdict skips it once another failed.
+// Collision: every step and dense samples along the validator's Hermite interpolation.
+void check_collision(const Problem& problem, const Plan& plan,
+                     const ValidationThresholds& thresholds, dynamics::Data& data, Validation& v) {
+  const dynamics::Model& model = *problem.model;
+  const int n = model.nq(), N = problem.steps, rows = N + 1;
+  const double dt = problem.dt();
+  collision::CollisionWorld world(model);
+  bool ok = true;
+  for (const collision::Obstacle& o : problem.obstacles) {
+    const collision::Status s = world.add_obstacle(o);
+    if (!s.ok) {
+      add_failure(v, "obstacle " + std::to_string(o.id) + ": " + s.reason);
+      ok = false;
+    }
+  }
+  if (ok) {
+    // The validator's Hermite interpolation sampled `sub` times per interval, walked by
+    // conservative advancement: stretches far from every obstacle cost one query, and near
+    // one the samples are as dense as the segment checker's sweep step.
+    collision::SegmentChecker checker(model);
+    const int sub = std::max(1, thresholds.collision_samples);
+    Eigen::MatrixXd path(N * sub + 1, n);
+    std::vector<double> times(N * sub + 1);
+    const bool timed = plan.t.size() == static_cast<size_t>(rows);
+    for (int k = 0; k < N; ++k) {
+      for (int i = 0; i < sub; ++i) {
+        const double s = static_cast<double>(i) / sub;
+        path.row(k * sub + i) =
+            i == 0 ? Eigen::VectorXd(plan.q.row(k).transpose()) : hermite(plan, k, s, dt);
+        times[k * sub + i] = (timed ? plan.t[k] : k * dt) + s * dt;
+      }
+    }
+    path.row(N * sub) = plan.q.row(N);
+    times[N * sub] = timed ? plan.t[N] : N * dt;
+    const collision::PathCheckResult r =
+        checker.check_path(world, data, path, times, thresholds.min_clearance);
+    v.min_clearance = std::min(v.min_clearance, r.min_distance);
+    if (v.min_clearance < thresholds.min_clearance) {
+      std::ostringstream os;
+      os << "collision: clearance " << v.min_clearance << " m below " << thresholds.min_clearance;
+      add_failure(v, os.str());
+    }
+  }
+}
+
+}  // namespace
+
+Validation validate(const Problem& problem, const Plan& plan,
+                    const ValidationThresholds& thresholds, bool verdict_only) {
+  Validation v;
+  if (!check_shape(problem, plan, v)) return v;
+  dynamics::Data data(*problem.model);
+  check_physics(problem, plan, thresholds, data, v);
+  check_start_and_goal(problem, plan, thresholds, data, v);
+  check_tasks(problem, plan, data, v);
+  // The only costly check; a caller that only needs the verdict skips it once another failed.
   if (!problem.obstacles.empty() && !(verdict_only && !v.failures.empty())) {
-    collision::CollisionWorld world(model);
-    bool ok = true;
-    for (const collision::Obstacle& o : problem.obstacles) {
-      const collision::Status s = world.add_obstacle(o);
-      if (!s.ok) {
-        fail("obstacle " + std::to_string(o.id) + ": " + s.reason);
-        ok = false;
-      }
-    }
-    if (ok) {
-      // The validator's Hermite interpolation sampled `sub` times per interval, walked by
-      // conservative advancement: stretches far from every obstacle cost one query, and near
-      // one the samples are as dense as the segment checker's sweep step.
-      collision::SegmentChecker checker(model);
-      const int sub = std::max(1, thresholds.collision_samples);
-      Eigen::MatrixXd path(N * sub + 1, n);
-      std::vector<double> times(N * sub + 1);
-      const bool timed = plan.t.size() == static_cast<size_t>(rows);
-      for (int k = 0; k < N; ++k) {
-        for (int i = 0; i < sub; ++i) {
-          const double s = static_cast<double>(i) / sub;
-          path.row(k * sub + i) =
-              i == 0 ? Eigen::VectorXd(plan.q.row(k).transpose()) : hermite(plan, k, s, dt);
-          times[k * sub + i] = (timed ? plan.t[k] : k * dt) + s * dt;
-        }
-      }
-      path.row(N * sub) = plan.q.row(N);
-      times[N * sub] = timed ? plan.t[N] : N * dt;
-      const collision::PathCheckResult r =
-          checker.check_path(world, data, path, times, thresholds.min_clearance);
-      v.min_clearance = std::min(v.min_clearance, r.min_distance);
-      if (v.min_clearance < thresholds.min_clearance) {
-        std::ostringstream os;
-        os << "collision: clearance " << v.min_clearance << " m below " << thresholds.min_clearance;
-        fail(os.str());
-      }
-    }
+    check_collision(problem, plan, thresholds, data, v);
   }
-
   v.valid = v.failures.empty();
   return v;
 }

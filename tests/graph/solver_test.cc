@@ -2,11 +2,15 @@
 // across solves after changing targets, fixed variables stay, statistics are consistent, LM's
 // iterates are pinned, and the LevenbergMarquardtOptions fields no other test covers take effect.
 #include <gtest/gtest.h>
+#include <spdlog/sinks/ringbuffer_sink.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <memory>
 #include <numeric>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "kinograph/graph/levenberg_marquardt.h"
 #include "kinograph/graph/linear_factor.h"
@@ -393,6 +397,62 @@ TEST(Solver, RecordHistoryOffLeavesTheHistoryEmpty) {
   const OptimizationResult r = LevenbergMarquardt(o).optimize(p.graph, v);
   ASSERT_GT(r.trials, 0);
   EXPECT_TRUE(r.history.empty());
+}
+
+// Sends spdlog's default logger to a ring buffer at debug level while alive; the previous
+// default logger (and with it its level and sinks) comes back on destruction, even on failure.
+class LogCapture {
+ public:
+  LogCapture()
+      : previous_(spdlog::default_logger()),
+        sink_(std::make_shared<spdlog::sinks::ringbuffer_sink_mt>(1024)) {
+    auto logger = std::make_shared<spdlog::logger>("log_capture", sink_);
+    logger->set_level(spdlog::level::debug);
+    spdlog::set_default_logger(logger);
+  }
+  ~LogCapture() { spdlog::set_default_logger(previous_); }
+  LogCapture(const LogCapture&) = delete;
+  LogCapture& operator=(const LogCapture&) = delete;
+
+  /// The messages logged so far, without the pattern's decoration.
+  std::vector<std::string> lines() const {
+    std::vector<std::string> out;
+    for (const auto& m : sink_->last_raw()) out.emplace_back(m.payload.data(), m.payload.size());
+    return out;
+  }
+
+ private:
+  std::shared_ptr<spdlog::logger> previous_;
+  std::shared_ptr<spdlog::sinks::ringbuffer_sink_mt> sink_;
+};
+
+TEST(Solver, LogIterationsLogsEveryTrialAndTheOutcomeOnlyWhenOn) {
+  // curve_fit rejects some trials and ends on the relative decrease, an accepted (so logged)
+  // trial: one line per history entry, then the outcome.
+  const auto p = problems::curve_fit();
+  for (bool log : {false, true}) {
+    LogCapture capture;
+    LevenbergMarquardtOptions o;
+    o.log_iterations = log;
+    Values v = p.start;
+    const OptimizationResult r = LevenbergMarquardt(o).optimize(p.graph, v);
+    ASSERT_TRUE(r.converged()) << r.reason;
+    ASSERT_LT(r.iterations, r.trials);
+    const std::vector<std::string> lines = capture.lines();
+    if (!log) {
+      EXPECT_TRUE(lines.empty()) << lines.size() << " lines, the first: " << lines.front();
+      continue;
+    }
+    ASSERT_EQ(lines.size(), r.history.size() + 1);
+    for (size_t i = 0; i < r.history.size(); ++i) {
+      const IterationStats& s = r.history[i];
+      EXPECT_TRUE(lines[i].starts_with("LM it " + std::to_string(s.iteration) + " ")) << lines[i];
+      EXPECT_TRUE(lines[i].ends_with(s.accepted ? " accepted" : " rejected")) << lines[i];
+    }
+    EXPECT_TRUE(lines.back().starts_with("LM: " + to_string(r.status) + " after " +
+                                         std::to_string(r.iterations) + " iterations"))
+        << lines.back();
+  }
 }
 
 TEST(Solver, CompactNonzeroRowsKeepsTheInformation) {

@@ -178,7 +178,7 @@ TEST(PlanMessage, RoundTripsTrajectoryAndMapsStatus) {
   EXPECT_EQ(msg.status, plan_t::NOT_CONVERGED);
   EXPECT_NE(msg.status_message.find("collision at step 4"), std::string::npos);
 
-  plan.stats.status = "invalid_problem";
+  plan.stats.status = planning::PlanStatus::kInvalidProblem;
   EXPECT_EQ(plan_to_message(plan, rr(), "rr", 5, 7, 0).status, plan_t::INVALID_GOAL);
 }
 

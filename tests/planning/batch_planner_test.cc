@@ -37,7 +37,7 @@ TEST(BatchPlanner, AcrobotSwingUpValidates) {
   const Plan plan = BatchPlanner().plan(p);
   const Validation& v = plan.validation;
   for (const auto& f : v.failures) ADD_FAILURE() << f;
-  EXPECT_EQ(plan.stats.status, "converged") << plan.stats.reason;
+  EXPECT_EQ(plan.stats.status, PlanStatus::kConverged) << plan.stats.reason;
   EXPECT_TRUE(plan.success());
   EXPECT_LT(v.max_unactuated_torque, 1e-3);
   EXPECT_LE(plan.tau.col(1).cwiseAbs().maxCoeff(), 8.0 + 1e-3);
@@ -46,7 +46,7 @@ TEST(BatchPlanner, AcrobotSwingUpValidates) {
   std::printf(
       "acrobot: %s its=%d outer=%d solves=%d time=%.3f s cost=%.4g viol=%.3g "
       "pos=%.3g vel=%.3g unact=%.3g maxtau=%.3f\n",
-      plan.stats.status.c_str(), plan.stats.iterations, plan.stats.outer_iterations,
+      to_string(plan.stats.status).c_str(), plan.stats.iterations, plan.stats.outer_iterations,
       plan.stats.linear_solves, plan.stats.solve_time_s, plan.stats.cost,
       plan.stats.max_constraint_violation, v.max_position_consistency, v.max_velocity_consistency,
       v.max_unactuated_torque, plan.tau.col(1).cwiseAbs().maxCoeff());
@@ -78,7 +78,7 @@ TEST(BatchPlanner, RrReachAvoidsTheBall) {
   EXPECT_GE(plan.validation.min_clearance, 0.0);
   // The straight line would have collided: the elbow moved.
   EXPECT_GT(plan.q.col(1).cwiseAbs().maxCoeff(), 0.05);
-  std::printf("rr: %s its=%d outer=%d time=%.3f s clearance=%.4f\n", plan.stats.status.c_str(),
+  std::printf("rr: %s its=%d outer=%d time=%.3f s clearance=%.4f\n", to_string(plan.stats.status).c_str(),
               plan.stats.iterations, plan.stats.outer_iterations, plan.stats.solve_time_s,
               plan.validation.min_clearance);
 }
@@ -123,7 +123,7 @@ TEST(BatchPlanner, IiwaCarriesTheBlockPastTheBox) {
   EXPECT_TRUE(plan.success()) << plan.stats.reason;
   EXPECT_GE(plan.validation.min_clearance, 0.0);
   std::printf("iiwa: %s its=%d outer=%d time=%.3f s clearance=%.4f maxtau_excess=%.3g\n",
-              plan.stats.status.c_str(), plan.stats.iterations, plan.stats.outer_iterations,
+              to_string(plan.stats.status).c_str(), plan.stats.iterations, plan.stats.outer_iterations,
               plan.stats.solve_time_s, plan.validation.min_clearance,
               plan.validation.max_tau_violation);
 }
@@ -135,20 +135,20 @@ TEST(BatchPlanner, ImpossibleProblemsFailCleanly) {
     p.goal.q[0] = 4.0;
     const Plan plan = planner.plan(p);
     EXPECT_FALSE(plan.success());
-    EXPECT_EQ(plan.stats.status, "invalid_problem");
+    EXPECT_EQ(plan.stats.status, PlanStatus::kInvalidProblem);
     EXPECT_NE(plan.stats.reason.find("joint1"), std::string::npos) << plan.stats.reason;
   }
   {  // start in collision
     Problem p = rr_reach();
     p.start_q = Eigen::Vector2d(0, 0);
     const Plan plan = planner.plan(p);
-    EXPECT_EQ(plan.stats.status, "invalid_problem");
+    EXPECT_EQ(plan.stats.status, PlanStatus::kInvalidProblem);
     EXPECT_NE(plan.stats.reason.find("collision"), std::string::npos) << plan.stats.reason;
   }
   {  // NaN input
     Problem p = rr_reach();
     p.start_q[1] = std::numeric_limits<double>::quiet_NaN();
-    EXPECT_EQ(planner.plan(p).stats.status, "invalid_problem");
+    EXPECT_EQ(planner.plan(p).stats.status, PlanStatus::kInvalidProblem);
   }
   {  // elbow torque far too low to swing up: bounded iterations, "infeasible", never valid
     Problem p = acrobot_swingup();
@@ -159,7 +159,7 @@ TEST(BatchPlanner, ImpossibleProblemsFailCleanly) {
     o.outer_loop.max_total_iterations = 150;
     const Plan plan = BatchPlanner(o).plan(p);
     EXPECT_FALSE(plan.success());
-    EXPECT_EQ(plan.stats.status, "infeasible");
+    EXPECT_EQ(plan.stats.status, PlanStatus::kInfeasible);
     EXPECT_LE(plan.stats.iterations, 150);
     EXPECT_FALSE(plan.stats.reason.empty());
   }

@@ -126,7 +126,7 @@ TEST(EndToEnd, WarmStartAfterTheGoalMoves) {
   // A warm start from a plan of another robot is bad input, reported, not thrown.
   Problem other = testing::iiwa_swing(10);
   const Plan bad = planner.plan(other, &first);
-  EXPECT_EQ(bad.stats.status, "invalid_problem");
+  EXPECT_EQ(bad.stats.status, PlanStatus::kInvalidProblem);
   EXPECT_FALSE(bad.success());
 }
 

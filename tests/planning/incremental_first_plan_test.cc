@@ -16,7 +16,7 @@ namespace {
 const std::string kScenes = std::string(KINOGRAPH_SOURCE_DIR) + "/robots/scenes/";
 
 std::string failures(const Plan& p) {
-  std::string s = p.stats.method + " " + p.stats.status + " " + p.stats.reason + ":";
+  std::string s = p.stats.method + " " + to_string(p.stats.status) + " " + p.stats.reason + ":";
   for (const auto& f : p.validation.failures) s += " | " + f;
   return s;
 }

@@ -23,7 +23,7 @@ const std::string kScenes = std::string(KINOGRAPH_SOURCE_DIR) + "/robots/scenes/
 Problem rr_problem() { return load_scene(kScenes + "rr_reach.yaml").problem; }
 
 std::string failures(const Plan& p) {
-  std::string s = p.stats.method + " " + p.stats.status + " " + p.stats.reason + ":";
+  std::string s = p.stats.method + " " + to_string(p.stats.status) + " " + p.stats.reason + ":";
   for (const auto& f : p.validation.failures) s += " | " + f;
   return s;
 }
@@ -220,13 +220,13 @@ TEST(IncrementalPlanner, HorizonChange) {
 TEST(IncrementalPlanner, InvalidChangesAreRejected) {
   const Problem p = rr_problem();
   IncrementalPlanner planner;
-  EXPECT_EQ(planner.set_goal(p.goal).stats.status, "no_plan");
+  EXPECT_EQ(planner.set_goal(p.goal).stats.status, PlanStatus::kNoPlan);
   const Plan first = planner.plan(p);
   ASSERT_TRUE(first.success());
-  EXPECT_EQ(planner.remove_obstacle(42).stats.status, "invalid_problem");
+  EXPECT_EQ(planner.remove_obstacle(42).stats.status, PlanStatus::kInvalidProblem);
   Goal g;
   g.q = Eigen::Vector3d(0, 0, 0);  // wrong size
-  EXPECT_EQ(planner.set_goal(g).stats.status, "invalid_problem");
+  EXPECT_EQ(planner.set_goal(g).stats.status, PlanStatus::kInvalidProblem);
   EXPECT_EQ(planner.problem().goal.q, p.goal.q);
   // Still usable afterwards.
   Goal ok;

@@ -33,7 +33,7 @@ Plan random_plan(const Problem& problem, unsigned seed) {
   plan.qdd = random();
   plan.tau = random();
   plan.stats.method = "batch-W";
-  plan.stats.status = "converged";
+  plan.stats.status = PlanStatus::kConverged;
   plan.stats.reason = "why not";
   plan.stats.iterations = 42;
   plan.stats.outer_iterations = 5;
@@ -229,7 +229,19 @@ TEST(PlanJson, ErrorsNameTheKey) {
       broken([](json& j) { j["validation"]["goal_error"] = "x"; }).find("validation.goal_error"),
       std::string::npos);
   EXPECT_NE(broken([](json& j) { j["q"][0][0] = "x"; }).find("p.json"), std::string::npos);
+  EXPECT_NE(broken([](json& j) { j["stats"]["status"] = "fine"; }).find("stats.status"),
+            std::string::npos);
   EXPECT_THROW(read_plan("/no/such/plan.json", model), PlanFileError);
+}
+
+TEST(PlanStatus, NamesRoundTrip) {
+  for (PlanStatus s : {PlanStatus::kConverged, PlanStatus::kInfeasible, PlanStatus::kNonFinite,
+                       PlanStatus::kSingular, PlanStatus::kMaxUpdates, PlanStatus::kMaxRounds,
+                       PlanStatus::kInvalidProblem, PlanStatus::kNoPlan, PlanStatus::kFailed}) {
+    EXPECT_EQ(plan_status_from_string(to_string(s)), s) << to_string(s);
+  }
+  EXPECT_EQ(to_string(PlanStatus::kInvalidProblem), "invalid_problem");
+  EXPECT_THROW(plan_status_from_string("max_iterations"), std::invalid_argument);
 }
 
 TEST(PlanFile, ReadsBackRobotObstaclesLimitsAndPlan) {

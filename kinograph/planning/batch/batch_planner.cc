@@ -9,20 +9,6 @@
 #include "kinograph/planning/formulation/initialization.h"
 
 namespace kinograph::planning {
-namespace {
-
-Plan failed_plan(const Problem& problem, const std::string& status, const std::string& reason) {
-  Plan plan;
-  plan.stats.method = "batch-L";
-  plan.stats.status = status;
-  plan.stats.reason = reason;
-  plan.validation.valid = false;
-  plan.validation.failures.push_back(status + ": " + reason);
-  (void)problem;
-  return plan;
-}
-
-}  // namespace
 
 std::string to_string(Formulation f) { return f == Formulation::kCondensed ? "condensed" : "dfg"; }
 
@@ -65,8 +51,7 @@ Plan BatchPlanner::plan(const Problem& problem, const Plan* warm, BatchSolution*
   const std::string method = warm != nullptr ? "batch-W" : "batch-L";
   const std::string problem_error = check_problem(problem);
   if (!problem_error.empty()) {
-    Plan p = failed_plan(problem, "invalid_problem", problem_error);
-    p.stats.method = method;
+    Plan p = failed_plan(method, PlanStatus::kInvalidProblem, problem_error);
     p.stats.solve_time_s = elapsed();
     return p;
   }
@@ -80,8 +65,7 @@ Plan BatchPlanner::plan(const Problem& problem, const Plan* warm, BatchSolution*
       init = straight_line(problem, q_goal);
     }
   } catch (const std::exception& e) {
-    Plan p = failed_plan(problem, "invalid_problem", e.what());
-    p.stats.method = method;
+    Plan p = failed_plan(method, PlanStatus::kInvalidProblem, e.what());
     p.stats.solve_time_s = elapsed();
     return p;
   }
@@ -123,14 +107,14 @@ Plan BatchPlanner::plan(const Problem& problem, const Plan* warm, BatchSolution*
       ++total.attempts;
     }
     spdlog::debug("plan {}: attempt {}: {}", problem.name, a + 1,
-                  p.success() ? "valid" : p.stats.status);
+                  p.success() ? std::string("valid") : to_string(p.stats.status));
     const bool first = a == 0;
     if (first || p.success() ||
         p.stats.max_constraint_violation < best.stats.max_constraint_violation) {
       best = std::move(p);
       if (solution != nullptr) *solution = std::move(attempt);
     }
-    if (best.success() || best.stats.status == "invalid_problem") break;
+    if (best.success() || best.stats.status == PlanStatus::kInvalidProblem) break;
     add_detours(false);
   }
   const SolveStats own = best.stats;
@@ -155,8 +139,7 @@ Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init, const s
       dfg_steps = use_dfg_dynamics(pg, problem, options_.graph, options_.dfg);
     }
   } catch (const std::exception& e) {
-    Plan p = failed_plan(problem, "invalid_problem", e.what());
-    p.stats.method = method;
+    Plan p = failed_plan(method, PlanStatus::kInvalidProblem, e.what());
     return p;
   }
   const OuterLoopOptions loop =

@@ -24,15 +24,6 @@ double seconds_since(Clock::time_point t0) {
 // the start prior holds x_0 to about the validator's threshold after a large change.
 constexpr double kStartSnap = 1e-4;
 
-Plan failed(const std::string& method, const std::string& status, const std::string& reason) {
-  Plan p;
-  p.stats.method = method;
-  p.stats.status = status;
-  p.stats.reason = reason;
-  p.validation.valid = false;
-  p.validation.failures.push_back(status + ": " + reason);
-  return p;
-}
 
 // Whether a bound row holds a positive multiplier (which shrinks once the row is inactive).
 bool has_bound_multipliers(const ConstrainedFactor& f, const Multipliers& m) {
@@ -119,14 +110,14 @@ Plan IncrementalPlanner::plan(const Problem& problem, const Plan* warm) {
   const auto t0 = Clock::now();
   if (warm != nullptr) {
     const std::string error = check_problem(problem);
-    if (!error.empty()) return failed("batch-W", "invalid_problem", error);
+    if (!error.empty()) return failed_plan("batch-W", PlanStatus::kInvalidProblem, error);
     Plan p;
     try {
       const Trajectory w = warm_start(problem, *warm);
       tree_ = solve_incremental_graph(problem, anchored(problem, w.q, w.qd, w.qdd), "batch-W",
                                       options_.batch, options_.isam2, p);
     } catch (const std::exception& e) {
-      return failed("batch-W", "invalid_problem", e.what());
+      return failed_plan("batch-W", PlanStatus::kInvalidProblem, e.what());
     }
     problem_ = problem;
     stats_ = IncrementalStats();
@@ -140,7 +131,7 @@ Plan IncrementalPlanner::plan(const Problem& problem, const Plan* warm) {
   // graph, values and multipliers become the tree's (no second solve).
   BatchSolution solution;
   const Plan batch = BatchPlanner(options_.batch).plan(problem, nullptr, &solution);
-  if (batch.stats.status == "invalid_problem" || batch.q.rows() != problem.steps + 1 ||
+  if (batch.stats.status == PlanStatus::kInvalidProblem || batch.q.rows() != problem.steps + 1 ||
       !batch.q.allFinite()) {
     return batch;
   }
@@ -158,7 +149,7 @@ Plan IncrementalPlanner::plan(const Problem& problem, const Plan* warm) {
     tree_ = solve_incremental_graph(problem, anchored(problem, batch.q, batch.qd, batch.qdd),
                                     "batch-L", options_.batch, options_.isam2, p);
   } catch (const std::exception& e) {
-    return failed("batch-L", "invalid_problem", e.what());
+    return failed_plan("batch-L", PlanStatus::kInvalidProblem, e.what());
   }
   problem_ = problem;
   stats_ = IncrementalStats();
@@ -230,21 +221,22 @@ Plan IncrementalPlanner::replan(const ProblemChange& change) {
   const auto t0 = Clock::now();
   stats_ = IncrementalStats();  // a refused change must not report the previous replan's figures
   stats_.method = "incremental";
-  if (!tree_) return failed("incremental", "no_plan", "replan needs a plan first");
+  if (!tree_) return failed_plan("incremental", PlanStatus::kNoPlan, "replan needs a plan first");
   // The changed problem; checked before any state changes.
   Problem next;
   std::set<int> changed_obstacles;
   std::string error = apply_change(problem_, change, next, changed_obstacles);
   if (error.empty()) error = check_problem(next);
-  if (!error.empty()) return failed("incremental", "invalid_problem", error);
+  if (!error.empty()) return failed_plan("incremental", PlanStatus::kInvalidProblem, error);
   try {
     replace_factors(change, next, changed_obstacles);
   } catch (const std::exception& e) {
-    return failed("incremental", "invalid_problem", e.what());
+    return failed_plan("incremental", PlanStatus::kInvalidProblem, e.what());
   }
   problem_ = next;
   tree_->compact_if_sparse();
-  std::string status = "max_updates", reason;
+  PlanStatus status = PlanStatus::kMaxUpdates;
+  std::string reason;
   std::optional<Plan> valid_plan = run_updates(plan_.stats.cost, status, reason);
   stats_.penalty = tree_->constraints.penalty();
   stats_.incremental_time_s = seconds_since(t0);
@@ -328,7 +320,7 @@ void IncrementalPlanner::replace_factors(const ProblemChange& change, const Prob
   }
 }
 
-std::optional<Plan> IncrementalPlanner::run_updates(double previous_cost, std::string& status,
+std::optional<Plan> IncrementalPlanner::run_updates(double previous_cost, PlanStatus& status,
                                                     std::string& reason) {
   IncrementalTree& t = *tree_;
   const AugmentedLagrangianOptions& alo = options_.batch.augmented_lagrangian;
@@ -344,7 +336,8 @@ std::optional<Plan> IncrementalPlanner::run_updates(double previous_cost, std::s
     // pulls the others back toward their linearization point, against the stiff start prior.
     const graph::ISAM2Result r = t.update(/*force_relinearize=*/true, totals);
     if (!r.ok()) {
-      status = graph::to_string(r.status);
+      status = r.status == graph::ISAM2Status::kSingular ? PlanStatus::kSingular
+                                                          : PlanStatus::kNonFinite;
       reason = r.reason;
       break;
     }
@@ -355,7 +348,7 @@ std::optional<Plan> IncrementalPlanner::run_updates(double previous_cost, std::s
                   r.error_increased ? " (rose)" : "", r.variables_relinearized,
                   r.cliques_reeliminated, r.lambda, r.total_s * 1e3);
     if (polish) {
-      status = "converged";
+      status = PlanStatus::kConverged;
       break;
     }
     if (options_.stop_at_first_valid && rule.accept(t.soft_cost())) {
@@ -365,7 +358,7 @@ std::optional<Plan> IncrementalPlanner::run_updates(double previous_cost, std::s
         candidate.stats.cost = t.soft_cost(&worst);
         candidate.stats.max_constraint_violation = worst;
         answer = std::move(candidate);
-        status = "converged";
+        status = PlanStatus::kConverged;
         break;
       }
     }
@@ -385,14 +378,14 @@ std::optional<Plan> IncrementalPlanner::run_updates(double previous_cost, std::s
     if (next == StoppingRule::Next::kSettleObjective) continue;
     if (next == StoppingRule::Next::kPolish) {
       if (totals.updates >= options_.max_updates) {
-        status = "converged";
+        status = PlanStatus::kConverged;
         break;
       }
       polish = true;  // one update relinearizing every moved variable (ISAM2's threshold)
       continue;
     }
     if (stats_.rounds >= options_.max_rounds) {
-      status = "max_rounds";
+      status = PlanStatus::kMaxRounds;
       break;
     }
     ++stats_.rounds;
@@ -459,7 +452,7 @@ Plan IncrementalPlanner::move_obstacle(int id, const Eigen::Isometry3d& pose) {
   const auto it = std::find_if(problem_.obstacles.begin(), problem_.obstacles.end(),
                                [id](const collision::Obstacle& o) { return o.id == id; });
   if (it == problem_.obstacles.end()) {
-    return failed("incremental", "invalid_problem",
+    return failed_plan("incremental", PlanStatus::kInvalidProblem,
                   "no obstacle with id " + std::to_string(id) + " to move");
   }
   collision::Obstacle o = *it;

@@ -116,7 +116,7 @@ class IncrementalPlanner {
   void replace_factors(const ProblemChange& change, const Problem& next,
                        const std::set<int>& changed_obstacles);
   /// ISAM2 updates and multiplier rounds until the stopping rule holds.
-  std::optional<Plan> run_updates(double previous_cost, std::string& status, std::string& reason);
+  std::optional<Plan> run_updates(double previous_cost, PlanStatus& status, std::string& reason);
   /// A multiplier round at the tree's estimate; returns the number of factors re-added.
   int multiplier_round(const std::vector<double>& violations, bool grow,
                        const class StoppingRule& rule);

@@ -243,7 +243,7 @@ Eigen::MatrixXd read_rows(const json& j, const char* key, const std::string& sou
 
 json to_json(const SolveStats& s) {
   return {{"method", s.method},
-          {"status", s.status},
+          {"status", to_string(s.status)},
           {"reason", s.reason},
           {"iterations", s.iterations},
           {"outer_iterations", s.outer_iterations},
@@ -290,7 +290,15 @@ SolveStats stats_from_json(const json& j, const std::string& source) {
     if (j.contains(key)) out = read_number(j[key], source, std::string("stats.") + key, kInf);
   };
   str("method", s.method);
-  str("status", s.status);
+  if (j.contains("status")) {
+    std::string name;
+    str("status", name);
+    try {
+      s.status = plan_status_from_string(name);
+    } catch (const std::invalid_argument& e) {
+      fail(source, "stats.status", e.what());
+    }
+  }
   str("reason", s.reason);
   integer("iterations", s.iterations);
   integer("outer_iterations", s.outer_iterations);

@@ -63,7 +63,6 @@ OuterLoopResult solve_outer_loop(const graph::FactorGraph& graph, graph::Values&
   graph::LevenbergMarquardt lm(lm_options);
   const double tol = options.constraint_tolerance, tol_final = options.inner_tolerance_final;
   OuterLoopResult out;
-  out.status = "infeasible";
   double lm_s = 0, al_s = 0;
   for (int outer = 0; outer < options.max_outer_iterations; ++outer) {
     lm_options.max_iterations =
@@ -76,7 +75,7 @@ OuterLoopResult solve_outer_loop(const graph::FactorGraph& graph, graph::Values&
     out.linear_solves += r.trials;
     out.outer_iterations = outer + 1;
     if (r.status == graph::SolverStatus::kNonFinite) {
-      out.status = "non_finite";
+      out.status = PlanStatus::kNonFinite;
       out.reason = r.reason;
       break;
     }
@@ -88,7 +87,7 @@ OuterLoopResult solve_outer_loop(const graph::FactorGraph& graph, graph::Values&
     // Converged once feasible at the final inner tolerance (the slack absorbs the rounding of
     // the repeated 10× tightening).
     if (worst.scaled_violation <= tol && lm_options.relative_error_tol <= tol_final * 1.0001) {
-      out.status = "converged";
+      out.status = PlanStatus::kConverged;
       al_s += seconds_since(t_al);
       break;
     }
@@ -100,8 +99,10 @@ OuterLoopResult solve_outer_loop(const graph::FactorGraph& graph, graph::Values&
                                         : std::max(tol_final, lm_options.relative_error_tol * 0.1);
   }
   out.worst = al.report(values);
-  if (out.status == "infeasible" && out.worst.scaled_violation <= tol) out.status = "converged";
-  if (out.status == "infeasible") {
+  if (out.status == PlanStatus::kInfeasible && out.worst.scaled_violation <= tol) {
+    out.status = PlanStatus::kConverged;
+  }
+  if (out.status == PlanStatus::kInfeasible) {
     std::ostringstream os;
     os << "constraints still violated after " << out.outer_iterations << " outer and "
        << out.iterations << " LM iterations: worst " << out.worst.violation << " at "

@@ -66,7 +66,7 @@ struct OuterLoopOptions {
 
 /// What the outer loop ended with.
 struct OuterLoopResult {
-  std::string status;  ///< "converged", "infeasible" or "non_finite"
+  PlanStatus status = PlanStatus::kInfeasible;  ///< kConverged, kInfeasible or kNonFinite
   std::string reason;  ///< why, when not converged
   int iterations = 0;  ///< LM linearizations
   int outer_iterations = 0;

@@ -1,0 +1,49 @@
+#include "kinograph/planning/plan.h"
+
+#include <ostream>
+#include <stdexcept>
+
+namespace kinograph::planning {
+namespace {
+constexpr PlanStatus kAll[] = {PlanStatus::kConverged,      PlanStatus::kInfeasible,
+                               PlanStatus::kNonFinite,      PlanStatus::kSingular,
+                               PlanStatus::kMaxUpdates,     PlanStatus::kMaxRounds,
+                               PlanStatus::kInvalidProblem, PlanStatus::kNoPlan,
+                               PlanStatus::kFailed};
+}  // namespace
+
+std::string to_string(PlanStatus status) {
+  switch (status) {
+    case PlanStatus::kConverged: return "converged";
+    case PlanStatus::kInfeasible: return "infeasible";
+    case PlanStatus::kNonFinite: return "non_finite";
+    case PlanStatus::kSingular: return "singular";
+    case PlanStatus::kMaxUpdates: return "max_updates";
+    case PlanStatus::kMaxRounds: return "max_rounds";
+    case PlanStatus::kInvalidProblem: return "invalid_problem";
+    case PlanStatus::kNoPlan: return "no_plan";
+    case PlanStatus::kFailed: return "failed";
+  }
+  return "failed";
+}
+
+PlanStatus plan_status_from_string(const std::string& name) {
+  for (PlanStatus s : kAll) {
+    if (to_string(s) == name) return s;
+  }
+  throw std::invalid_argument("unknown plan status '" + name + "'");
+}
+
+Plan failed_plan(const std::string& method, PlanStatus status, const std::string& reason) {
+  Plan p;
+  p.stats.method = method;
+  p.stats.status = status;
+  p.stats.reason = reason;
+  p.validation.valid = false;
+  p.validation.failures.push_back(to_string(status) + ": " + reason);
+  return p;
+}
+
+std::ostream& operator<<(std::ostream& os, PlanStatus status) { return os << to_string(status); }
+
+}  // namespace kinograph::planning
