@@ -326,15 +326,14 @@ std::optional<Plan> IncrementalPlanner::run_updates(double previous_cost, PlanSt
   const AugmentedLagrangianOptions& alo = options_.batch.augmented_lagrangian;
   StoppingRule rule(options_.batch.outer_loop.constraint_tolerance, previous_cost,
                     options_.stop_at_first_valid);
-  UpdateTotals totals;
   bool polish = false;
   t.last_violation = -1;
   std::vector<double> violations;
   std::optional<Plan> answer;
-  while (totals.updates < options_.max_updates) {
+  while (stats_.updates < options_.max_updates) {
     // Every update relinearizes every moved variable: with the threshold alone a damped step
     // pulls the others back toward their linearization point, against the stiff start prior.
-    const graph::ISAM2Result r = t.update(/*force_relinearize=*/true, totals);
+    const graph::ISAM2Result r = t.update(/*force_relinearize=*/true, stats_);
     if (!r.ok()) {
       status = r.status == graph::ISAM2Status::kSingular ? PlanStatus::kSingular
                                                           : PlanStatus::kNonFinite;
@@ -344,7 +343,7 @@ std::optional<Plan> IncrementalPlanner::run_updates(double previous_cost, PlanSt
     const double e = r.error_evaluated ? r.error_after : t.isam->error();
     spdlog::debug("iDFGP update {}{}: error {:.6g} -> {:.6g}{}, {} relinearized, {} cliques, "
                   "lambda {:.3g}, {:.2f} ms",
-                  totals.updates, polish ? " (polish)" : "", r.error_before, e,
+                  stats_.updates, polish ? " (polish)" : "", r.error_before, e,
                   r.error_increased ? " (rose)" : "", r.variables_relinearized,
                   r.cliques_reeliminated, r.lambda, r.total_s * 1e3);
     if (polish) {
@@ -377,7 +376,7 @@ std::optional<Plan> IncrementalPlanner::run_updates(double previous_cost, PlanSt
     const StoppingRule::Next next = rule.after_settling(worst);
     if (next == StoppingRule::Next::kSettleObjective) continue;
     if (next == StoppingRule::Next::kPolish) {
-      if (totals.updates >= options_.max_updates) {
+      if (stats_.updates >= options_.max_updates) {
         status = PlanStatus::kConverged;
         break;
       }
@@ -395,10 +394,6 @@ std::optional<Plan> IncrementalPlanner::run_updates(double previous_cost, PlanSt
     t.last_violation = worst;
     stats_.factors_readded += multiplier_round(violations, grow, rule);
   }
-  stats_.updates = totals.updates;
-  stats_.cliques_reeliminated = totals.cliques_reeliminated;
-  stats_.variables_relinearized = totals.variables_relinearized;
-  stats_.full_reeliminations = totals.full_reeliminations;
   return answer;
 }
 

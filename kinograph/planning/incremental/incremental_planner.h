@@ -20,6 +20,7 @@
 
 #include "kinograph/graph/isam2.h"
 #include "kinograph/planning/batch/batch_planner.h"
+#include "kinograph/planning/incremental/incremental_stats.h"
 #include "kinograph/planning/incremental/problem_change.h"
 #include "kinograph/planning/plan.h"
 #include "kinograph/planning/problem.h"
@@ -49,21 +50,6 @@ struct IncrementalPlannerOptions {
   /// optimum (the batch plan stops short of it), so that later replans do not depend on where
   /// the batch solve stopped; answered when it validates and costs no more than the batch plan.
   bool settle_first_plan = true;
-};
-
-/// What the last plan or replan did; complements Plan::stats.
-struct IncrementalStats {
-  std::string method;        ///< "batch-L"/"batch-W" (first or warm plan) or "incremental"
-  int updates = 0;           ///< ISAM2 updates
-  int rounds = 0;            ///< multiplier rounds (each re-adds the factors it changed)
-  int factors_replaced = 0;  ///< factors removed for the change itself
-  int factors_added = 0;     ///< factors added for the change itself
-  int factors_readded = 0;   ///< factors re-added for multiplier or penalty changes
-  long cliques_reeliminated = 0;
-  long variables_relinearized = 0;
-  int full_reeliminations = 0;
-  double incremental_time_s = 0;  ///< the ISAM2 part (whole replan time is in Plan::stats)
-  double penalty = 0;             ///< μ at the end
 };
 
 struct IncrementalTree;

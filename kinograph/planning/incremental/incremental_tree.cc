@@ -35,7 +35,7 @@ void IncrementalTree::compact_if_sparse() {
   for (size_t i = 0; i < entries.size(); ++i) pending_add_.push_back(i);
 }
 
-graph::ISAM2Result IncrementalTree::update(bool force_relinearize, UpdateTotals& totals) {
+graph::ISAM2Result IncrementalTree::update(bool force_relinearize, IncrementalStats& stats) {
   std::vector<graph::FactorPtr> new_factors;
   for (size_t i : pending_add_) new_factors.push_back(entries[i].factor);
   graph::ISAM2UpdateOptions uo;
@@ -47,11 +47,10 @@ graph::ISAM2Result IncrementalTree::update(bool force_relinearize, UpdateTotals&
   pending_add_.clear();
   pending_remove_.clear();
   pending_values_ = graph::Values();
-  ++totals.updates;
-  totals.isam2_s += r.total_s;
-  totals.cliques_reeliminated += r.cliques_reeliminated;
-  totals.variables_relinearized += r.variables_relinearized;
-  totals.full_reeliminations += r.full_reelimination ? 1 : 0;
+  ++stats.updates;
+  stats.cliques_reeliminated += r.cliques_reeliminated;
+  stats.variables_relinearized += r.variables_relinearized;
+  stats.full_reeliminations += r.full_reelimination ? 1 : 0;
   return r;
 }
 

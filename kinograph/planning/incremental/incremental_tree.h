@@ -8,18 +8,10 @@
 
 #include "kinograph/graph/isam2.h"
 #include "kinograph/planning/formulation/planning_graph.h"
+#include "kinograph/planning/incremental/incremental_stats.h"
 #include "kinograph/planning/solver/constraint_state.h"
 
 namespace kinograph::planning {
-
-/// Totals of the ISAM2 updates of one replan.
-struct UpdateTotals {
-  int updates = 0;
-  long cliques_reeliminated = 0;
-  long variables_relinearized = 0;
-  int full_reeliminations = 0;
-  double isam2_s = 0;
-};
 
 /// The Bayes tree of a planning graph and the table of its factors (slots are ISAM2 indices).
 struct IncrementalTree {
@@ -41,8 +33,8 @@ struct IncrementalTree {
   /// A fresh tree from the current estimate at the next update when re-added factors left
   /// many empty slots in the ISAM2 graph.
   void compact_if_sparse();
-  /// One ISAM2 update with the queued changes; totals accumulate in `totals`.
-  graph::ISAM2Result update(bool force_relinearize, UpdateTotals& totals);
+  /// One ISAM2 update with the queued changes; its counts and time add to `stats`.
+  graph::ISAM2Result update(bool force_relinearize, IncrementalStats& stats);
 
   /// The soft cost (and the worst violation) of the ISAM2 graph at its estimate, in slot order.
   double soft_cost(double* violation = nullptr) const;

@@ -1,6 +1,7 @@
 #include "kinograph/planning/io/plan_json.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -239,6 +240,23 @@ Eigen::MatrixXd read_rows(const json& j, const char* key, const std::string& sou
   return m;
 }
 
+// The figures of a validation by their plan-file keys, in file order.
+std::array<std::pair<const char*, double*>, 13> validation_figures(Validation& v) {
+  return {{{"max_dynamics_residual", &v.max_dynamics_residual},
+           {"max_position_consistency", &v.max_position_consistency},
+           {"max_velocity_consistency", &v.max_velocity_consistency},
+           {"max_q_violation", &v.max_q_violation},
+           {"max_qd_violation", &v.max_qd_violation},
+           {"max_qdd_violation", &v.max_qdd_violation},
+           {"max_tau_violation", &v.max_tau_violation},
+           {"min_clearance", &v.min_clearance},
+           {"goal_error", &v.goal_error},
+           {"max_task_error", &v.max_task_error},
+           {"max_unactuated_torque", &v.max_unactuated_torque},
+           {"start_error", &v.start_error},
+           {"final_velocity", &v.final_velocity}}};
+}
+
 }  // namespace
 
 json to_json(const SolveStats& s) {
@@ -255,21 +273,10 @@ json to_json(const SolveStats& s) {
 }
 
 json to_json(const Validation& v) {
-  return {{"valid", v.valid},
-          {"failures", v.failures},
-          {"max_dynamics_residual", number(v.max_dynamics_residual)},
-          {"max_position_consistency", number(v.max_position_consistency)},
-          {"max_velocity_consistency", number(v.max_velocity_consistency)},
-          {"max_q_violation", number(v.max_q_violation)},
-          {"max_qd_violation", number(v.max_qd_violation)},
-          {"max_qdd_violation", number(v.max_qdd_violation)},
-          {"max_tau_violation", number(v.max_tau_violation)},
-          {"min_clearance", number(v.min_clearance)},
-          {"goal_error", number(v.goal_error)},
-          {"max_task_error", number(v.max_task_error)},
-          {"max_unactuated_torque", number(v.max_unactuated_torque)},
-          {"start_error", number(v.start_error)},
-          {"final_velocity", number(v.final_velocity)}};
+  json j = {{"valid", v.valid}, {"failures", v.failures}};
+  Validation copy = v;
+  for (const auto& [key, value] : validation_figures(copy)) j[key] = number(*value);
+  return j;
 }
 
 SolveStats stats_from_json(const json& j, const std::string& source) {
@@ -324,20 +331,7 @@ Validation validation_from_json(const json& j, const std::string& source) {
       v.failures.push_back(f.get<std::string>());
     }
   }
-  const std::pair<const char*, double*> figures[] = {
-      {"max_dynamics_residual", &v.max_dynamics_residual},
-      {"max_position_consistency", &v.max_position_consistency},
-      {"max_velocity_consistency", &v.max_velocity_consistency},
-      {"max_q_violation", &v.max_q_violation},
-      {"max_qd_violation", &v.max_qd_violation},
-      {"max_qdd_violation", &v.max_qdd_violation},
-      {"max_tau_violation", &v.max_tau_violation},
-      {"min_clearance", &v.min_clearance},
-      {"goal_error", &v.goal_error},
-      {"max_task_error", &v.max_task_error},
-      {"max_unactuated_torque", &v.max_unactuated_torque},
-      {"start_error", &v.start_error},
-      {"final_velocity", &v.final_velocity}};
+  const auto figures = validation_figures(v);
   for (const auto& [key, out] : figures) {
     if (j.contains(key)) *out = read_number(j[key], source, std::string("validation.") + key, kInf);
   }
@@ -347,23 +341,27 @@ Validation validation_from_json(const json& j, const std::string& source) {
 std::string summarize(const Validation& v) {
   std::ostringstream os;
   os.precision(4);
-  const auto row = [&](const char* name, double value, const char* unit) {
-    os << "  " << name << ": " << value << (unit[0] ? " " : "") << unit << "\n";
-  };
   os << "validation: " << (v.valid ? "valid" : "INVALID") << "\n";
-  row("max dynamics residual |tau - ID|", v.max_dynamics_residual, "N·m");
-  row("max position consistency", v.max_position_consistency, "rad");
-  row("max velocity consistency", v.max_velocity_consistency, "rad/s");
-  row("max q limit violation", v.max_q_violation, "rad");
-  row("max qd limit violation", v.max_qd_violation, "rad/s");
-  row("max qdd limit violation", v.max_qdd_violation, "rad/s²");
-  row("max tau limit violation", v.max_tau_violation, "N·m");
-  row("max unactuated torque", v.max_unactuated_torque, "N·m");
-  row("min clearance", v.min_clearance, "m");
-  row("goal error", v.goal_error, "");
-  row("max task error", v.max_task_error, "");
-  row("start error", v.start_error, "");
-  row("final velocity", v.final_velocity, "");
+  const struct {
+    const char* name;
+    double value;
+    const char* unit;
+  } rows[] = {{"max dynamics residual |tau - ID|", v.max_dynamics_residual, "N·m"},
+              {"max position consistency", v.max_position_consistency, "rad"},
+              {"max velocity consistency", v.max_velocity_consistency, "rad/s"},
+              {"max q limit violation", v.max_q_violation, "rad"},
+              {"max qd limit violation", v.max_qd_violation, "rad/s"},
+              {"max qdd limit violation", v.max_qdd_violation, "rad/s²"},
+              {"max tau limit violation", v.max_tau_violation, "N·m"},
+              {"max unactuated torque", v.max_unactuated_torque, "N·m"},
+              {"min clearance", v.min_clearance, "m"},
+              {"goal error", v.goal_error, ""},
+              {"max task error", v.max_task_error, ""},
+              {"start error", v.start_error, ""},
+              {"final velocity", v.final_velocity, ""}};
+  for (const auto& r : rows) {
+    os << "  " << r.name << ": " << r.value << (r.unit[0] ? " " : "") << r.unit << "\n";
+  }
   for (const std::string& f : v.failures) os << "  failed: " << f << "\n";
   return os.str();
 }
