@@ -48,12 +48,6 @@ std::vector<std::vector<int>> coupled_block_rows(const std::vector<std::vector<i
   return block_rows;
 }
 
-// Sets the reason a factor's `what` is not finite; returns false for the caller to return.
-bool non_finite(int slot, const Factor& f, const char* what, std::string* reason) {
-  if (reason) *reason = factor_label(static_cast<size_t>(slot), f) + " has a non-finite " + what;
-  return false;
-}
-
 }  // namespace
 
 // Free variables in slot order ("natural" index) and, per factor, the slots of its keys.
@@ -251,116 +245,89 @@ bool NormalEquations::run(const FactorGraph& graph, const Values& values, double
     const int m = f.residual_dim();
     const int nk = static_cast<int>(f.keys().size());
     for (int k = 0; k < nk; ++k) x_ptrs_[k] = base + key_value_offset_[info.first_key + k];
-    Segment r = r_.head(m);
+    auto r = r_.head(m);
     r.setZero();
-    bool ok;
-    if constexpr (kWithJacobian) {
-      ok = linearize_factor(fi, f, r, &total, reason);
+    if constexpr (!kWithJacobian) {
+      f.whitened(x_ptrs_.data(), r, nullptr);
+      if (!r.allFinite()) {
+        if (reason) {
+          *reason = "factor " + std::to_string(info.slot) + " (" + f.name() +
+                    ") has a non-finite residual";
+        }
+        return false;
+      }
+      total += 0.5 * r.squaredNorm();
+      continue;
     } else {
-      ok = add_error(info, f, r, &total, reason);
+      const int nc = f.jacobian_cols();
+      // A linear factor whose Jacobian is unchanged keeps J and JᵀJ: only r and Jᵀr are new.
+      const long version = f.jacobian_version();
+      LinearCache* cache = version >= 0 && info.num_pairs > 0 ? &linear_[fi] : nullptr;
+      const bool kept = cache != nullptr && cache->version == version;
+      Eigen::Ref<Eigen::MatrixXd> J = J_.topLeftCorner(m, nc);
+      f.whitened(x_ptrs_.data(), r, kept ? nullptr : &J);
+      const bool r_ok = r.allFinite();
+      if (!r_ok || (!kept && !J.allFinite())) {
+        if (reason) {
+          *reason = "factor " + std::to_string(info.slot) + " (" + f.name() +
+                    ") has a non-finite " + (r_ok ? "Jacobian" : "residual");
+        }
+        return false;
+      }
+      total += 0.5 * r.squaredNorm();
+      if (info.num_pairs == 0) continue;
+      auto Jtr = Jtr_.head(nc);
+      const double* jtj = nullptr;
+      Eigen::Index stride = 0;
+      if (kept) {
+        Jtr.noalias() = cache->J.transpose() * r;
+        jtj = cache->JtJ.data();
+        stride = cache->JtJ.outerStride();
+      } else {
+        if (cache != nullptr) cache->J = J;  // before the compaction reorders its rows
+        const int active = compact_nonzero_rows(J, r);
+        if (active == 0) continue;  // e.g. a collision factor with every pair clear
+        const auto Ja = J.topRows(active);
+        auto JtJ = JtJ_.topLeftCorner(nc, nc);
+        jacobian_gram(Ja, JtJ, /*upper_only=*/true);  // only upper blocks are scattered
+        Jtr.noalias() = Ja.transpose() * r.head(active);
+        jtj = JtJ.data();
+        stride = JtJ.outerStride();
+        if (cache != nullptr) {
+          cache->JtJ = JtJ;
+          cache->version = version;
+        }
+      }
+      const auto& offsets = f.block_offsets();
+      const auto& dims = f.dims();
+      for (int k = 0; k < nk; ++k) {
+        const int col = key_col_[info.first_key + k];
+        if (col >= 0) g_.segment(col, dims[k]) += Jtr.segment(offsets[k], dims[k]);
+      }
+      double* h = h_.data();
+      for (int p = info.first_pair; p < info.first_pair + info.num_pairs; ++p) {
+        const Pair& pair = pairs_[p];
+        const int ro = offsets[pair.row_key], co = offsets[pair.col_key];
+        const int dr = dims[pair.row_key], dc = dims[pair.col_key];
+        if (ro <= co) {  // the block lies in JᵀJ's upper triangle
+          for (int k = 0; k < dc; ++k) {
+            double* dst = h + col_ptr_[pair.first_col + k] + pair.within;
+            const double* src = jtj + (co + k) * stride + ro;
+            const int rows = pair.diagonal ? k + 1 : dr;
+            for (int i = 0; i < rows; ++i) dst[i] += src[i];
+          }
+        } else {  // below the diagonal of JᵀJ: read the mirrored entries from the upper triangle
+          for (int k = 0; k < dc; ++k) {
+            double* dst = h + col_ptr_[pair.first_col + k] + pair.within;
+            const double* src = jtj + ro * stride + co + k;
+            for (int i = 0; i < dr; ++i) dst[i] += src[i * stride];
+          }
+        }
+      }
     }
-    if (!ok) return false;
   }
   *error = total;
   return true;
-}
-
-// Adds one factor's ½‖r‖² to total; false with a reason if r is not finite.
-bool NormalEquations::add_error(const FactorInfo& info, const Factor& f, Segment r, double* total,
-                                std::string* reason) const {
-  f.whitened(x_ptrs_.data(), r, nullptr);
-  if (!r.allFinite()) return non_finite(info.slot, f, "residual", reason);
-  *total += 0.5 * r.squaredNorm();
-  return true;
-}
-
-// Adds one factor's ½‖r‖² to total and its Jᵀr and JᵀJ to g and H; false with a reason if r
-// or J is not finite.
-bool NormalEquations::linearize_factor(size_t fi, const Factor& f, Segment r, double* total,
-                                       std::string* reason) {
-  const FactorInfo& info = factors_[fi];
-  const int nc = f.jacobian_cols();
-  // A linear factor whose Jacobian is unchanged keeps J and JᵀJ: only r and Jᵀr are new.
-  const long version = f.jacobian_version();
-  LinearCache* cache = version >= 0 && info.num_pairs > 0 ? &linear_[fi] : nullptr;
-  const bool kept = cache != nullptr && cache->version == version;
-  Eigen::Ref<Eigen::MatrixXd> J = J_.topLeftCorner(r.size(), nc);
-  f.whitened(x_ptrs_.data(), r, kept ? nullptr : &J);
-  const bool r_ok = r.allFinite();
-  if (!r_ok || (!kept && !J.allFinite())) {
-    return non_finite(info.slot, f, r_ok ? "Jacobian" : "residual", reason);
-  }
-  *total += 0.5 * r.squaredNorm();
-  if (info.num_pairs == 0) return true;
-  Segment Jtr = Jtr_.head(nc);
-  const Gram jtj = kept ? cached_gram(*cache, r, Jtr) : fresh_gram(J, r, cache, version, Jtr);
-  if (jtj.data == nullptr) return true;
-  scatter_gradient(f, info, Jtr);
-  scatter_hessian(f, info, jtj);
-  return true;
-}
-
-// A kept linear factor: Jᵀr from its cached J, JᵀJ as cached.
-NormalEquations::Gram NormalEquations::cached_gram(const LinearCache& cache, const Segment& r,
-                                                   Segment Jtr) {
-  Jtr.noalias() = cache.J.transpose() * r;
-  return {cache.JtJ.data(), cache.JtJ.outerStride()};
-}
-
-// JᵀJ and Jᵀr over J's nonzero rows, kept in `cache` (if any) for a linear factor.
-NormalEquations::Gram NormalEquations::fresh_gram(Eigen::Ref<Eigen::MatrixXd> J, Segment r,
-                                                  LinearCache* cache, long version, Segment Jtr) {
-  const Eigen::Index nc = J.cols();
-  if (cache != nullptr) cache->J = J;  // before the compaction reorders its rows
-  const int active = compact_nonzero_rows(J, r);
-  if (active == 0) return {};  // e.g. a collision factor with every pair clear
-  const auto Ja = J.topRows(active);
-  auto JtJ = JtJ_.topLeftCorner(nc, nc);
-  jacobian_gram(Ja, JtJ, /*upper_only=*/true);  // only upper blocks are scattered
-  Jtr.noalias() = Ja.transpose() * r.head(active);
-  if (cache != nullptr) {
-    cache->JtJ = JtJ;
-    cache->version = version;
-  }
-  return {JtJ.data(), JtJ.outerStride()};
-}
-
-// g += Jᵀr on the factor's free keys.
-void NormalEquations::scatter_gradient(const Factor& f, const FactorInfo& info,
-                                       const Segment& Jtr) {
-  const auto& offsets = f.block_offsets();
-  const auto& dims = f.dims();
-  const int nk = static_cast<int>(f.keys().size());
-  for (int k = 0; k < nk; ++k) {
-    const int col = key_col_[info.first_key + k];
-    if (col >= 0) g_.segment(col, dims[k]) += Jtr.segment(offsets[k], dims[k]);
-  }
-}
-
-// H += the factor's upper blocks of JᵀJ, each at its precomputed place in the pattern.
-void NormalEquations::scatter_hessian(const Factor& f, const FactorInfo& info, const Gram& jtj) {
-  const auto& offsets = f.block_offsets();
-  const auto& dims = f.dims();
-  double* h = h_.data();
-  for (int p = info.first_pair; p < info.first_pair + info.num_pairs; ++p) {
-    const Pair& pair = pairs_[p];
-    const int ro = offsets[pair.row_key], co = offsets[pair.col_key];
-    const int dr = dims[pair.row_key], dc = dims[pair.col_key];
-    if (ro <= co) {  // the block lies in JᵀJ's upper triangle
-      for (int k = 0; k < dc; ++k) {
-        double* dst = h + col_ptr_[pair.first_col + k] + pair.within;
-        const double* src = jtj.data + (co + k) * jtj.stride + ro;
-        const int rows = pair.diagonal ? k + 1 : dr;
-        for (int i = 0; i < rows; ++i) dst[i] += src[i];
-      }
-    } else {  // below the diagonal of JᵀJ: read the mirrored entries from the upper triangle
-      for (int k = 0; k < dc; ++k) {
-        double* dst = h + col_ptr_[pair.first_col + k] + pair.within;
-        const double* src = jtj.data + ro * jtj.stride + co + k;
-        for (int i = 0; i < dr; ++i) dst[i] += src[i * jtj.stride];
-      }
-    }
-  }
 }
 
 bool NormalEquations::linearize(const FactorGraph& graph, const Values& values, double* error,

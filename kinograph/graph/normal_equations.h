@@ -79,11 +79,6 @@ class NormalEquations {
   };
   struct Incidence;     // the free variables and each factor's keys, while building
   struct BlockPattern;  // per block column: its block rows and their offsets in the column
-  struct Gram {         // a factor's JᵀJ (upper triangle) as the scatter reads it
-    const double* data = nullptr;  // nullptr: no active row, nothing to scatter
-    Eigen::Index stride = 0;
-  };
-  using Segment = Eigen::VectorBlock<Eigen::VectorXd>;  // a head of r_ or Jtr_
 
   // Construction, in the constructor's order.
   static Incidence incidence(const FactorGraph& graph, const Values& values);
@@ -99,17 +94,10 @@ class NormalEquations {
   void add_pairs(const std::vector<int>& pos, const BlockPattern& pattern, FactorInfo& info);
   void size_workspaces(const Incidence& inc);
 
-  // Evaluation: run() loops over the factors, the rest handle one factor.
+  // Evaluation of every factor: one loop, kept whole so that the compiler keeps the
+  // per-factor work inline (this is the solvers' hot path).
   template <bool kWithJacobian>
   bool run(const FactorGraph& graph, const Values& values, double* error, std::string* reason);
-  bool add_error(const FactorInfo& info, const Factor& f, Segment r, double* total,
-                 std::string* reason) const;
-  bool linearize_factor(size_t fi, const Factor& f, Segment r, double* total, std::string* reason);
-  static Gram cached_gram(const LinearCache& cache, const Segment& r, Segment Jtr);
-  Gram fresh_gram(Eigen::Ref<Eigen::MatrixXd> J, Segment r, LinearCache* cache, long version,
-                  Segment Jtr);
-  void scatter_gradient(const Factor& f, const FactorInfo& info, const Segment& Jtr);
-  void scatter_hessian(const Factor& f, const FactorInfo& info, const Gram& jtj);
 
   uint64_t graph_id_ = 0;
   uint64_t layout_id_ = 0;

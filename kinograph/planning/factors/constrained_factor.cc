@@ -19,7 +19,6 @@ ConstrainedFactor::ConstrainedFactor(std::vector<graph::Key> keys, std::vector<i
       throw std::invalid_argument("constraint row has lower bound above upper bound");
     }
   }
-  m_ = std::make_shared<const Multipliers>(residual_dim());
 }
 
 Multipliers::Multipliers(int rows, double mu)
@@ -35,6 +34,7 @@ void ConstrainedFactor::bind(std::shared_ptr<const Multipliers> m) {
 }
 
 void ConstrainedFactor::penalty_changed() {
+  if (!m_) return;
   if (!(m_->penalty > 0)) throw std::invalid_argument("penalty must be positive");
   if (m_->penalty != penalty_read_) jacobian_changed();
   penalty_read_ = m_->penalty;
@@ -43,9 +43,10 @@ void ConstrainedFactor::penalty_changed() {
 void ConstrainedFactor::evaluate(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> e,
                                  const graph::Jacobians* J) const {
   compute(x, e, J);
-  const Eigen::VectorXd& lambda = m_->lower;
-  const Eigen::VectorXd& lambda_upper = m_->upper;
-  const double sq = std::sqrt(m_->penalty);
+  // An unbound factor reads μ = 1 and λ = 0.
+  const double* lambda = m_ ? m_->lower.data() : nullptr;
+  const double* lambda_upper = m_ ? m_->upper.data() : nullptr;
+  const double sq = m_ ? std::sqrt(m_->penalty) : 1.0;
   // dr/dz of every row, applied to the Jacobian blocks column by column afterwards (blocks are
   // column-major: scaling row by row would stride through memory). Per-thread scratch that only
   // grows, so linearizing allocates nothing after the first factor of the largest size.
@@ -62,11 +63,12 @@ void ConstrainedFactor::evaluate(const graph::FactorValues& x, Eigen::Ref<Eigen:
         break;
       case RowKind::kEquality:
         f[i] = sq / row.scale;
-        e[i] = f[i] * (z - row.lower) + lambda[i] / sq;
+        e[i] = f[i] * (z - row.lower) + (lambda ? lambda[i] : 0.0) / sq;
         break;
       case RowKind::kBounds: {
-        const double a = sq * (row.lower - z) / row.scale + lambda[i] / sq;
-        const double b = sq * (z - row.upper) / row.scale + lambda_upper[i] / sq;
+        const double a = sq * (row.lower - z) / row.scale + (lambda ? lambda[i] : 0.0) / sq;
+        const double b =
+            sq * (z - row.upper) / row.scale + (lambda_upper ? lambda_upper[i] : 0.0) / sq;
         e[i] = std::max(0.0, a) - std::max(0.0, b);
         f[i] = -(sq / row.scale) * ((a > 0 ? 1.0 : 0.0) + (b > 0 ? 1.0 : 0.0));
         break;

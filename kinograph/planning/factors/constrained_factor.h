@@ -63,12 +63,10 @@ class ConstrainedFactor : public graph::Factor {
   /// Whether any row is soft (part of the objective).
   bool has_soft_rows() const { return num_constraints_ < residual_dim(); }
 
-  /// Reads μ and the multipliers from `m` from now on (a new factor reads μ = 1, λ = 0).
+  /// Reads μ and the multipliers from `m` from now on (an unbound factor reads μ = 1, λ = 0).
   /// Marks the Jacobian changed when μ differs from the one read so far. Throws
   /// std::invalid_argument if m is null, its sizes are not residual_dim or μ ≤ 0.
   void bind(std::shared_ptr<const Multipliers> m);
-  /// The multipliers read by evaluate().
-  const Multipliers& multipliers() const { return *m_; }
   /// Call after changing the bound record's penalty in place (marks the Jacobian changed).
   void penalty_changed();
 
@@ -111,8 +109,8 @@ class ConstrainedFactor : public graph::Factor {
 
   std::vector<RowSpec> rows_;
   int num_constraints_ = 0;
-  std::shared_ptr<const Multipliers> m_;
-  double penalty_read_ = 1;  // μ of the last bind or penalty_changed
+  std::shared_ptr<const Multipliers> m_;  // null until bound
+  double penalty_read_ = 1;               // μ of the last bind or penalty_changed
 };
 
 }  // namespace kinograph::planning

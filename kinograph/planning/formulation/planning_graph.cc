@@ -252,21 +252,29 @@ PlanningGraph build_graph(const Problem& problem, const Trajectory& init,
   return pg;
 }
 
-double soft_cost(const std::vector<FactorEntry>& entries, const graph::Values& values,
+double soft_cost(const std::vector<const FactorEntry*>& entries, const graph::Values& values,
                  double* violation) {
   double soft = 0;
-  for (const FactorEntry& e : entries) {
-    if (!e.constrained) {
-      soft += e.factor->error(values);
+  for (const FactorEntry* e : entries) {
+    if (!e->constrained) {
+      soft += e->factor->error(values);
       continue;
     }
     // Most constraint factors (collision, limits) have no soft rows: no evaluation for the cost.
-    if (violation == nullptr && !e.constrained->has_soft_rows()) continue;
-    const ConstrainedFactor::Terms t = e.constrained->terms(values);
+    if (violation == nullptr && !e->constrained->has_soft_rows()) continue;
+    const ConstrainedFactor::Terms t = e->constrained->terms(values);
     soft += t.soft_cost;
     if (violation != nullptr) *violation = std::max(*violation, t.violation);
   }
   return soft;
+}
+
+double soft_cost(const std::vector<FactorEntry>& entries, const graph::Values& values,
+                 double* violation) {
+  std::vector<const FactorEntry*> all;
+  all.reserve(entries.size());
+  for (const FactorEntry& e : entries) all.push_back(&e);
+  return soft_cost(all, values, violation);
 }
 
 Trajectory read_trajectory(const graph::Values& values, int steps, int nq) {

@@ -137,6 +137,9 @@ FactorEntry goal_entry(const Problem& problem, const std::shared_ptr<dynamics::D
 /// constraint violation in the rows' own units, over `entries` (anchors included).
 double soft_cost(const std::vector<FactorEntry>& entries, const graph::Values& values,
                  double* violation = nullptr);
+/// The same over entries given by pointer, in their order.
+double soft_cost(const std::vector<const FactorEntry*>& entries, const graph::Values& values,
+                 double* violation = nullptr);
 
 /// Reads q, q̇, q̈ of every state back from the values.
 Trajectory read_trajectory(const graph::Values& values, int steps, int nq);

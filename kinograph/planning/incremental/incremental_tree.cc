@@ -55,9 +55,11 @@ graph::ISAM2Result IncrementalTree::update(bool force_relinearize, IncrementalSt
 }
 
 double IncrementalTree::soft_cost(double* violation) const {
-  std::vector<FactorEntry> by_slot(entries);
+  std::vector<const FactorEntry*> by_slot;
+  by_slot.reserve(entries.size());
+  for (const FactorEntry& e : entries) by_slot.push_back(&e);
   std::sort(by_slot.begin(), by_slot.end(),
-            [](const FactorEntry& a, const FactorEntry& b) { return a.slot < b.slot; });
+            [](const FactorEntry* a, const FactorEntry* b) { return a->slot < b->slot; });
   return planning::soft_cost(by_slot, isam->estimate(), violation);
 }
 

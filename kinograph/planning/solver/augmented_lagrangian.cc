@@ -14,7 +14,10 @@ AugmentedLagrangian::AugmentedLagrangian(std::vector<const FactorEntry*> constra
                                          ConstraintState& state,
                                          AugmentedLagrangianOptions options)
     : constraints_(std::move(constraints)), state_(state), options_(options) {
-  for (const FactorEntry* e : constraints_) state_.bind(*e);
+  for (const FactorEntry* e : constraints_) {
+    state_.bind(*e);
+    multipliers_.push_back(&state_.at(e->key));
+  }
   state_.set_penalty(options_.initial_penalty);
 }
 
@@ -35,8 +38,9 @@ ConstraintReport AugmentedLagrangian::report(const graph::Values& values) const 
 
 double AugmentedLagrangian::update(const graph::Values& values) {
   double worst = 0;
-  for (const FactorEntry* e : constraints_) {
-    worst = std::max(worst, e->constrained->update_multipliers(values, state_.at(e->key)).scaled);
+  for (size_t i = 0; i < constraints_.size(); ++i) {
+    worst = std::max(worst,
+                     constraints_[i]->constrained->update_multipliers(values, *multipliers_[i]).scaled);
   }
   if (last_violation_ >= 0 && worst > options_.required_decrease * last_violation_) {
     state_.set_penalty(std::min(options_.max_penalty, state_.penalty() * options_.penalty_growth));

@@ -47,6 +47,7 @@ class AugmentedLagrangian {
 
  private:
   std::vector<const FactorEntry*> constraints_;
+  std::vector<Multipliers*> multipliers_;  // each constraint's record in state_, same order
   ConstraintState& state_;
   AugmentedLagrangianOptions options_;
   double last_violation_ = -1;

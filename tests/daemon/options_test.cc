@@ -1,0 +1,193 @@
+// PlannerNodeOptions, each set by a test that fails when the node ignores it: the channel
+// prefix, the heartbeat period and the LCM URL. (PlannerNodeOptions::replanning is pinned by
+// planner_node_test's ReplanFixture tests: BatchModeWarmStartsObstacleReplans,
+// BatchSolvesAreInTheDfgFormulationWhenAsked, AFailedReplanIs*.) In-process, no network.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <lcm/lcm-cpp.hpp>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "daemon/planner_node.h"
+#include "kinograph/planner_status_t.hpp"
+#include "kinograph/planning/io/scene.h"
+#include "lcmtypes/safe_decode.h"
+
+namespace kinograph::daemon {
+namespace {
+
+constexpr char kScene[] = R"(
+name: rr_options_test
+robot:
+  urdf: robots/rr/rr.urdf
+horizon: 2.0
+steps: 20
+start:
+  q: [-0.8, 0.4]
+goal:
+  q: [0.8, -0.4]
+)";
+
+planning::Scene scene() {
+  return planning::parse_scene(kScene, std::string(KINOGRAPH_SOURCE_DIR) + "/scene.yaml");
+}
+
+goal_t joint_goal(int64_t id, std::vector<double> q) {
+  goal_t g{};
+  g.goal_id = id;
+  g.kind = goal_t::KIND_JOINT_CONFIGURATION;
+  g.num_joints = static_cast<int32_t>(q.size());
+  g.joint_position = std::move(q);
+  g.ee_quaternion[0] = 1;
+  return g;
+}
+
+// Counts what arrives on a channel prefix's PLAN and PLANNER_STATUS channels.
+class Listener {
+ public:
+  Listener(lcm::LCM& lcm, const std::string& prefix) {
+    lcm.subscribe(prefix + "_PLAN", &Listener::on_plan, this);
+    lcm.subscribe(prefix + "_PLANNER_STATUS", &Listener::on_status, this);
+  }
+  void on_plan(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+    plan_t msg;
+    ASSERT_TRUE(lcmtypes::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), msg).ok);
+    std::lock_guard lock(mutex_);
+    plans_.push_back(std::move(msg));
+    cv_.notify_all();
+  }
+  void on_status(const lcm::ReceiveBuffer*, const std::string&) {
+    std::lock_guard lock(mutex_);
+    ++statuses_;
+    cv_.notify_all();
+  }
+  // Waits (bounded) for `count` plans; returns all that arrived.
+  std::vector<plan_t> wait_plans(size_t count, double timeout_s) {
+    std::unique_lock lock(mutex_);
+    cv_.wait_for(lock, std::chrono::duration<double>(timeout_s),
+                 [&] { return plans_.size() >= count; });
+    return plans_;
+  }
+  // Waits (bounded) for `count` status messages; returns how many arrived.
+  int wait_statuses(int count, double timeout_s) {
+    std::unique_lock lock(mutex_);
+    cv_.wait_for(lock, std::chrono::duration<double>(timeout_s),
+                 [&] { return statuses_ >= count; });
+    return statuses_;
+  }
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  std::vector<plan_t> plans_;
+  int statuses_ = 0;
+};
+
+// A node on its own thread over a shared memq:// instance.
+class Node {
+ public:
+  Node(lcm::LCM& lcm, PlannerNodeOptions options)
+      : node_(scene(), std::move(options), &lcm), thread_([this] { node_.run(stop_); }) {}
+  ~Node() {
+    stop_ = true;
+    thread_.join();
+  }
+  PlannerNode& operator*() { return node_; }
+  PlannerNode* operator->() { return &node_; }
+
+ private:
+  std::atomic<bool> stop_{false};
+  PlannerNode node_;
+  std::thread thread_;
+};
+
+TEST(PlannerNodeOptions, ChannelPrefix) {
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  Listener listener(lcm, "ARM7");
+  PlannerNodeOptions options;
+  options.channel_prefix = "ARM7";  // the URDF's robot name would give "RR"
+  Node node(lcm, options);
+  EXPECT_EQ(node->channel("GOAL"), "ARM7_GOAL");
+  EXPECT_EQ(node->identity().channel_prefix, "ARM7");
+  const goal_t g = joint_goal(5, {0.5, 0.5});
+  lcm.publish("ARM7_GOAL", &g);
+  const std::vector<plan_t> plans = listener.wait_plans(1, 60);
+  ASSERT_EQ(plans.size(), 1u);
+  EXPECT_EQ(plans[0].goal_id, 5);
+  EXPECT_EQ(plans[0].status, plan_t::SUCCESS) << plans[0].status_message;
+  EXPECT_GE(listener.wait_statuses(1, 10), 1);
+  EXPECT_EQ(node->counters().goals_received, 1);
+}
+
+// The heartbeat: with a 10 ms period, 20 planner_status_t arrive in about a second (the node's
+// loop wakes at least every 50 ms); at the default 1 s they would take 19 s. The bound (10 s)
+// only limits how long a failing run waits.
+TEST(PlannerNodeOptions, StatusPeriod) {
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  Listener listener(lcm, "RR");
+  PlannerNodeOptions options;
+  options.status_period_s = 0.01;
+  Node node(lcm, options);
+  EXPECT_GE(listener.wait_statuses(20, 10), 20);
+  EXPECT_EQ(node->counters().plans_published, 0) << "only heartbeats: nothing was asked";
+}
+
+// The node opens options.lcm_url when given no LCM instance: here an LCM log file (read mode)
+// holding one goal, which the node receives; the default URL (made memq:// here, so nothing
+// leaves the process) would receive nothing. An unknown provider throws, naming the URL.
+TEST(PlannerNodeOptions, LcmUrl) {
+  ::setenv("LCM_DEFAULT_URL", "memq://", 1);
+  const std::string log = (std::filesystem::temp_directory_path() /
+                           ("kinograph_options_test_" + std::to_string(::getpid()) + ".lcmlog"))
+                              .string();
+  {
+    lcm::LogFile file(log, "w");
+    ASSERT_TRUE(file.good());
+    goal_t g = joint_goal(9, {0.5, 0.5});
+    std::vector<uint8_t> bytes(g.getEncodedSize());
+    g.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+    lcm::LogEvent e{};
+    e.timestamp = 1;
+    e.channel = "RR_GOAL";
+    e.datalen = static_cast<int32_t>(bytes.size());
+    e.data = bytes.data();
+    ASSERT_EQ(file.writeEvent(&e), 0);
+  }
+  {
+    PlannerNodeOptions options;
+    options.lcm_url = "file://" + log + "?mode=r&speed=0";
+    PlannerNode node(scene(), options);
+    std::atomic<bool> stop{false};
+    std::thread thread([&] { node.run(stop); });
+    // The goal is counted on the LCM thread as it is read (bounded wait).
+    for (int i = 0; i < 1000 && node.counters().goals_received == 0; ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    stop = true;
+    thread.join();
+    EXPECT_EQ(node.counters().goals_received, 1);
+  }
+  std::filesystem::remove(log);
+  PlannerNodeOptions bad;
+  bad.lcm_url = "nonesuch://nowhere";
+  try {
+    PlannerNode node(scene(), bad);
+    ADD_FAILURE() << "an unknown LCM provider must throw";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("nonesuch://nowhere"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace kinograph::daemon
