@@ -10,16 +10,14 @@
 #include "kinograph/planning/incremental/incremental_planner.h"
 #include "kinograph/planning/io/scene.h"
 
+#include "tests/planning/test_problems.h"
+
 namespace kinograph::planning {
 namespace {
 
-const std::string kScenes = std::string(KINOGRAPH_SOURCE_DIR) + "/robots/scenes/";
+using testing::failures;
 
-std::string failures(const Plan& p) {
-  std::string s = p.stats.method + " " + to_string(p.stats.status) + " " + p.stats.reason + ":";
-  for (const auto& f : p.validation.failures) s += " | " + f;
-  return s;
-}
+const std::string kScenes = std::string(KINOGRAPH_SOURCE_DIR) + "/robots/scenes/";
 
 double max_abs(const Eigen::MatrixXd& m) { return m.cwiseAbs().maxCoeff(); }
 

@@ -15,18 +15,16 @@
 #include "kinograph/planning/io/scene.h"
 #include "kinograph/planning/factors/trajectory_factors.h"
 
+#include "tests/planning/test_problems.h"
+
 namespace kinograph::planning {
 namespace {
+
+using testing::failures;
 
 const std::string kScenes = std::string(KINOGRAPH_SOURCE_DIR) + "/robots/scenes/";
 
 Problem rr_problem() { return load_scene(kScenes + "rr_reach.yaml").problem; }
-
-std::string failures(const Plan& p) {
-  std::string s = p.stats.method + " " + to_string(p.stats.status) + " " + p.stats.reason + ":";
-  for (const auto& f : p.validation.failures) s += " | " + f;
-  return s;
-}
 
 // Smallest clearance of the robot to the problem's obstacles over a plan, sampled densely.
 double plan_clearance(const Problem& problem, const Plan& plan) {

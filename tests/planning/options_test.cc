@@ -34,13 +34,9 @@
 namespace kinograph::planning {
 namespace {
 
-const std::string kScenes = std::string(KINOGRAPH_SOURCE_DIR) + "/robots/scenes/";
+using testing::failures;
 
-std::string failures(const Plan& p) {
-  std::string s = p.stats.method + " " + to_string(p.stats.status) + " " + p.stats.reason + ":";
-  for (const auto& f : p.validation.failures) s += " | " + f;
-  return s;
-}
+const std::string kScenes = std::string(KINOGRAPH_SOURCE_DIR) + "/robots/scenes/";
 
 bool mentions(const Validation& v, const std::string& what) {
   for (const auto& f : v.failures) {

@@ -8,9 +8,17 @@
 
 #include "kinograph/dynamics/kinematics.h"
 #include "kinograph/dynamics/payload.h"
+#include "kinograph/planning/plan.h"
 #include "kinograph/planning/problem.h"
 
 namespace kinograph::planning::testing {
+
+/// A plan's method, status, reason and validation failures on one line, for test messages.
+inline std::string failures(const Plan& p) {
+  std::string s = p.stats.method + " " + to_string(p.stats.status) + " " + p.stats.reason + ":";
+  for (const auto& f : p.validation.failures) s += " | " + f;
+  return s;
+}
 
 inline std::shared_ptr<const dynamics::Model> load_robot(const std::string& rel) {
   return std::make_shared<const dynamics::Model>(
