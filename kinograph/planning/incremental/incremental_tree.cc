@@ -55,11 +55,10 @@ graph::ISAM2Result IncrementalTree::update(bool force_relinearize, IncrementalSt
 }
 
 double IncrementalTree::soft_cost(double* violation) const {
-  std::vector<const FactorEntry*> by_slot;
-  by_slot.reserve(entries.size());
-  for (const FactorEntry& e : entries) by_slot.push_back(&e);
-  std::sort(by_slot.begin(), by_slot.end(),
-            [](const FactorEntry* a, const FactorEntry* b) { return a->slot < b->slot; });
+  // Slot order, as the ISAM2 graph sums its error: the stopping rule compares these costs.
+  std::vector<const FactorEntry*> by_slot(isam->graph().size(), nullptr);
+  for (const FactorEntry& e : entries) by_slot[e.slot] = &e;
+  std::erase(by_slot, nullptr);
   return planning::soft_cost(by_slot, isam->estimate(), violation);
 }
 
