@@ -43,9 +43,11 @@ void ConstrainedFactor::penalty_changed() {
 void ConstrainedFactor::evaluate(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> e,
                                  const graph::Jacobians* J) const {
   compute(x, e, J);
-  // An unbound factor reads μ = 1 and λ = 0.
-  const double* lambda = m_ ? m_->lower.data() : nullptr;
-  const double* lambda_upper = m_ ? m_->upper.data() : nullptr;
+  // An unbound factor reads μ = 1 and λ = 0 (per-thread zeros that only grow).
+  thread_local Eigen::VectorXd zeros;
+  if (!m_ && zeros.size() < residual_dim()) zeros.setZero(residual_dim());
+  const double* lambda = m_ ? m_->lower.data() : zeros.data();
+  const double* lambda_upper = m_ ? m_->upper.data() : zeros.data();
   const double sq = m_ ? std::sqrt(m_->penalty) : 1.0;
   // dr/dz of every row, applied to the Jacobian blocks column by column afterwards (blocks are
   // column-major: scaling row by row would stride through memory). Per-thread scratch that only
@@ -63,12 +65,11 @@ void ConstrainedFactor::evaluate(const graph::FactorValues& x, Eigen::Ref<Eigen:
         break;
       case RowKind::kEquality:
         f[i] = sq / row.scale;
-        e[i] = f[i] * (z - row.lower) + (lambda ? lambda[i] : 0.0) / sq;
+        e[i] = f[i] * (z - row.lower) + lambda[i] / sq;
         break;
       case RowKind::kBounds: {
-        const double a = sq * (row.lower - z) / row.scale + (lambda ? lambda[i] : 0.0) / sq;
-        const double b =
-            sq * (z - row.upper) / row.scale + (lambda_upper ? lambda_upper[i] : 0.0) / sq;
+        const double a = sq * (row.lower - z) / row.scale + lambda[i] / sq;
+        const double b = sq * (z - row.upper) / row.scale + lambda_upper[i] / sq;
         e[i] = std::max(0.0, a) - std::max(0.0, b);
         f[i] = -(sq / row.scale) * ((a > 0 ? 1.0 : 0.0) + (b > 0 ? 1.0 : 0.0));
         break;
