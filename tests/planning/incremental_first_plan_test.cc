@@ -21,17 +21,7 @@ const std::string kScenes = std::string(KINOGRAPH_SOURCE_DIR) + "/robots/scenes/
 
 double max_abs(const Eigen::MatrixXd& m) { return m.cwiseAbs().maxCoeff(); }
 
-// The tip's position at joint configuration q as a pose goal.
-Goal tip_goal(const Problem& p, const Eigen::VectorXd& q) {
-  dynamics::Data data(*p.model);
-  dynamics::forward_kinematics(*p.model, data, q);
-  Goal g;
-  g.kind = Goal::Kind::kPose;
-  g.frame = "ee";
-  g.pose = dynamics::frame_pose(*p.model, data, p.model->frame_index("ee"));
-  g.position_only = true;
-  return g;
-}
+using testing::tip_goal;
 
 // The RR reach with its ball, and the same with the goal as the tip's position at the joint goal.
 Problem rr_joint_goal() { return load_scene(kScenes + "rr_reach.yaml").problem; }

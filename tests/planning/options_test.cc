@@ -85,17 +85,7 @@ void expect_scaled(const Problem& p, const GraphOptions& options, FactorRole rol
   }
 }
 
-// The tip's position at q as a pose goal (position only).
-Goal tip_goal(const Problem& p, const Eigen::VectorXd& q) {
-  dynamics::Data data(*p.model);
-  dynamics::forward_kinematics(*p.model, data, q);
-  Goal g;
-  g.kind = Goal::Kind::kPose;
-  g.frame = "ee";
-  g.pose = dynamics::frame_pose(*p.model, data, p.model->frame_index("ee"));
-  g.position_only = true;
-  return g;
-}
+using testing::tip_goal;
 
 TEST(GraphOptions, CollocationScale) {
   GraphOptions o;
@@ -312,28 +302,7 @@ TEST(DfgOptions, ConstraintScaleOfTheEquationRows) {
 // ValidationThresholds: each threshold decides its own check.
 
 // The RR arm holding still at q* for 1 s over 10 steps (validate_test's fixture).
-struct Still {
-  Problem problem;
-  Plan plan;
-  Still() {
-    problem.model = testing::load_robot("robots/rr/rr.urdf");
-    problem.horizon = 1;
-    problem.steps = 10;
-    const Eigen::Vector2d q(0.5, -0.3);
-    problem.start_q = q;
-    problem.start_qd = Eigen::Vector2d::Zero();
-    problem.goal.q = q;
-    const int rows = problem.steps + 1;
-    plan.q = q.transpose().replicate(rows, 1);
-    plan.qd = Eigen::MatrixXd::Zero(rows, 2);
-    plan.qdd = Eigen::MatrixXd::Zero(rows, 2);
-    dynamics::Data d(*problem.model);
-    const Eigen::VectorXd tau =
-        dynamics::rnea(*problem.model, d, q, Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero());
-    plan.tau = tau.transpose().replicate(rows, 1);
-    for (int k = 0; k < rows; ++k) plan.t.push_back(0.1 * k);
-  }
-};
+using Still = testing::StillRr;
 
 TEST(ValidationThresholds, Dynamics) {
   Still f;

@@ -6,6 +6,7 @@
 #include <memory>
 #include <string>
 
+#include "kinograph/dynamics/inverse_dynamics.h"
 #include "kinograph/dynamics/kinematics.h"
 #include "kinograph/dynamics/payload.h"
 #include "kinograph/planning/plan.h"
@@ -78,5 +79,42 @@ inline Problem iiwa_swing(int steps = 20) {
   p.goal.q = qg;
   return p;
 }
+
+/// The tip's position ("ee") at joint configuration q as a position-only pose goal.
+inline Goal tip_goal(const Problem& p, const Eigen::VectorXd& q) {
+  dynamics::Data data(*p.model);
+  dynamics::forward_kinematics(*p.model, data, q);
+  Goal g;
+  g.kind = Goal::Kind::kPose;
+  g.frame = "ee";
+  g.pose = dynamics::frame_pose(*p.model, data, p.model->frame_index("ee"));
+  g.position_only = true;
+  return g;
+}
+
+/// The RR arm holding still at q* = (0.5, −0.3) for 1 s over 10 steps, with its exact plan
+/// (consistent, within limits, τ = gravity torque): a plan for validation tests to doctor.
+struct StillRr {
+  Problem problem;
+  Plan plan;
+  StillRr() {
+    problem.model = load_robot("robots/rr/rr.urdf");
+    problem.horizon = 1;
+    problem.steps = 10;
+    const Eigen::Vector2d q(0.5, -0.3);
+    problem.start_q = q;
+    problem.start_qd = Eigen::Vector2d::Zero();
+    problem.goal.q = q;
+    const int rows = problem.steps + 1;
+    plan.q = q.transpose().replicate(rows, 1);
+    plan.qd = Eigen::MatrixXd::Zero(rows, 2);
+    plan.qdd = Eigen::MatrixXd::Zero(rows, 2);
+    dynamics::Data d(*problem.model);
+    const Eigen::VectorXd tau =
+        dynamics::rnea(*problem.model, d, q, Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero());
+    plan.tau = tau.transpose().replicate(rows, 1);
+    for (int k = 0; k < rows; ++k) plan.t.push_back(0.1 * k);
+  }
+};
 
 }  // namespace kinograph::planning::testing

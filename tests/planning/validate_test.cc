@@ -5,33 +5,13 @@
 
 #include "kinograph/dynamics/inverse_dynamics.h"
 
+#include "tests/planning/test_problems.h"
+
 namespace kinograph::planning {
 namespace {
 
 // The RR arm holding still at q* for 1 s: consistent, within limits, τ = gravity torque.
-struct Fixture {
-  Problem problem;
-  Plan plan;
-  Fixture() {
-    problem.model = std::make_shared<const dynamics::Model>(
-        dynamics::Model::from_urdf_file(std::string(KINOGRAPH_SOURCE_DIR) + "/robots/rr/rr.urdf"));
-    problem.horizon = 1;
-    problem.steps = 10;
-    const Eigen::Vector2d q(0.5, -0.3);
-    problem.start_q = q;
-    problem.start_qd = Eigen::Vector2d::Zero();
-    problem.goal.q = q;
-    const int rows = problem.steps + 1;
-    plan.q = q.transpose().replicate(rows, 1);
-    plan.qd = Eigen::MatrixXd::Zero(rows, 2);
-    plan.qdd = Eigen::MatrixXd::Zero(rows, 2);
-    dynamics::Data d(*problem.model);
-    const Eigen::VectorXd tau =
-        dynamics::rnea(*problem.model, d, q, Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero());
-    plan.tau = tau.transpose().replicate(rows, 1);
-    for (int k = 0; k < rows; ++k) plan.t.push_back(0.1 * k);
-  }
-};
+using Fixture = testing::StillRr;
 
 bool mentions(const Validation& v, const std::string& what) {
   for (const auto& f : v.failures) {

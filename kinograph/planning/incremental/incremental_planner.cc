@@ -270,18 +270,19 @@ void IncrementalPlanner::replace_factors(const ProblemChange& change, const Prob
       default: return timing && k.depends_on_dt();
     }
   };
+  // Copies: the tree stays as it was if building a replacement throws.
   std::vector<FactorEntry> keep, added;
   std::vector<size_t> removed_slots;
+  std::vector<FactorKey> dropped;  // a removed obstacle's keys: no replacement carries them
   const std::set<int> removed_ids(change.remove.begin(), change.remove.end());
-  for (FactorEntry& e : t.entries) {
-    if (replaced(e.key)) {
-      removed_slots.push_back(e.slot);
-      // Multipliers carry to a replacement under the same key; a removed obstacle's go.
-      if (e.key.role == FactorRole::kCollision && removed_ids.count(e.key.index) > 0) {
-        t.constraints.erase(e.key);
-      }
-    } else {
-      keep.push_back(std::move(e));
+  for (const FactorEntry& e : t.entries) {
+    if (!replaced(e.key)) {
+      keep.push_back(e);
+      continue;
+    }
+    removed_slots.push_back(e.slot);
+    if (e.key.role == FactorRole::kCollision && removed_ids.count(e.key.index) > 0) {
+      dropped.push_back(e.key);
     }
   }
   if (change.start_q || change.start_qd) added.push_back(start_entry(next));
@@ -307,6 +308,8 @@ void IncrementalPlanner::replace_factors(const ProblemChange& change, const Prob
     for (FactorEntry& e : collision_entries(next, ctx, o.id, go)) added.push_back(std::move(e));
   }
   for (int id : change.remove) t.contexts.erase(id);
+  // Multipliers carry to a replacement under the same key.
+  for (const FactorKey& k : dropped) t.constraints.erase(k);
   for (const FactorEntry& e : added) {
     if (tracked(e)) t.constraints.bind(e);
   }
