@@ -3,6 +3,7 @@
 #include <cxxabi.h>
 
 #include <atomic>
+#include <cmath>
 #include <cstdlib>
 #include <memory>
 #include <stdexcept>
@@ -106,6 +107,10 @@ double Factor::error(const Values& values) const {
   Eigen::VectorXd r;
   whitened_residual(values, r);
   return 0.5 * r.squaredNorm();
+}
+
+bool all_finite(const Eigen::Ref<const Eigen::MatrixXd>& M) {
+  return std::isfinite((M.array() * 0.0).sum());
 }
 
 int compact_nonzero_rows(Eigen::Ref<Eigen::MatrixXd> J, Eigen::Ref<Eigen::VectorXd> r) {
