@@ -108,6 +108,16 @@ json times(const std::vector<Run>& runs) {
 // A JSON number, NaN for null (NaN is written as null).
 double num(const json& j) { return j.is_number() ? j.get<double>() : std::nan(""); }
 
+// Self and floor clearance of one configuration, as walk() measures them.
+Clearance at(const Problem& problem, const Eigen::VectorXd& q) {
+  Plan still;
+  still.q = q.transpose().replicate(2, 1);
+  still.qd = Eigen::MatrixXd::Zero(2, q.size());
+  Problem one = problem;
+  one.steps = 1;
+  return walk(one, still);
+}
+
 int run(int argc, char** argv) {
   int count = 50;
   std::string json_path;
@@ -136,7 +146,7 @@ int run(int argc, char** argv) {
     planning::GoalSampler goals(desk.problem, iiwa_goal_options(12));
     const std::vector<Eigen::VectorXd> qs = starts.sample(count), qg = goals.sample(count);
     json cases = json::array();
-    int ok = 0, clear = 0;
+    int ok = 0, clear = 0, ok_without = 0;
     double worst_self = std::numeric_limits<double>::infinity(), worst_floor = worst_self;
     std::vector<double> ok_times, horizons;
     for (std::size_t i = 0; i < std::min(qs.size(), qg.size()); ++i) {
@@ -146,11 +156,21 @@ int run(int argc, char** argv) {
       fit_horizon(p);
       horizons.push_back(p.horizon);
       const Run r = plan_once(planner, p);
+      const Run blind = plan_once(planner, without_self_and_floor(p));
+      if (blind.plan.success()) ++ok_without;
       json c = {{"case", i},
                 {"horizon_s", p.horizon},
                 {"success", r.plan.success()},
                 {"status", to_string(r.plan.stats.status)},
-                {"time_s", r.wall_s}};
+                {"time_s", r.wall_s},
+                {"success_without", blind.plan.success()}};
+      const Clearance cs = at(p, p.start_q), cg = at(p, p.goal.q);
+      c["start_q"] = std::vector<double>(p.start_q.data(), p.start_q.data() + p.start_q.size());
+      c["goal_q"] = std::vector<double>(p.goal.q.data(), p.goal.q.data() + p.goal.q.size());
+      c["start_self_m"] = cs.self;
+      c["start_floor_m"] = cs.floor;
+      c["goal_self_m"] = cg.self;
+      c["goal_floor_m"] = cg.floor;
       if (r.plan.success()) {
         ++ok;
         ok_times.push_back(r.wall_s);
@@ -172,6 +192,7 @@ int run(int argc, char** argv) {
                              {"successes", ok},
                              {"success_rate", cases.empty() ? 0.0 : double(ok) / cases.size()},
                              {"successes_clear", clear},
+                             {"successes_without_self_and_floor", ok_without},
                              {"min_self_clearance_m", worst_self},
                              {"min_floor_clearance_m", worst_floor},
                              {"time_s_median", median(ok_times)},
@@ -195,10 +216,21 @@ int run(int argc, char** argv) {
       without.push_back(plan_once(planner, without_self_and_floor(p)));
     }
     int with_clear = 0, without_unclear = 0;
+    json failed = json::array();
     for (std::size_t i = 0; i < with.size(); ++i) {
       if (with[i].plan.success()) {
         const Clearance c = walk(scene.problem, with[i].plan);
         if (c.self >= 0 && c.floor >= 0) ++with_clear;
+      } else {
+        const Clearance g = at(scene.problem, with[i].plan.q.bottomRows(1).transpose());
+        const Eigen::VectorXd qg = with[i].plan.q.bottomRows(1).transpose();
+        failed.push_back({{"goal", i},
+                          {"goal_q", std::vector<double>(qg.data(), qg.data() + qg.size())},
+                          {"status", to_string(with[i].plan.stats.status)},
+                          {"reason", with[i].plan.stats.reason},
+                          {"goal_self_m", g.self},
+                          {"goal_floor_m", g.floor},
+                          {"without_success", without[i].plan.success()}});
       }
       if (without[i].plan.success()) {
         const Clearance c = walk(scene.problem, without[i].plan);
@@ -209,7 +241,8 @@ int run(int argc, char** argv) {
                    {"without", times(without)},
                    {"with_successes_clear", with_clear},
                    {"without_successes_self_or_floor_colliding", without_unclear},
-                   {"goal_candidates_drawn", sampler.attempts()}};
+                   {"goal_candidates_drawn", sampler.attempts()},
+                   {"with_failed", failed}};
     std::cerr << key << ": " << result[key].dump() << "\n";
   }
   result["settings"] = {{"count", count},
@@ -219,11 +252,13 @@ int run(int argc, char** argv) {
   if (!json_path.empty()) std::ofstream(json_path) << result.dump(2) << "\n";
 
   const json& r = result["random_desk"];
-  std::cout << "| random desk moves | success | clear successes | min self clearance (mm) | "
+  std::cout << "| random desk moves | success | without self / floor | clear successes | min self "
+               "clearance (mm) | "
                "min floor clearance (mm) | median time (ms) | median horizon (s) |\n"
-               "|---|---|---|---|---|---|---|\n";
-  std::cout << "| " << r["cases"] << " | " << r["successes"] << " | " << r["successes_clear"]
-            << " | " << cell(num(r["min_self_clearance_m"]), 1e3, 1) << " | "
+               "|---|---|---|---|---|---|---|---|\n";
+  std::cout << "| " << r["cases"] << " | " << r["successes"] << " | "
+            << r["successes_without_self_and_floor"] << " | " << r["successes_clear"] << " | "
+            << cell(num(r["min_self_clearance_m"]), 1e3, 1) << " | "
             << cell(num(r["min_floor_clearance_m"]), 1e3, 1) << " | "
             << cell(num(r["time_s_median"]), 1e3) << " | " << cell(num(r["horizon_s_median"]), 1, 1)
             << " |\n\n";

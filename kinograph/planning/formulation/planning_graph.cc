@@ -157,7 +157,8 @@ namespace {
 // Hinges of `context` at every free state and sub-step, keyed by `role` and `obstacle`.
 std::vector<FactorEntry> hinge_entries(const Problem& problem,
                                        const std::shared_ptr<CollisionContext>& context,
-                                       FactorRole role, int obstacle, const GraphOptions& options) {
+                                       FactorRole role, int obstacle, double epsilon,
+                                       const GraphOptions& options) {
   std::vector<FactorEntry> out;
   if (!context || context->num_pairs == 0) return out;
   const Objectives& obj = problem.objectives;
@@ -166,15 +167,15 @@ std::vector<FactorEntry> hinge_entries(const Problem& problem,
   for (int k = 0; k <= N; ++k) {
     if (k > 0) {  // the start state is fixed; its clearance is checked before planning
       out.push_back(make_entry(
-          std::make_shared<CollisionFactor>(k, 0.0, dt, obj.collision_epsilon,
-                                            options.collision_scale, context),
+          std::make_shared<CollisionFactor>(k, 0.0, dt, epsilon, options.collision_scale,
+                                            context),
           {role, k, 0, obstacle}));
     }
     if (k == N) break;
     for (int i = 1; i <= sub; ++i) {
       out.push_back(make_entry(std::make_shared<CollisionFactor>(
-                                   k, static_cast<double>(i) / (sub + 1), dt,
-                                   obj.collision_epsilon, options.collision_scale, context),
+                                   k, static_cast<double>(i) / (sub + 1), dt, epsilon,
+                                   options.collision_scale, context),
                                {role, k, i, obstacle}));
     }
   }
@@ -186,7 +187,8 @@ std::vector<FactorEntry> hinge_entries(const Problem& problem,
 std::vector<FactorEntry> collision_entries(const Problem& problem,
                                            const std::shared_ptr<CollisionContext>& context,
                                            int obstacle, const GraphOptions& options) {
-  return hinge_entries(problem, context, FactorRole::kCollision, obstacle, options);
+  return hinge_entries(problem, context, FactorRole::kCollision, obstacle,
+                       problem.objectives.collision_epsilon, options);
 }
 
 std::vector<FactorEntry> self_collision_entries(const Problem& problem,
@@ -197,11 +199,12 @@ std::vector<FactorEntry> self_collision_entries(const Problem& problem,
   if (sf.floor) floor.push_back(floor_obstacle(*sf.floor));
   SelfPairs self{sf.allowed_pairs, problem.objectives.self_collision_epsilon};
   const Objectives& obj = problem.objectives;
+  // The floor takes the self ε too: arms work close to the surface they stand on.
   auto ctx = std::make_shared<CollisionContext>(
-      problem.model, floor,
-      std::max(obj.collision_epsilon, obj.self_collision_epsilon) + options.collision_query_margin,
+      problem.model, floor, obj.self_collision_epsilon + options.collision_query_margin,
       sf.self_collision ? &self : nullptr);
-  return hinge_entries(problem, ctx, FactorRole::kSelfCollision, -1, options);
+  return hinge_entries(problem, ctx, FactorRole::kSelfCollision, -1, obj.self_collision_epsilon,
+                       options);
 }
 
 FactorEntry start_entry(const Problem& problem) {
