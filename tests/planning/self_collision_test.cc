@@ -15,6 +15,7 @@
 #include "kinograph/planning/factors/trajectory_factors.h"
 #include "kinograph/planning/formulation/initialization.h"
 #include "kinograph/planning/formulation/planning_graph.h"
+#include "kinograph/planning/incremental/incremental_planner.h"
 #include "kinograph/planning/io/scene.h"
 #include "kinograph/planning/problem_check.h"
 #include "kinograph/planning/validate.h"
@@ -226,6 +227,30 @@ TEST(SelfCollisionEntries, SelfAndFloorRowsTakeTheSelfEpsilon) {
   const std::vector<RowSpec>& rows = entries[0].constrained->rows();
   EXPECT_GT(rows.size(), 19u + 50u);  // 19 floor rows (the arm's moving geometries and the block)
   for (const RowSpec& r : rows) EXPECT_EQ(r.lower, 0.03);
+}
+
+TEST(IncrementalPlanner, ObstacleChangesKeepTheSelfFactorsAndANewHorizonRebuildsThem) {
+  Problem p = testing::iiwa_swing(10);
+  p.self_and_floor.floor = 0.0;
+  p.self_and_floor.allowed_pairs = {{4, 6}};
+  IncrementalPlanner planner;
+  const Plan first = planner.plan(p);
+  ASSERT_TRUE(first.success()) << failures(first);
+  // An obstacle far away: only its own hinges are added, nothing is replaced.
+  collision::Obstacle ball;
+  ball.id = 3;
+  ball.shape = collision::Shape::sphere(0.05);
+  ball.pose.translation() = Eigen::Vector3d(-1.5, 0, 1.5);
+  const Plan with_ball = planner.add_or_move_obstacle(ball);
+  EXPECT_TRUE(with_ball.success()) << failures(with_ball);
+  EXPECT_EQ(planner.last_stats().factors_replaced, 0);
+  EXPECT_EQ(planner.last_stats().factors_added, 20);  // states 1..10 and one sub-step each
+  // A new horizon replaces every Δt-dependent factor: GP prior and collocation (2 × 10), the
+  // ball's hinges (20) and the self/floor hinges (20), each rebuilt.
+  const Plan longer = planner.set_horizon(2.4);
+  EXPECT_TRUE(longer.success()) << failures(longer);
+  EXPECT_EQ(planner.last_stats().factors_replaced, 60);
+  EXPECT_EQ(planner.last_stats().factors_added, 60);
 }
 
 TEST(CheckProblem, AllowedPairsAndTheSwitchDecideWhatIsInCollision) {
