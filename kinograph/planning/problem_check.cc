@@ -1,10 +1,12 @@
 #include "kinograph/planning/problem_check.h"
 
 #include <cmath>
+#include <memory>
 #include <sstream>
 
 #include "kinograph/collision/collision_world.h"
 #include "kinograph/dynamics/kinematics.h"
+#include "kinograph/planning/clearance_world.h"
 
 namespace kinograph::planning {
 namespace {
@@ -22,12 +24,18 @@ std::string joint_list_outside(const dynamics::Model& model, const Eigen::Vector
   return os.str();
 }
 
-double min_clearance(const Problem& problem, const Eigen::VectorXd& q) {
-  collision::CollisionWorld world(*problem.model);
-  for (const auto& o : problem.obstacles) world.add_obstacle(o);
+// Why configuration q (the start or the goal) is in collision, naming the pair and the depth;
+// empty when it is clear of obstacles, the floor and its own links.
+std::string collision_at(const Problem& problem, const Eigen::VectorXd& q, const char* what) {
+  const std::unique_ptr<collision::CollisionWorld> world = clearance_world(problem);
   dynamics::Data data(*problem.model);
   dynamics::forward_kinematics(*problem.model, data, q);
-  return world.closest(data, 0).distance;
+  const collision::Proximity p = world->closest(data, 0);
+  if (!(p.distance < 0)) return "";
+  std::ostringstream os;
+  os << "the " << what << " configuration is in collision: " << describe_pair(*problem.model, p)
+     << " overlap by " << -p.distance << " m";
+  return os.str();
 }
 
 }  // namespace
@@ -45,7 +53,7 @@ std::string check_problem(const Problem& p) {
   if (!p.start_q.allFinite() || !p.start_qd.allFinite()) return "start state holds NaN or inf";
   if (!(p.objectives.qc > 0) || !std::isfinite(p.objectives.qc)) return "Qc must be positive";
   if (!(p.objectives.min_torque >= 0) || !(p.objectives.collision_epsilon >= 0) ||
-      !(p.objectives.limit_epsilon >= 0))
+      !(p.objectives.self_collision_epsilon >= 0) || !(p.objectives.limit_epsilon >= 0))
     return "objective weights and margins must be non-negative numbers";
   std::string r = joint_list_outside(model, p.start_q, "start");
   if (!r.empty()) return r;
@@ -69,11 +77,11 @@ std::string check_problem(const Problem& p) {
       return "task-constraint frame '" + t.frame + "' is not in the model";
     }
   }
-  if (!p.obstacles.empty()) {
+  if (has_clearance_checks(p)) {
     try {
-      if (min_clearance(p, p.start_q) < 0) return "the start configuration is in collision";
-      if (p.goal.kind == Goal::Kind::kJoint && min_clearance(p, p.goal.q) < 0)
-        return "the goal configuration is in collision";
+      r = collision_at(p, p.start_q, "start");
+      if (r.empty() && p.goal.kind == Goal::Kind::kJoint) r = collision_at(p, p.goal.q, "goal");
+      if (!r.empty()) return r;
     } catch (const std::exception& e) {
       return std::string("bad obstacle: ") + e.what();
     }

@@ -9,6 +9,7 @@
 #include "kinograph/collision/segment_checker.h"
 #include "kinograph/dynamics/inverse_dynamics.h"
 #include "kinograph/dynamics/kinematics.h"
+#include "kinograph/planning/clearance_world.h"
 #include "kinograph/planning/factors/pose_error.h"
 
 namespace kinograph::planning {
@@ -193,48 +194,54 @@ void check_tasks(const Problem& problem, const Plan& plan, dynamics::Data& data,
   }
 }
 
-// Collision: every step and dense samples along the validator's Hermite interpolation.
+// Clearance (obstacles, the floor, self pairs): every step and dense samples along the
+// validator's Hermite interpolation; a failure names the closest pair, its time and depth.
 void check_collision(const Problem& problem, const Plan& plan,
                      const ValidationThresholds& thresholds, dynamics::Data& data, Validation& v) {
   const dynamics::Model& model = *problem.model;
   const int n = model.nq(), N = problem.steps, rows = N + 1;
   const double dt = problem.dt();
-  collision::CollisionWorld world(model);
-  bool ok = true;
-  for (const collision::Obstacle& o : problem.obstacles) {
-    const collision::Status s = world.add_obstacle(o);
-    if (!s.ok) {
-      add_failure(v, "obstacle " + std::to_string(o.id) + ": " + s.reason);
-      ok = false;
+  std::unique_ptr<collision::CollisionWorld> world;
+  try {
+    world = clearance_world(problem);
+  } catch (const std::invalid_argument& e) {
+    add_failure(v, e.what());
+    return;
+  }
+  // The validator's Hermite interpolation sampled `sub` times per interval, walked by
+  // conservative advancement: stretches far from everything cost one query, and near
+  // something the samples are as dense as the segment checker's sweep step.
+  collision::SegmentChecker checker(model);
+  const int sub = std::max(1, thresholds.collision_samples);
+  Eigen::MatrixXd path(N * sub + 1, n);
+  std::vector<double> times(N * sub + 1);
+  const bool timed = plan.t.size() == static_cast<size_t>(rows);
+  for (int k = 0; k < N; ++k) {
+    for (int i = 0; i < sub; ++i) {
+      const double s = static_cast<double>(i) / sub;
+      path.row(k * sub + i) =
+          i == 0 ? Eigen::VectorXd(plan.q.row(k).transpose()) : hermite(plan, k, s, dt);
+      times[k * sub + i] = (timed ? plan.t[k] : k * dt) + s * dt;
     }
   }
-  if (ok) {
-    // The validator's Hermite interpolation sampled `sub` times per interval, walked by
-    // conservative advancement: stretches far from every obstacle cost one query, and near
-    // one the samples are as dense as the segment checker's sweep step.
-    collision::SegmentChecker checker(model);
-    const int sub = std::max(1, thresholds.collision_samples);
-    Eigen::MatrixXd path(N * sub + 1, n);
-    std::vector<double> times(N * sub + 1);
-    const bool timed = plan.t.size() == static_cast<size_t>(rows);
-    for (int k = 0; k < N; ++k) {
-      for (int i = 0; i < sub; ++i) {
-        const double s = static_cast<double>(i) / sub;
-        path.row(k * sub + i) =
-            i == 0 ? Eigen::VectorXd(plan.q.row(k).transpose()) : hermite(plan, k, s, dt);
-        times[k * sub + i] = (timed ? plan.t[k] : k * dt) + s * dt;
-      }
+  path.row(N * sub) = plan.q.row(N);
+  times[N * sub] = timed ? plan.t[N] : N * dt;
+  const collision::PathCheckResult r =
+      checker.check_path(*world, data, path, times, thresholds.min_clearance);
+  v.min_clearance = std::min(v.min_clearance, r.min_distance);
+  if (r.min_distance < thresholds.min_clearance) {
+    const size_t at = std::min(static_cast<size_t>(r.segment), times.size() - 1);
+    const double t =
+        at + 1 < times.size() ? times[at] + r.s * (times[at + 1] - times[at]) : times[at];
+    std::ostringstream os;
+    os << "collision: " << describe_pair(model, r.closest);
+    if (r.min_distance < 0) {
+      os << " overlap by " << -r.min_distance << " m";
+    } else {
+      os << " are " << r.min_distance << " m apart";
     }
-    path.row(N * sub) = plan.q.row(N);
-    times[N * sub] = timed ? plan.t[N] : N * dt;
-    const collision::PathCheckResult r =
-        checker.check_path(world, data, path, times, thresholds.min_clearance);
-    v.min_clearance = std::min(v.min_clearance, r.min_distance);
-    if (v.min_clearance < thresholds.min_clearance) {
-      std::ostringstream os;
-      os << "collision: clearance " << v.min_clearance << " m below " << thresholds.min_clearance;
-      add_failure(v, os.str());
-    }
+    os << " at t = " << t << " s (required clearance " << thresholds.min_clearance << " m)";
+    add_failure(v, os.str());
   }
 }
 
@@ -249,7 +256,7 @@ Validation validate(const Problem& problem, const Plan& plan,
   check_start_and_goal(problem, plan, thresholds, data, v);
   check_tasks(problem, plan, data, v);
   // The only costly check; a caller that only needs the verdict skips it once another failed.
-  if (!problem.obstacles.empty() && !(verdict_only && !v.failures.empty())) {
+  if (has_clearance_checks(problem) && !(verdict_only && !v.failures.empty())) {
     check_collision(problem, plan, thresholds, data, v);
   }
   v.valid = v.failures.empty();

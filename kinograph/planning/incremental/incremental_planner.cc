@@ -289,6 +289,7 @@ void IncrementalPlanner::replace_factors(const ProblemChange& change, const Prob
   if (change.goal) added.push_back(goal_entry(next, t.workspace, go));
   if (timing) {
     for (FactorEntry& e : timing_entries(next, go)) added.push_back(std::move(e));
+    for (FactorEntry& e : self_collision_entries(next, go)) added.push_back(std::move(e));
   }
   for (const collision::Obstacle& o : next.obstacles) {
     if (!timing && changed_obstacles.count(o.id) == 0) continue;

@@ -66,6 +66,11 @@ struct Scene {
   std::vector<std::pair<std::string, LimitOverride>> limits;
   /// Obstacle names; problem.obstacles[i] has id i and the name obstacle_names[i].
   std::vector<std::string> obstacle_names;
+  std::string srdf;       ///< robot.srdf as written in the file; empty when none
+  std::string srdf_path;  ///< robot.srdf resolved to an absolute path
+  /// The scene's allowed_collisions link pairs, as named; problem.self_and_floor.allowed_pairs
+  /// holds their bodies and the SRDF's.
+  std::vector<std::pair<std::string, std::string>> allowed_collisions;
   PlannerSpec planner;
   /// The problem; problem.model is the URDF with payload attached and overrides applied.
   Problem problem;
