@@ -252,7 +252,8 @@ horizon: 2
 steps: 10
 start: {q: [0, 0, 0, 0, 0, 0, 0]}
 goal: {q: [0.1, 0, 0, 0, 0, 0, 0]}
-limits: {iiwa_joint_2: {velocity: 0.5, lower: -1}, iiwa_joint_7: {effort: 0}}
+limits: {iiwa_joint_2: {velocity: 0.5, lower: -1}}
+unactuated: [iiwa_joint_7]
 obstacles:
   - {id: post, shape: cylinder, size: [0.1, 0.4], position: [0.5, 0, 0.2], rpy: [0.3, 0, 0]}
   - id: ball

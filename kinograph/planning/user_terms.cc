@@ -1,0 +1,34 @@
+#include "kinograph/planning/user_terms.h"
+
+#include <iomanip>
+#include <sstream>
+
+namespace kinograph::planning {
+
+std::string joint_label(const dynamics::Model& model, int joint) {
+  return "joint " + std::to_string(joint + 1) + " (" + model.bodies[joint].joint_name + ")";
+}
+
+std::string joint_unit(const dynamics::Model& model, int joint, int derivative) {
+  const bool prismatic = model.bodies[joint].joint_type == dynamics::JointType::kPrismatic;
+  switch (derivative) {
+    case 0: return prismatic ? "m" : "rad";
+    case 1: return prismatic ? "m/s" : "rad/s";
+    case 2: return prismatic ? "m/s²" : "rad/s²";
+    default: return prismatic ? "N" : "N·m";
+  }
+}
+
+std::string number(double x) {
+  std::ostringstream os;
+  os << std::setprecision(3) << x;
+  return os.str();
+}
+
+std::string at_time(double t) {
+  std::ostringstream os;
+  os << "t = " << std::setprecision(4) << t << " s";
+  return os.str();
+}
+
+}  // namespace kinograph::planning
