@@ -369,6 +369,10 @@ TEST(PlanFile, ErrorsNameTheKey) {
   expect("limits.effort", [](json& j) { j["limits"]["effort"] = {1, 2}; });
   expect("'q'", [](json& j) { j.erase("q"); });
   expect("iiwa_joint_3", [](json& j) { j["joint_names"][2] = "elbow"; });
+  // Passive joints are named, never written as effort 0.
+  expect("joint 'iiwa_joint_2' has effort limit 0", [](json& j) { j["limits"]["effort"][1] = 0; });
+  expect("no joint 'elbow'", [](json& j) { j["unactuated"] = {"elbow"}; });
+  expect("'unactuated'", [](json& j) { j["unactuated"] = "iiwa_joint_7"; });
   EXPECT_THROW(read_plan_file("/no/such/plan.json"), PlanFileError);
 }
 

@@ -10,6 +10,8 @@
 
 #include "kinograph/dynamics/inverse_dynamics.h"
 #include "kinograph/planning/batch/batch_planner.h"
+#include "kinograph/planning/factors/dynamics_factors.h"
+#include "kinograph/planning/formulation/dfg_builder.h"
 #include "kinograph/planning/formulation/planning_graph.h"
 #include "kinograph/planning/motion_bounds.h"
 #include "kinograph/planning/solver/violation_text.h"
@@ -215,6 +217,34 @@ TEST(ViolationText, CollisionRowNamesLinkAndObstacle) {
   EXPECT_TRUE(has(text, "link 'link")) << text;
   EXPECT_TRUE(has(text, "obstacle 1")) << text;
   EXPECT_TRUE(has(text, "t = ")) << text;
+}
+
+// Both formulations' torque rows map to the same joints: the Acrobot's passive shoulder is
+// row 0 of the condensed factor and of the DFG's torque rows.
+TEST(ViolationText, TorqueRowsOfBothFormulationsNameTheJoint) {
+  Problem p = testing::acrobot_swingup();
+  const auto workspace = std::make_shared<dynamics::Data>(*p.model);
+  const FactorKey key{FactorRole::kDynamics, 55, 0, -1};
+  const FactorEntry condensed =
+      make_entry(std::make_shared<DynamicsStepFactor>(55, p.model, workspace,
+                                                      DynamicsStepOptions{}),
+                 key);
+  const FactorEntry dfg =
+      make_entry(std::make_shared<DfgTorqueRowsFactor>(*p.model, 55, DynamicsStepOptions{}), key);
+  for (const FactorEntry* e : {&condensed, &dfg}) {
+    ConstraintReport r;
+    r.entry = e;
+    r.row = 0;
+    r.value = 0.166;
+    r.violation = r.scaled_violation = 0.166;
+    EXPECT_EQ(describe_violation(p, r), "joint 1 (shoulder) is unactuated but needs 0.166 N·m at "
+                                        "t = 5.5 s");
+    r.row = 1;  // the elbow's ±8 N·m bound
+    r.value = -8.6;
+    r.violation = r.scaled_violation = 0.6;
+    EXPECT_EQ(describe_violation(p, r),
+              "joint 2 (elbow) torque -8.6 N·m exceeds its 8 N·m limit by 0.6 N·m at t = 5.5 s");
+  }
 }
 
 // The batch planner's failure reason is the same description, not solver internals.

@@ -9,6 +9,7 @@
 #include "kinograph/planning/factors/pose_factors.h"
 #include "kinograph/planning/factors/state_target_factor.h"
 #include "kinograph/planning/factors/trajectory_factors.h"
+#include "kinograph/planning/formulation/dfg_builder.h"
 #include "kinograph/planning/user_terms.h"
 
 namespace kinograph::planning {
@@ -98,13 +99,22 @@ std::string describe_violation(const Problem& problem, const ConstraintReport& w
     const StateLimitFactor::Limit& l = lim->limits()[worst.row];
     return limit_text(model, l.variable, l.joint, z, row, worst.violation, t);
   }
-  if (const auto* dyn = dynamic_cast<const DynamicsStepFactor*>(&f)) {
-    const int j = dyn->joint_of_row()[worst.row];
+  const auto torque_text = [&](int j) {
     if (row.kind == RowKind::kEquality) {
       return joint_label(model, j) + " is unactuated but needs " + number(z) + " " +
              joint_unit(model, j, 3) + " at " + at_time(t);
     }
     return limit_text(model, 3, j, z, row, worst.violation, t);
+  };
+  if (const auto* dyn = dynamic_cast<const DynamicsStepFactor*>(&f)) {
+    return torque_text(dyn->joint_of_row()[worst.row]);
+  }
+  if (dynamic_cast<const DfgTorqueRowsFactor*>(&f) != nullptr) {
+    // The same rows as the condensed factor's; their constraint rows come first and do not
+    // depend on the margins or the soft weight.
+    std::vector<int> joints;
+    DynamicsStepFactor::rows_for(model, DynamicsStepOptions{}, &joints);
+    if (worst.row < static_cast<int>(joints.size())) return torque_text(joints[worst.row]);
   }
   if (const auto* col = dynamic_cast<const CollisionFactor*>(&f)) {
     return collision_text(*col, worst.row, z, row);
