@@ -66,11 +66,12 @@ std::string check_horizon(const Problem& p) {
     std::string why = joint_label(model, j) + " must move " + number(std::abs(d)) + " " + u;
     if (v0 != 0) why += " from " + number(v0) + " " + uv;
     if (l.velocity == 0) return why + " but its velocity limit is 0";
-    why += " and needs " + number(t) + " s at its velocity limit " + number(l.velocity) + " " + uv;
+    const auto [needs, horizon] = distinct_numbers(t, p.horizon);
+    why += " and needs " + needs + " s at its velocity limit " + number(l.velocity) + " " + uv;
     if (std::isfinite(l.acceleration)) {
       why += " and acceleration limit " + number(l.acceleration) + " " + joint_unit(model, j, 2);
     }
-    return why + "; the horizon is " + number(p.horizon) + " s";
+    return why + "; the horizon is " + horizon + " s";
   }
   return "";
 }

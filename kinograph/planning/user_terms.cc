@@ -19,10 +19,16 @@ std::string joint_unit(const dynamics::Model& model, int joint, int derivative) 
   }
 }
 
-std::string number(double x) {
+std::string number(double x, int digits) {
   std::ostringstream os;
-  os << std::setprecision(3) << x;
+  os << std::setprecision(digits) << x;
   return os.str();
+}
+
+std::pair<std::string, std::string> distinct_numbers(double x, double y) {
+  int digits = 3;
+  while (digits < 17 && x != y && number(x, digits) == number(y, digits)) ++digits;
+  return {number(x, digits), number(y, digits)};
 }
 
 std::string at_time(double t) {

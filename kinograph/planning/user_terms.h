@@ -2,6 +2,7 @@
 // How planning messages name things for the user: joints by number and URDF name, values with
 // their units, times in seconds.
 #include <string>
+#include <utility>
 
 #include "kinograph/dynamics/model.h"
 
@@ -14,8 +15,12 @@ std::string joint_label(const dynamics::Model& model, int joint);
 /// acceleration, 3 effort (N·m or N).
 std::string joint_unit(const dynamics::Model& model, int joint, int derivative);
 
-/// A number as messages print it (3 significant digits, no trailing zeros).
-std::string number(double x);
+/// A number as messages print it (`digits` significant digits, no trailing zeros).
+std::string number(double x, int digits = 3);
+
+/// `x` and `y` printed with the fewest significant digits (3 or more) that tell them apart, so
+/// "needs 2.001 s; the horizon is 2 s" never reads "needs 2 s; the horizon is 2 s".
+std::pair<std::string, std::string> distinct_numbers(double x, double y);
 
 /// "t = 5.5 s".
 std::string at_time(double t);
