@@ -123,14 +123,16 @@ class Loader {
            model_.bodies[body].joint_name + "') but has no <inertial>");
     }
     for (const auto& c : link->collision_array) {
-      if (!c || !c->geometry) fail("link '" + link->name + "'" + outline_.link_line(link->name) +
-                                   ": a <collision> without a usable <geometry>");
+      if (!c || !c->geometry)
+        fail("link '" + link->name + "'" + outline_.link_line(link->name) +
+             ": a <collision> without a usable <geometry>");
       add_geometry(*c->geometry, c->origin, link->name, body, placement, nullptr, "collision",
                    model_.collision);
     }
     for (const auto& v : link->visual_array) {
-      if (!v || !v->geometry) fail("link '" + link->name + "'" + outline_.link_line(link->name) +
-                                   ": a <visual> without a usable <geometry>");
+      if (!v || !v->geometry)
+        fail("link '" + link->name + "'" + outline_.link_line(link->name) +
+             ": a <visual> without a usable <geometry>");
       urdf::MaterialSharedPtr mat = v->material;
       if (!mat && !v->material_name.empty()) mat = urdf_->getMaterial(v->material_name);
       add_geometry(*v->geometry, v->origin, link->name, body, placement, mat.get(), "visual",
@@ -197,9 +199,10 @@ class Loader {
       // Many vendor files write effort="0" as a placeholder; URDF cannot say "passive", so a
       // scene declares unactuated joints itself.
       if (b.limits.effort == 0) {
-        spdlog::warn("{}: {}: effort=\"0\" read as unknown: no torque limit (an unactuated "
-                     "joint is declared in the scene's 'unactuated' list)",
-                     source_, jname);
+        spdlog::warn(
+            "{}: {}: effort=\"0\" read as unknown: no torque limit (an unactuated "
+            "joint is declared in the scene's 'unactuated' list)",
+            source_, jname);
         b.limits.effort = std::numeric_limits<double>::infinity();
       }
     }
@@ -296,10 +299,10 @@ class Loader {
       if (!l) fail("link '" + name + "'" + outline_.link_line(name) + " was not read by urdfdom");
       const auto check = [&](size_t read, const std::vector<int>& lines, const char* kind) {
         if (read == lines.size()) return;
-        fail("link '" + name + "': " + std::to_string(lines.size()) + " <" + kind +
-             "> elements" + (lines.empty() ? "" : " (first on line " + std::to_string(lines.front()) + ")") +
-             " but urdfdom read " +
-             std::to_string(read) + "; one of them has geometry it could not parse");
+        fail("link '" + name + "': " + std::to_string(lines.size()) + " <" + kind + "> elements" +
+             (lines.empty() ? "" : " (first on line " + std::to_string(lines.front()) + ")") +
+             " but urdfdom read " + std::to_string(read) +
+             "; one of them has geometry it could not parse");
       };
       check(l->collision_array.size(), link.collision_lines, "collision");
       check(l->visual_array.size(), link.visual_lines, "visual");

@@ -22,19 +22,32 @@ struct NumericAttribute {
 
 // The URDF attributes urdfdom parses as numbers (urdfdom 3 / URDF spec).
 constexpr NumericAttribute kNumeric[] = {
-    {"origin", "xyz", 3, false},       {"origin", "rpy", 3, false},
-    {"axis", "xyz", 3, false},         {"limit", "lower", 1, false},
-    {"limit", "upper", 1, false},      {"limit", "effort", 1, false},
-    {"limit", "velocity", 1, false},   {"dynamics", "damping", 1, false},
-    {"dynamics", "friction", 1, false}, {"mass", "value", 1, false},
-    {"inertia", "ixx", 1, false},      {"inertia", "ixy", 1, false},
-    {"inertia", "ixz", 1, false},      {"inertia", "iyy", 1, false},
-    {"inertia", "iyz", 1, false},      {"inertia", "izz", 1, false},
-    {"box", "size", 3, true},          {"cylinder", "radius", 1, true},
-    {"cylinder", "length", 1, true},   {"sphere", "radius", 1, true},
-    {"mesh", "scale", 3, false},       {"color", "rgba", 4, false},
-    {"mimic", "multiplier", 1, false}, {"mimic", "offset", 1, false},
-    {"calibration", "rising", 1, false}, {"calibration", "falling", 1, false},
+    {"origin", "xyz", 3, false},
+    {"origin", "rpy", 3, false},
+    {"axis", "xyz", 3, false},
+    {"limit", "lower", 1, false},
+    {"limit", "upper", 1, false},
+    {"limit", "effort", 1, false},
+    {"limit", "velocity", 1, false},
+    {"dynamics", "damping", 1, false},
+    {"dynamics", "friction", 1, false},
+    {"mass", "value", 1, false},
+    {"inertia", "ixx", 1, false},
+    {"inertia", "ixy", 1, false},
+    {"inertia", "ixz", 1, false},
+    {"inertia", "iyy", 1, false},
+    {"inertia", "iyz", 1, false},
+    {"inertia", "izz", 1, false},
+    {"box", "size", 3, true},
+    {"cylinder", "radius", 1, true},
+    {"cylinder", "length", 1, true},
+    {"sphere", "radius", 1, true},
+    {"mesh", "scale", 3, false},
+    {"color", "rgba", 4, false},
+    {"mimic", "multiplier", 1, false},
+    {"mimic", "offset", 1, false},
+    {"calibration", "rising", 1, false},
+    {"calibration", "falling", 1, false},
     {"safety_controller", "soft_lower_limit", 1, false},
     {"safety_controller", "soft_upper_limit", 1, false},
     {"safety_controller", "k_position", 1, false},
@@ -104,8 +117,9 @@ class Outliner {
   // xacro macros, properties and substitutions survive into the text only when it was never
   // expanded; urdfdom would skip the macros and read the rest, silently losing links.
   void check_not_xacro(const TiXmlElement* e) const {
-    const std::string kExpand = "this is a xacro file: expand it with xacro first "
-                                "(xacro robot.urdf.xacro > robot.urdf)";
+    const std::string kExpand =
+        "this is a xacro file: expand it with xacro first "
+        "(xacro robot.urdf.xacro > robot.urdf)";
     if (std::strncmp(e->Value(), "xacro:", 6) == 0) {
       fail(e->Row(), std::string("<").append(e->Value()).append(">: ") + kExpand);
     }
@@ -129,8 +143,8 @@ class Outliner {
       if (std::strcmp(e->Value(), spec.element) != 0) continue;
       const char* text = e->Attribute(spec.attribute);
       if (text == nullptr) continue;
-      const std::string where = label + " " + path + "<" + e->Value() + " " + spec.attribute +
-                                "='" + text + "'>";
+      const std::string where =
+          label + " " + path + "<" + e->Value() + " " + spec.attribute + "='" + text + "'>";
       if (!parse_numbers(text, values)) fail(e->Row(), where + ": not a number");
       if (static_cast<int>(values.size()) != spec.count) {
         fail(e->Row(), where + ": needs " + std::to_string(spec.count) +

@@ -90,11 +90,11 @@ std::string check_goal_holding(const Problem& p) {
   constexpr double kSlack = 0.05;
   for (int j = 0; j < n; ++j) {
     const double tau = data.tau[j];
-    const double margin = 2 * kSlack *
-                              (data.dtau_dq.row(j).cwiseAbs().sum() +
-                               data.M.row(j).cwiseAbs().sum() +
-                               data.dtau_dqd.row(j).cwiseAbs().sum()) +
-                          2e-3;
+    const double margin =
+        2 * kSlack *
+            (data.dtau_dq.row(j).cwiseAbs().sum() + data.M.row(j).cwiseAbs().sum() +
+             data.dtau_dqd.row(j).cwiseAbs().sum()) +
+        2e-3;
     const dynamics::Body& b = model.bodies[j];
     const std::string u = joint_unit(model, j, 3);
     if (!b.actuated && std::abs(tau) > margin) {

@@ -12,10 +12,14 @@ std::string joint_label(const dynamics::Model& model, int joint) {
 std::string joint_unit(const dynamics::Model& model, int joint, int derivative) {
   const bool prismatic = model.bodies[joint].joint_type == dynamics::JointType::kPrismatic;
   switch (derivative) {
-    case 0: return prismatic ? "m" : "rad";
-    case 1: return prismatic ? "m/s" : "rad/s";
-    case 2: return prismatic ? "m/s²" : "rad/s²";
-    default: return prismatic ? "N" : "N·m";
+    case 0:
+      return prismatic ? "m" : "rad";
+    case 1:
+      return prismatic ? "m/s" : "rad/s";
+    case 2:
+      return prismatic ? "m/s²" : "rad/s²";
+    default:
+      return prismatic ? "N" : "N·m";
   }
 }
 

@@ -145,16 +145,16 @@ void check_start_and_goal(const Problem& problem, const Plan& plan,
   if (problem.start_q.size() == n) start_row(plan.q, problem.start_q, 0);
   if (problem.start_qd.size() == n) start_row(plan.qd, problem.start_qd, 1);
   if (v.start_error > thresholds.start)
-    add_failure(v, fmt("start state error", v.start_error, thresholds.start) + " (" +
-                       start_worst + " at t = 0)");
+    add_failure(v, fmt("start state error", v.start_error, thresholds.start) + " (" + start_worst +
+                       " at t = 0)");
   std::string final_worst;
   for (int j = 0; j < n; ++j) {
     for (int d = 1; d <= 2; ++d) {
       const double x = d == 1 ? plan.qd(N, j) : plan.qdd(N, j);
       if (std::abs(x) <= v.final_velocity) continue;
       v.final_velocity = std::abs(x);
-      final_worst = joint_label(model, j) + (d == 1 ? " velocity " : " acceleration ") +
-                    number(x) + " " + joint_unit(model, j, d);
+      final_worst = joint_label(model, j) + (d == 1 ? " velocity " : " acceleration ") + number(x) +
+                    " " + joint_unit(model, j, d);
     }
   }
   if (v.final_velocity > thresholds.final_velocity)
@@ -188,9 +188,9 @@ void check_start_and_goal(const Problem& problem, const Plan& plan,
       v.goal_error = problem.goal.position_only ? e.position : std::max(e.position, e.rotation);
       goal_worst = "frame '" + problem.goal.frame + "' ends " + number(e.position) +
                    " m from its goal position" +
-                   (problem.goal.position_only ? ""
-                                               : " and " + number(e.rotation) +
-                                                     " rad from its goal orientation");
+                   (problem.goal.position_only
+                        ? ""
+                        : " and " + number(e.rotation) + " rad from its goal orientation");
     }
   }
   if (v.goal_error > thresholds.goal)
@@ -224,9 +224,9 @@ void check_tasks(const Problem& problem, const Plan& plan, dynamics::Data& data,
     }
     v.max_task_error = std::max(v.max_task_error, worst);
     if (worst > task.tolerance)
-      add_failure(v, fmt(("task constraint on '" + task.frame + "'").c_str(), worst,
-                         task.tolerance) +
-                         " at " + at_time(timed ? plan.t[worst_step] : worst_step * problem.dt()));
+      add_failure(v,
+                  fmt(("task constraint on '" + task.frame + "'").c_str(), worst, task.tolerance) +
+                      " at " + at_time(timed ? plan.t[worst_step] : worst_step * problem.dt()));
   }
 }
 

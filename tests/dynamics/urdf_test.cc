@@ -100,9 +100,9 @@ TEST(UrdfBadInput, NonPositiveSize) {
 TEST(UrdfBadInput, XacroRefusedByNameAndByContent) {
   expect_urdf_error(testing::data_path("arm.urdf.xacro"),
                     {"arm.urdf.xacro", "expand it with xacro first"});
-  expect_urdf_error(testing::data_path("xacro_content.urdf"),
-                    {"xacro_content.urdf", "line 4", "<xacro:property>",
-                     "expand it with xacro first"});
+  expect_urdf_error(
+      testing::data_path("xacro_content.urdf"),
+      {"xacro_content.urdf", "line 4", "<xacro:property>", "expand it with xacro first"});
   // A substitution left in an attribute, without any xacro element.
   try {
     Model::from_urdf_string(R"(<robot name="r"><link name="base">
@@ -129,12 +129,12 @@ TEST(UrdfLoad, ZeroEffortIsUnknownWithAWarning) {
     EXPECT_TRUE(b.actuated) << b.joint_name;
     EXPECT_TRUE(std::isinf(b.limits.effort) && b.limits.effort > 0) << b.joint_name;
   }
-  EXPECT_TRUE(any_has(lines, {"zero_effort.urdf", "joint 'j1' (line 5)", "effort=\"0\"",
-                              "unknown"}));
+  EXPECT_TRUE(
+      any_has(lines, {"zero_effort.urdf", "joint 'j1' (line 5)", "effort=\"0\"", "unknown"}));
   EXPECT_TRUE(any_has(lines, {"joint 'j2' (line 13)", "unknown"}));
   // A file with real limits loads without a warning.
-  EXPECT_TRUE(warnings_of([] { Model::from_urdf_file(testing::robot_path("rr/rr.urdf")); })
-                  .empty());
+  EXPECT_TRUE(
+      warnings_of([] { Model::from_urdf_file(testing::robot_path("rr/rr.urdf")); }).empty());
 }
 
 TEST(UrdfBadInput, MissingFile) {

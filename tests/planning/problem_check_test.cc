@@ -29,11 +29,11 @@ bool has(const std::string& text, const std::string& needle) {
 
 // Hand-worked profiles (V = vmax, A = amax).
 TEST(MinTimeToRest, ClosedForms) {
-  EXPECT_DOUBLE_EQ(min_time_to_rest(2, 0, 1, kInf), 2);       // d / V
-  EXPECT_DOUBLE_EQ(min_time_to_rest(-2, 0.5, 1, kInf), 2);    // start velocity cannot help
-  EXPECT_DOUBLE_EQ(min_time_to_rest(1, 0, kInf, 1), 2);       // triangle: 2√(d/A)
-  EXPECT_DOUBLE_EQ(min_time_to_rest(4, 0, 1, 1), 5);          // d/V + V/A
-  EXPECT_DOUBLE_EQ(min_time_to_rest(1, 1, 1, 1), 1.5);        // coast 0.5 s, brake 1 s
+  EXPECT_DOUBLE_EQ(min_time_to_rest(2, 0, 1, kInf), 2);     // d / V
+  EXPECT_DOUBLE_EQ(min_time_to_rest(-2, 0.5, 1, kInf), 2);  // start velocity cannot help
+  EXPECT_DOUBLE_EQ(min_time_to_rest(1, 0, kInf, 1), 2);     // triangle: 2√(d/A)
+  EXPECT_DOUBLE_EQ(min_time_to_rest(4, 0, 1, 1), 5);        // d/V + V/A
+  EXPECT_DOUBLE_EQ(min_time_to_rest(1, 1, 1, 1), 1.5);      // coast 0.5 s, brake 1 s
   EXPECT_NEAR(min_time_to_rest(0.1, 1, 1, 1), 1 + 2 * std::sqrt(0.4), 1e-12);  // overshoot
   EXPECT_DOUBLE_EQ(min_time_to_rest(1, -1, 1, 1), 1 + 2.5);  // stop, then 1.5 m from rest
   EXPECT_DOUBLE_EQ(min_time_to_rest(0, 0, 1, 1), 0);
@@ -192,9 +192,9 @@ TEST(ViolationText, TorqueRowNamesJointLimitExcessAndTime) {
   double excess = 0;
   int step = -1;
   for (int k = 0; k <= p.steps; ++k) {
-    const Eigen::VectorXd tau = dynamics::rnea(*m, data, init.q.row(k).transpose(),
-                                               init.qd.row(k).transpose(),
-                                               init.qdd.row(k).transpose());
+    const Eigen::VectorXd tau =
+        dynamics::rnea(*m, data, init.q.row(k).transpose(), init.qd.row(k).transpose(),
+                       init.qdd.row(k).transpose());
     if (std::abs(tau[0]) - 1.0 > excess) {
       excess = std::abs(tau[0]) - 1.0;
       step = k;
@@ -228,10 +228,8 @@ TEST(ViolationText, TorqueRowsOfBothFormulationsNameTheJoint) {
   Problem p = testing::acrobot_swingup();
   const auto workspace = std::make_shared<dynamics::Data>(*p.model);
   const FactorKey key{FactorRole::kDynamics, 55, 0, -1};
-  const FactorEntry condensed =
-      make_entry(std::make_shared<DynamicsStepFactor>(55, p.model, workspace,
-                                                      DynamicsStepOptions{}),
-                 key);
+  const FactorEntry condensed = make_entry(
+      std::make_shared<DynamicsStepFactor>(55, p.model, workspace, DynamicsStepOptions{}), key);
   const FactorEntry dfg =
       make_entry(std::make_shared<DfgTorqueRowsFactor>(*p.model, 55, DynamicsStepOptions{}), key);
   for (const FactorEntry* e : {&condensed, &dfg}) {
@@ -240,8 +238,9 @@ TEST(ViolationText, TorqueRowsOfBothFormulationsNameTheJoint) {
     r.row = 0;
     r.value = 0.166;
     r.violation = r.scaled_violation = 0.166;
-    EXPECT_EQ(describe_violation(p, r), "joint 1 (shoulder) is unactuated but needs 0.166 N·m at "
-                                        "t = 5.5 s");
+    EXPECT_EQ(describe_violation(p, r),
+              "joint 1 (shoulder) is unactuated but needs 0.166 N·m at "
+              "t = 5.5 s");
     r.row = 1;  // the elbow's ±8 N·m bound
     r.value = -8.6;
     r.violation = r.scaled_violation = 0.6;

@@ -331,7 +331,8 @@ class SceneParser {
       for (int b = 0; b < model.nq(); ++b) {
         if (model.bodies[b].joint_name == joint) body = b;
       }
-      if (body < 0) r_.fail(list[i], key, "no joint '" + joint + "' in the robot '" + model.name + "'");
+      if (body < 0)
+        r_.fail(list[i], key, "no joint '" + joint + "' in the robot '" + model.name + "'");
       for (const std::string& other : scene.unactuated) {
         if (other == joint) r_.fail(list[i], key, "joint '" + joint + "' is listed twice");
       }

@@ -33,8 +33,8 @@ std::string limit_text(const dynamics::Model& model, int derivative, int joint, 
                                 ? "its limits [" + number(lo) + ", " + number(hi) + "] " + u
                                 : "its " + number(hi) + " " + u + " limit";
   if (over > 0) {
-    return head + (derivative == 0 ? " is outside " : " exceeds ") + limit + " by " +
-           number(over) + " " + u + " at " + at_time(t);
+    return head + (derivative == 0 ? " is outside " : " exceeds ") + limit + " by " + number(over) +
+           " " + u + " at " + at_time(t);
   }
   const double bound = z > 0 ? row.upper : row.lower;
   return head + " is within " + limit + " but past the planner's margin (bound " + number(bound) +
@@ -63,23 +63,35 @@ std::string collision_text(const CollisionFactor& f, int row, double z, const Ro
 
 const char* kind_name(char kind) {
   switch (kind) {
-    case 'q': return "position";
-    case 'v': return "velocity";
-    case 'a': return "acceleration";
-    default: return "value";
+    case 'q':
+      return "position";
+    case 'v':
+      return "velocity";
+    case 'a':
+      return "acceleration";
+    default:
+      return "value";
   }
 }
 
 const char* role_name(FactorRole role) {
   switch (role) {
-    case FactorRole::kStart: return "start";
-    case FactorRole::kGoal: return "goal";
-    case FactorRole::kGpPrior: return "smoothness prior";
-    case FactorRole::kCollocation: return "collocation";
-    case FactorRole::kLimits: return "limits";
-    case FactorRole::kDynamics: return "equations of motion";
-    case FactorRole::kCollision: return "collision";
-    case FactorRole::kTask: return "task constraint";
+    case FactorRole::kStart:
+      return "start";
+    case FactorRole::kGoal:
+      return "goal";
+    case FactorRole::kGpPrior:
+      return "smoothness prior";
+    case FactorRole::kCollocation:
+      return "collocation";
+    case FactorRole::kLimits:
+      return "limits";
+    case FactorRole::kDynamics:
+      return "equations of motion";
+    case FactorRole::kCollision:
+      return "collision";
+    case FactorRole::kTask:
+      return "task constraint";
   }
   return "constraint";
 }
@@ -155,7 +167,8 @@ std::string describe_violation(const Problem& problem, const ConstraintReport& w
 std::string infeasible_reason(const Problem& problem, const OuterLoopResult& result) {
   std::ostringstream os;
   os << "constraints still violated after " << result.outer_iterations << " outer and "
-     << result.iterations << " LM iterations; the worst: " << describe_violation(problem, result.worst);
+     << result.iterations
+     << " LM iterations; the worst: " << describe_violation(problem, result.worst);
   return os.str();
 }
 
