@@ -171,6 +171,10 @@ TEST_F(NodeFixture, AnInvalidGoalIsAnsweredWithInvalidGoal) {
   ASSERT_EQ(plans.size(), 2u);
   EXPECT_EQ(plans[1].goal_id, 14);
   EXPECT_EQ(plans[1].status, plan_t::INVALID_GOAL) << plans[1].status_message;
+  // The answer carries the planner's reason in the user's terms.
+  EXPECT_NE(plans[1].status_message.find("goal joint 1 (joint1) = 10 rad is outside its limits"),
+            std::string::npos)
+      << plans[1].status_message;
 }
 
 TEST_F(NodeFixture, AnObstacleInThePathTriggersACollisionFreeReplan) {

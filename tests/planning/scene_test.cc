@@ -38,7 +38,8 @@ goal:
   position_only: false
 limits:
   iiwa_joint_2: {lower: -1.5, upper: 1.6, velocity: 1.2, effort: 250, acceleration: 10}
-  iiwa_joint_7: {effort: 0}
+  iiwa_joint_6: {effort: 35}
+unactuated: [iiwa_joint_7]
 obstacles:
   - {id: table, shape: box, size: [1, 0.5, 0.04], position: [0.7, 0, 0.4], rpy: [0, 0, 0.3]}
   - {id: ball, shape: sphere, size: [0.1], position: [0.3, 0.4, 0.9]}
@@ -182,9 +183,11 @@ TEST_F(FullScene, EveryFieldReachesTheProblem) {
   EXPECT_EQ(l2.velocity, 1.2);
   EXPECT_EQ(l2.effort, 250);
   EXPECT_EQ(l2.acceleration, 10);
-  EXPECT_FALSE(p.model->bodies[6].actuated);  // effort 0 means unactuated
+  EXPECT_FALSE(p.model->bodies[6].actuated);  // listed under `unactuated`
+  EXPECT_EQ(p.model->bodies[6].limits.effort, bare.bodies[6].limits.effort);
   EXPECT_TRUE(p.model->bodies[5].actuated);
-  EXPECT_EQ(p.model->bodies[5].limits.effort, bare.bodies[5].limits.effort);
+  EXPECT_EQ(p.model->bodies[5].limits.effort, 35);
+  EXPECT_EQ(s.unactuated, std::vector<std::string>{"iiwa_joint_7"});
   EXPECT_EQ(p.horizon, 2.5);
   EXPECT_EQ(p.steps, 25);
   EXPECT_DOUBLE_EQ(p.dt(), 0.1);
@@ -296,6 +299,25 @@ TEST(SceneErrors, DuplicateKeys) {
   EXPECT_NE(std::string(e.what()).find("duplicate"), std::string::npos);
   e = parse_error(std::string(kBase) + "limits:\n  joint1: {effort: 1}\n  joint1: {effort: 2}\n");
   EXPECT_EQ(e.key(), "limits.joint1");
+}
+
+// Passive joints are listed, not given effort 0 (which would mean "no torque allowed").
+TEST(SceneErrors, UnactuatedJoints) {
+  SceneError e = parse_error(std::string(kBase) + "unactuated: [joint3]\n");
+  EXPECT_EQ(e.key(), "unactuated[0]");
+  EXPECT_EQ(e.line(), 6);
+  EXPECT_NE(std::string(e.what()).find("no joint 'joint3'"), std::string::npos) << e.what();
+  e = parse_error(std::string(kBase) + "unactuated: [joint1, joint1]\n");
+  EXPECT_EQ(e.key(), "unactuated[1]");
+  EXPECT_NE(std::string(e.what()).find("twice"), std::string::npos) << e.what();
+  e = parse_error(std::string(kBase) + "unactuated: joint1\n");
+  EXPECT_EQ(e.key(), "unactuated");
+  e = parse_error(std::string(kBase) + "limits: {joint1: {effort: 0}}\n");
+  EXPECT_EQ(e.key(), "limits.joint1.effort");
+  EXPECT_NE(std::string(e.what()).find("'unactuated'"), std::string::npos) << e.what();
+  const Scene ok = parse_scene(std::string(kBase) + "unactuated: [joint2]\n");
+  EXPECT_TRUE(ok.problem.model->bodies[0].actuated);
+  EXPECT_FALSE(ok.problem.model->bodies[1].actuated);
 }
 
 TEST(SceneErrors, UnknownNestedKey) {

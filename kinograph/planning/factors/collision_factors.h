@@ -61,6 +61,10 @@ class CollisionFactor final : public ConstrainedFactor {
                   std::shared_ptr<CollisionContext> context);
   void compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
                const graph::Jacobians* J) const override;
+  /// The time (s) of the state the rows are checked at.
+  double time() const { return t_; }
+  /// The collision scene, whose row_of names each row's (geometry, obstacle) pair.
+  const CollisionContext& context() const { return *ctx_; }
 
  private:
   double s_, dt_, t_;

@@ -147,6 +147,8 @@ ConstrainedFactor::Violation ConstrainedFactor::scan(const graph::Values& values
     if (viol / row.scale > v.scaled) {
       v.scaled = viol / row.scale;
       v.own_units = viol;
+      v.row = i;
+      v.value = z[i];
     }
     if (!update) continue;
     const double mu = m->penalty;

@@ -80,6 +80,8 @@ class ConstrainedFactor : public graph::Factor {
   struct Violation {
     double scaled = 0;
     double own_units = 0;
+    int row = -1;      ///< the worst constraint row, −1 when every row holds
+    double value = 0;  ///< its raw value z
   };
   /// The worst constraint row at `values` (one evaluation, no allocation).
   Violation check(const graph::Values& values) const;

@@ -34,6 +34,8 @@ class DynamicsStepFactor final : public ConstrainedFactor {
   static std::vector<RowSpec> rows_for(const dynamics::Model& model,
                                        const DynamicsStepOptions& options,
                                        std::vector<int>* joint_of_row = nullptr);
+  /// The joint whose torque each row holds.
+  const std::vector<int>& joint_of_row() const { return joint_of_row_; }
 
  private:
   std::shared_ptr<const dynamics::Model> model_;

@@ -10,6 +10,7 @@
 #include "kinograph/planning/incremental/incremental_tree.h"
 #include "kinograph/planning/incremental/stopping_rule.h"
 #include "kinograph/planning/problem_check.h"
+#include "kinograph/planning/solver/violation_text.h"
 #include "kinograph/planning/validate.h"
 
 namespace kinograph::planning {
@@ -251,6 +252,16 @@ Plan IncrementalPlanner::replan(const ProblemChange& change) {
     os << stats_.updates << " ISAM2 updates, " << stats_.rounds << " multiplier rounds, "
        << stats_.cliques_reeliminated << " cliques re-eliminated";
     plan.stats.reason = os.str();
+  }
+  if (!valid_plan && (status == PlanStatus::kMaxUpdates || status == PlanStatus::kMaxRounds)) {
+    std::vector<const FactorEntry*> constraints;
+    for (const FactorEntry& e : tree_->entries) {
+      if (tracked(e)) constraints.push_back(&e);
+    }
+    const ConstraintReport worst = worst_constraint(constraints, tree_->isam->estimate());
+    if (worst.scaled_violation > options_.batch.outer_loop.constraint_tolerance) {
+      plan.stats.reason += "; the worst violation: " + describe_violation(problem_, worst);
+    }
   }
   plan.stats.solve_time_s = seconds_since(t0);
   plan_ = plan;

@@ -208,13 +208,14 @@ class SceneParser {
     if (!root.IsDefined() || root.IsNull()) r_.fail(root, "", "the file is empty");
     r_.expect_map(root, "",
                   {"name", "robot", "horizon", "steps", "start", "goal", "obstacles", "limits",
-                   "task_constraints", "objectives", "planner", "camera", "self_collision",
-                   "allowed_collisions", "floor"});
+                   "unactuated", "task_constraints", "objectives", "planner", "camera",
+                   "self_collision", "allowed_collisions", "floor"});
     Problem& problem = scene.problem;
     problem.name = root["name"] ? r_.string(root["name"], "name")
                                 : (source_.empty() ? "scene" : fs::path(source_).stem().string());
     dynamics::Model model = parse_robot(root, scene);
     if (const YAML::Node limits = root["limits"]) parse_limits(limits, scene, model);
+    if (const YAML::Node passive = root["unactuated"]) parse_unactuated(passive, scene, model);
     problem.model = std::make_shared<const dynamics::Model>(std::move(model));
     const dynamics::Model& m = *problem.model;
 
@@ -364,8 +365,31 @@ class SceneParser {
       bound("velocity", o.velocity, l.velocity);
       bound("effort", o.effort, l.effort);
       bound("acceleration", o.acceleration, l.acceleration);
-      if (o.effort) model.bodies[body].actuated = *o.effort > 0;
+      if (o.effort && *o.effort == 0) {
+        r_.fail(node["effort"], join(key, "effort"),
+                "0 would forbid any torque; list a passive joint under 'unactuated' instead");
+      }
       scene.limits.emplace_back(joint, o);
+    }
+  }
+
+  // The passive joints: URDF has no way to say a joint has no motor.
+  void parse_unactuated(const YAML::Node& list, Scene& scene, dynamics::Model& model) {
+    if (!list.IsSequence()) r_.fail(list, "unactuated", "must be a list of joint names");
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const std::string key = index_key("unactuated", i);
+      const std::string joint = r_.string(list[i], key);
+      int body = -1;
+      for (int b = 0; b < model.nq(); ++b) {
+        if (model.bodies[b].joint_name == joint) body = b;
+      }
+      if (body < 0)
+        r_.fail(list[i], key, "no joint '" + joint + "' in the robot '" + model.name + "'");
+      for (const std::string& other : scene.unactuated) {
+        if (other == joint) r_.fail(list[i], key, "joint '" + joint + "' is listed twice");
+      }
+      model.bodies[body].actuated = false;
+      scene.unactuated.push_back(joint);
     }
   }
 
@@ -693,6 +717,9 @@ void emit_limits(YAML::Emitter& out, const Scene& scene) {
       out << YAML::EndMap;
     }
     out << YAML::EndMap;
+  }
+  if (!scene.unactuated.empty()) {
+    out << YAML::Key << "unactuated" << YAML::Value << YAML::Flow << scene.unactuated;
   }
 }
 
