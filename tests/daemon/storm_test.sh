@@ -2,8 +2,8 @@
 # A goal storm over real UDP multicast: goals at 1 kHz and obstacle moves at 200 Hz for
 # SECONDS (default 2.5; the 60 s run of docs/reliability.md is this script with 60), and every
 # goal must be answered exactly once (planned or SUPERSEDED), the last one by a valid plan, and
-# the daemon's heartbeat must account for all of them. Prints the client's figures (JSON) and
-# the daemon's resident memory before and after.
+# the daemon's heartbeat must account for all of them (its counts include the 1 s warm-up).
+# Prints the client's figures (JSON) and the daemon's resident memory before and after.
 # Usage: storm_test.sh BUILD_DIR SOURCE_DIR [SECONDS] [SCENE] [Q] [JSON_OUT]
 set -euo pipefail
 BUILD=$1
@@ -17,12 +17,14 @@ URL="udpm://239.255.76.67:7712?ttl=0&recv_buf_size=8388608"
 rss_kb() { awk '/VmRSS/ {print $2}' "/proc/$1/status"; }
 
 start_daemon "$SCENE" "$URL" "$WORK/daemon.log"
-# Warm up (first plan builds the planner), so that the memory figure compares steady states.
-"$STORM" --url "$URL" --prefix RR --goals 1 --first-id 1 --q "$Q" --answer-timeout 120 \
-  >"$WORK/warmup.out" 2>&1 || { cat "$WORK/warmup.out"; fail "warm-up goal not planned"; }
+# Warm up with a 1 s storm (the planner, its obstacle and LCM's buffers built), so that the
+# memory figure compares steady states.
+"$STORM" --url "$URL" --prefix RR --goals 1000 --first-id 1 --rate 1000 --obstacle-rate 200 \
+  --q "$Q" --answer-timeout 120 >"$WORK/warmup.out" 2>&1 \
+  || { cat "$WORK/warmup.out"; fail "warm-up storm not answered"; }
 RSS0=$(rss_kb "$DAEMON")
 GOALS=$(awk -v s="$SECONDS_" 'BEGIN { printf "%d", s * 1000 }')
-"$STORM" --url "$URL" --prefix RR --goals "$GOALS" --first-id 2 --rate 1000 --obstacle-rate 200 \
+"$STORM" --url "$URL" --prefix RR --goals "$GOALS" --first-id 1001 --rate 1000 --obstacle-rate 200 \
   --q "$Q" --answer-timeout 120 --json "$WORK/storm.json" >"$WORK/storm.out" 2>&1 \
   || { cat "$WORK/storm.out"; fail "storm: not every goal answered as it should be"; }
 RSS1=$(rss_kb "$DAEMON")
