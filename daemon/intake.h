@@ -17,6 +17,7 @@ struct LostGoals {
   int64_t first = 0;
   int64_t last = 0;
   int64_t revealed_by = 0;
+  /// How many ids never arrived.
   int64_t count() const { return last - first + 1; }
 };
 
@@ -32,6 +33,7 @@ struct Intake {
   std::optional<messages::MeasuredState> state;
   std::uint64_t states = 0;  ///< measured states received
 
+  /// Nothing arrived.
   bool empty() const;
   /// Adds what arrived after this intake: a newer goal supersedes the one held here, a
   /// replace_all discards the obstacle changes held here, a newer state replaces the old one.
