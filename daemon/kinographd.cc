@@ -61,7 +61,8 @@ int main(int argc, char** argv) {
     kinograph::planning::Scene scene = kinograph::planning::load_scene(scene_path);
     // Every batch solve of the node (first plans, fallbacks) is in this formulation.
     const std::string name = formulation.empty() ? scene.planner.formulation : formulation;
-    options.replanning.incremental.batch.formulation = kinograph::planning::formulation_from_name(name).value();
+    options.replanning.incremental.batch.formulation =
+        kinograph::planning::formulation_from_name(name).value();
     spdlog::info("kinographd: batch formulation {}",
                  kinograph::planning::to_string(options.replanning.incremental.batch.formulation));
     kinograph::daemon::PlannerNode node(std::move(scene), options);
@@ -72,8 +73,8 @@ int main(int argc, char** argv) {
         "kinographd: stopped after {} goals ({} answered, {} superseded, {} dropped in "
         "transport), {} plans ({} failed, {} incremental replans, {} fallbacks), {} rejected "
         "messages",
-        c.goals_received, c.goals_answered, c.goals_superseded, c.goals_dropped,
-        c.plans_published, c.failures, c.incremental, c.fallbacks, c.messages_rejected);
+        c.goals_received, c.goals_answered, c.goals_superseded, c.goals_dropped, c.plans_published,
+        c.failures, c.incremental, c.fallbacks, c.messages_rejected);
   } catch (const std::exception& e) {
     std::cerr << "kinographd: error: " << e.what() << "\n";
     return 1;

@@ -26,9 +26,7 @@ std::string upper(std::string s) {
 }  // namespace
 
 PlannerNode::PlannerNode(planning::Scene scene, PlannerNodeOptions options, lcm::LCM* shared)
-    : scene_(std::move(scene)),
-      options_(std::move(options)),
-      replanner_(options_.replanning) {
+    : scene_(std::move(scene)), options_(std::move(options)), replanner_(options_.replanning) {
   if (!scene_.problem.model) throw std::invalid_argument("PlannerNode: the scene has no robot");
   identity_.model_name = scene_.problem.model->name;
   identity_.channel_prefix =

@@ -64,11 +64,11 @@ struct NodeCounters {
   int64_t goals_superseded = 0;  ///< of which SUPERSEDED: a newer goal was planned instead
   int64_t goals_dropped = 0;     ///< goal ids skipped in the sender's sequence (lost), answered
   int messages_rejected = 0;     ///< messages of any type that failed to decode or check
-  int plans_published = 0;    ///< plan_t messages sent (successes and failures)
-  int failures = 0;           ///< of which not SUCCESS
-  int replans = 0;            ///< plans triggered by an obstacle change for the current goal
-  int incremental = 0;        ///< plans answered by an incremental replan (validated or not)
-  int fallbacks = 0;          ///< incremental replans redone by a batch solve
+  int plans_published = 0;       ///< plan_t messages sent (successes and failures)
+  int failures = 0;              ///< of which not SUCCESS
+  int replans = 0;               ///< plans triggered by an obstacle change for the current goal
+  int incremental = 0;           ///< plans answered by an incremental replan (validated or not)
+  int fallbacks = 0;             ///< incremental replans redone by a batch solve
 };
 
 /// The planner daemon's node: scene (robot, defaults, fixed obstacles) + LCM + worker thread.

@@ -126,7 +126,8 @@ std::string position_range_error(const Eigen::Vector3d& position) {
     const double c = position[i];
     if (std::isfinite(c) && std::abs(c) <= kMaxObstacleCoordinate) continue;
     std::ostringstream out;
-    out << "position " << "xyz"[i] << " is " << c << " m";
+    out << "position "
+        << "xyz"[i] << " is " << c << " m";
     if (std::isfinite(c)) {
       out << ", beyond the " << kMaxObstacleCoordinate << " m limit";
     } else {

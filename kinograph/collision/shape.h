@@ -36,13 +36,14 @@ struct Shape {
 Shape shape_of(const dynamics::Geometry& geometry);
 
 // Dimensions (m) within which Bullet's GJK/EPA measures signed distances faithfully: within
-// 1 µm of the closed form for a 5 cm sphere anywhere in or around the solid
-// (tests/collision/shape_range_test.cc). Beyond them it mis-measures, up to calling a robot
+// 1 µm of the closed form for a 5 cm sphere anywhere in or around the solid (within the
+// solid's thickness where the sphere swallows its cross-section;
+// tests/collision/shape_range_test.cc). Beyond them it mis-measures, up to calling a robot
 // inside a huge box collision-free (docs/reliability.md), so such shapes are refused.
-inline constexpr double kMinShapeDimension = 1e-4;     // every radius, length, side, scale
-inline constexpr double kMaxShapeDimension = 1e4;      // box sides, sphere and capsule
-inline constexpr double kMaxCylinderDimension = 10;    // cylinder radius and length
-inline constexpr double kMaxMeshScale = 1e2;           // per-axis scale of a mesh (no unit)
+inline constexpr double kMinShapeDimension = 1e-4;   // every radius, length, side, scale
+inline constexpr double kMaxShapeDimension = 1e4;    // box sides, sphere and capsule
+inline constexpr double kMaxCylinderDimension = 10;  // cylinder radius and length
+inline constexpr double kMaxMeshScale = 1e2;         // per-axis scale of a mesh (no unit)
 // Largest |coordinate| (m) of an obstacle's position: keeps every distance's rounding far
 // below a micrometre.
 inline constexpr double kMaxObstacleCoordinate = 1e5;

@@ -1,8 +1,6 @@
 // The documented shape ranges (collision/shape.h): at their ends Bullet's signed distance to a
 // 5 cm sphere matches the closed form everywhere in and around the solid, and a shape a step
 // beyond them is refused with the dimension and the limit named.
-#include "kinograph/collision/shape.h"
-
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -11,6 +9,7 @@
 
 #include "kinograph/collision/convex_shape.h"
 #include "kinograph/collision/pair_distance.h"
+#include "kinograph/collision/shape.h"
 
 namespace kinograph::collision {
 namespace {
@@ -85,11 +84,11 @@ double worst_error(const Shape& shape) {
 
 TEST(ShapeRange, BulletIsFaithfulAtTheEndsOfEveryRange) {
   const double lo = kMinShapeDimension, hi = kMaxShapeDimension, cyl = kMaxCylinderDimension;
-  for (const Shape& s : {Shape::box(hi, hi, hi), Shape::box(hi, hi, lo), Shape::box(lo, lo, lo),
-                         Shape::sphere(hi), Shape::sphere(lo), Shape::capsule(hi, hi),
-                         Shape::capsule(lo, hi), Shape::capsule(hi, 0), Shape::cylinder(cyl, cyl),
-                         Shape::cylinder(cyl, lo), Shape::cylinder(lo, cyl),
-                         Shape::cylinder(lo, lo)}) {
+  for (const Shape& s :
+       {Shape::box(hi, hi, hi), Shape::box(hi, hi, lo), Shape::box(lo, lo, lo), Shape::sphere(hi),
+        Shape::sphere(lo), Shape::capsule(hi, hi), Shape::capsule(lo, hi), Shape::capsule(hi, 0),
+        Shape::cylinder(cyl, cyl), Shape::cylinder(cyl, lo), Shape::cylinder(lo, cyl),
+        Shape::cylinder(lo, lo)}) {
     ASSERT_EQ(range_error(s), "");
     EXPECT_LE(worst_error(s), 1.0)
         << "kind " << static_cast<int>(s.kind) << " size " << s.size.transpose();

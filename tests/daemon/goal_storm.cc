@@ -81,7 +81,8 @@ class Answers {
   }
   bool wait_echoed(int64_t n, double timeout_s) {
     std::unique_lock lock(mutex_);
-    return cv_.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] { return echoed_ >= n; });
+    return cv_.wait_for(lock, std::chrono::duration<double>(timeout_s),
+                        [&] { return echoed_ >= n; });
   }
   void mark_sent(int64_t id) {
     std::lock_guard lock(mutex_);
@@ -162,10 +163,11 @@ int main(int argc, char** argv) {
   });
 
   const auto start = Clock::now();
-  const auto goal_period = rate > 0 ? std::chrono::duration<double>(1.0 / rate)
-                                    : std::chrono::duration<double>(0);
-  const auto obstacle_period = obstacle_rate > 0 ? std::chrono::duration<double>(1.0 / obstacle_rate)
-                                                 : std::chrono::duration<double>(1e9);
+  const auto goal_period =
+      rate > 0 ? std::chrono::duration<double>(1.0 / rate) : std::chrono::duration<double>(0);
+  const auto obstacle_period = obstacle_rate > 0
+                                   ? std::chrono::duration<double>(1.0 / obstacle_rate)
+                                   : std::chrono::duration<double>(1e9);
   auto next_obstacle = start;
   int64_t obstacle_moves = 0;
   for (int64_t i = 0; i < goals; ++i) {
@@ -243,9 +245,9 @@ int main(int argc, char** argv) {
   std::ostringstream json;
   json << "{\"goals\": " << goals << ", \"goal_rate_hz\": " << rate
        << ", \"obstacle_rate_hz\": " << obstacle_rate << ", \"obstacle_moves\": " << obstacle_moves
-       << ", \"send_s\": " << send_s << ", \"answered\": " << answered << ", \"planned\": "
-       << by_status[kinograph::plan_t::SUCCESS] << ", \"superseded\": "
-       << by_status[kinograph::plan_t::SUPERSEDED] << ", \"other_status\": "
+       << ", \"send_s\": " << send_s << ", \"answered\": " << answered
+       << ", \"planned\": " << by_status[kinograph::plan_t::SUCCESS]
+       << ", \"superseded\": " << by_status[kinograph::plan_t::SUPERSEDED] << ", \"other_status\": "
        << answered - by_status[kinograph::plan_t::SUCCESS] -
               by_status[kinograph::plan_t::SUPERSEDED]
        << ", \"last_goal_valid\": " << (last_valid ? "true" : "false")

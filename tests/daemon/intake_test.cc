@@ -79,12 +79,12 @@ TEST(GoalIdSequence, FindsTheIdsSkippedBetweenConsecutiveGoals) {
 TEST(GoalIdSequence, AStepBackOrAHugeJumpIsANewNumberingNotALoss) {
   GoalIdSequence ids(100);
   EXPECT_FALSE(ids.next(50));
-  EXPECT_FALSE(ids.next(3));    // a restarted sender
-  EXPECT_FALSE(ids.next(3));    // the same id again
+  EXPECT_FALSE(ids.next(3));        // a restarted sender
+  EXPECT_FALSE(ids.next(3));        // the same id again
   const auto most = ids.next(104);  // 100 ids skipped: the largest gap still taken as a loss
   ASSERT_TRUE(most);
   EXPECT_EQ(most->count(), 100);
-  EXPECT_FALSE(ids.next(1000000));  // e.g. a sender numbering by time
+  EXPECT_FALSE(ids.next(1000000));        // e.g. a sender numbering by time
   EXPECT_FALSE(ids.next(1000000 + 102));  // 101 skipped
   EXPECT_TRUE(ids.next(1000000 + 104));
 }

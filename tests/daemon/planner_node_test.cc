@@ -697,7 +697,8 @@ TEST_F(NodeFixture, TheWorldHoldsAtMostTheDocumentedNumberOfObstacles) {
     list.num_obstacles = static_cast<int32_t>(list.obstacles.size());
     return list;
   };
-  for (int first = 0; first < collision::kMaxObstacles + 10; first += messages::kMaxObstaclesPerMessage) {
+  for (int first = 0; first < collision::kMaxObstacles + 10;
+       first += messages::kMaxObstaclesPerMessage) {
     const obstacle_list_t list = batch(first, messages::kMaxObstaclesPerMessage);
     lcm_.publish("RR_OBSTACLES", &list);
   }

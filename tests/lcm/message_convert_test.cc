@@ -141,7 +141,10 @@ TEST(ObstaclesFromMessage, RefusesShapesAndPositionsBeyondTheFaithfulRange) {
     std::string names;
   };
   const std::vector<Case> cases = {
-      {obstacle_t::BOX, {1e80, 1e80, 1e80}, 0, "(\"a\").size: box side x is 1e+80 m, beyond the 10000 m"},
+      {obstacle_t::BOX,
+       {1e80, 1e80, 1e80},
+       0,
+       "(\"a\").size: box side x is 1e+80 m, beyond the 10000 m"},
       {obstacle_t::CYLINDER, {1e79, 1, 0}, 0, "cylinder radius is 1e+79 m, beyond the 10 m"},
       {obstacle_t::CYLINDER, {1, 11, 0}, 0, "cylinder length is 11 m"},
       {obstacle_t::SPHERE, {5e-5, 0, 0}, 0, "sphere radius is 5e-05 m, below the 0.0001 m"},

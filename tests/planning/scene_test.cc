@@ -426,11 +426,12 @@ TEST(SceneErrors, InconsistentValues) {
 // Obstacles the collision engine cannot measure faithfully, or too many of them, are refused
 // with the key, the line, the obstacle and the limit.
 TEST(SceneErrors, ObstaclesBeyondTheCollisionEnginesRangeOrCount) {
-  const SceneError huge = parse_error(std::string(kBase) +
-                                      "obstacles:\n  - {id: room, shape: box, size: [1e80, 1, 1]}\n");
+  const SceneError huge = parse_error(
+      std::string(kBase) + "obstacles:\n  - {id: room, shape: box, size: [1e80, 1, 1]}\n");
   EXPECT_EQ(huge.key(), "obstacles[0].size");
-  EXPECT_NE(std::string(huge.what()).find("obstacle 'room': box side x is 1e+80 m, beyond the "
-                                          "10000 m"),
+  EXPECT_NE(std::string(huge.what())
+                .find("obstacle 'room': box side x is 1e+80 m, beyond the "
+                      "10000 m"),
             std::string::npos)
       << huge.what();
   EXPECT_NE(std::string(huge.what()).find("line 7"), std::string::npos) << huge.what();
@@ -449,8 +450,7 @@ TEST(SceneErrors, ObstaclesBeyondTheCollisionEnginesRangeOrCount) {
   }
   const SceneError crowd = parse_error(many);
   EXPECT_EQ(crowd.key(), "obstacles");
-  EXPECT_NE(std::string(crowd.what()).find("1025 obstacles, more than the 1024"),
-            std::string::npos)
+  EXPECT_NE(std::string(crowd.what()).find("1025 obstacles, more than the 1024"), std::string::npos)
       << crowd.what();
   // At the limits: accepted.
   const Scene ok = parse_scene(std::string(kBase) +
