@@ -445,6 +445,43 @@ TEST(SceneErrors, InconsistentValues) {
   EXPECT_EQ(parse_error(text).key(), "steps");
 }
 
+// Obstacles the collision engine cannot measure faithfully, or too many of them, are refused
+// with the key, the line, the obstacle and the limit.
+TEST(SceneErrors, ObstaclesBeyondTheCollisionEnginesRangeOrCount) {
+  const SceneError huge = parse_error(
+      std::string(kBase) + "obstacles:\n  - {id: room, shape: box, size: [1e80, 1, 1]}\n");
+  EXPECT_EQ(huge.key(), "obstacles[0].size");
+  EXPECT_NE(std::string(huge.what())
+                .find("obstacle 'room': box side x is 1e+80 m, beyond the "
+                      "10000 m"),
+            std::string::npos)
+      << huge.what();
+  EXPECT_NE(std::string(huge.what()).find("line 7"), std::string::npos) << huge.what();
+  EXPECT_EQ(parse_error(std::string(kBase) +
+                        "obstacles:\n  - {id: can, shape: cylinder, size: [1e79, 1]}\n")
+                .key(),
+            "obstacles[0].size");
+  EXPECT_EQ(parse_error(std::string(kBase) + "obstacles:\n  - {id: far, shape: sphere, size: "
+                                             "[0.1], position: [0, 0, 1e6]}\n")
+                .key(),
+            "obstacles[0].position");
+  std::string many = std::string(kBase) + "obstacles:\n";
+  for (int i = 0; i <= collision::kMaxObstacles; ++i) {
+    many += "  - {id: b" + std::to_string(i) + ", shape: sphere, size: [0.01], position: [3, 3, " +
+            std::to_string(i) + "]}\n";
+  }
+  const SceneError crowd = parse_error(many);
+  EXPECT_EQ(crowd.key(), "obstacles");
+  EXPECT_NE(std::string(crowd.what()).find("1025 obstacles, more than the 1024"), std::string::npos)
+      << crowd.what();
+  // At the limits: accepted.
+  const Scene ok = parse_scene(std::string(kBase) +
+                               "obstacles:\n  - {id: floor, shape: box, size: [1e4, 1e4, 0.1]}\n"
+                               "  - {id: can, shape: cylinder, size: [10, 10], position: [20, 0, "
+                               "0]}\n");
+  EXPECT_EQ(ok.problem.obstacles.size(), 2u);
+}
+
 TEST(SceneErrors, SyntaxErrorsAndMissingFiles) {
   const SceneError e = parse_error(std::string(kBase) + "obstacles: [\n  {id: a\n");
   EXPECT_GT(e.line(), 5);

@@ -9,6 +9,8 @@
 #include <set>
 #include <sstream>
 
+#include "kinograph/collision/obstacle.h"
+#include "kinograph/collision/shape.h"
 #include "kinograph/dynamics/payload.h"
 #include "kinograph/planning/batch/batch_planner.h"
 #include "kinograph/planning/clearance_world.h"
@@ -429,6 +431,11 @@ class SceneParser {
 
   void parse_obstacles(const YAML::Node& list, Scene& scene) {
     if (!list.IsSequence()) r_.fail(list, "obstacles", "must be a list");
+    if (list.size() > static_cast<std::size_t>(collision::kMaxObstacles)) {
+      r_.fail(list, "obstacles",
+              "holds " + std::to_string(list.size()) + " obstacles, more than the " +
+                  std::to_string(collision::kMaxObstacles) + " a world may hold");
+    }
     for (std::size_t i = 0; i < list.size(); ++i) {
       const YAML::Node node = list[i];
       const std::string key = index_key("obstacles", i);
@@ -443,9 +450,16 @@ class SceneParser {
       collision::Obstacle obstacle;
       obstacle.id = static_cast<int>(scene.obstacle_names.size());
       obstacle.shape = parse_shape(node, key);
+      if (const std::string e = collision::range_error(obstacle.shape); !e.empty()) {
+        const char* k = obstacle.shape.kind == collision::ShapeKind::kMesh ? "scale" : "size";
+        r_.fail(node[k], join(key, k), "obstacle '" + name + "': " + e);
+      }
       const Eigen::Vector3d position = node["position"]
                                            ? r_.vector3(node["position"], join(key, "position"))
                                            : Eigen::Vector3d::Zero().eval();
+      if (const std::string e = collision::position_range_error(position); !e.empty()) {
+        r_.fail(node["position"], join(key, "position"), "obstacle '" + name + "': " + e);
+      }
       obstacle.pose =
           make_pose(position, r_.rotation(node, key).value_or(Eigen::Matrix3d::Identity()));
       if (const YAML::Node motion = node["motion"]) {
