@@ -1,5 +1,6 @@
 #include "kinograph/planning/user_terms.h"
 
+#include <algorithm>
 #include <iomanip>
 #include <sstream>
 
@@ -39,6 +40,41 @@ std::string at_time(double t) {
   std::ostringstream os;
   os << "t = " << std::setprecision(4) << t << " s";
   return os.str();
+}
+
+namespace {
+const char* const kQuantity[] = {"position", "velocity", "acceleration", "torque"};
+}  // namespace
+
+std::string limit_text(const dynamics::Model& model, int derivative, int joint, double z,
+                       double lower, double upper, double violation, double t) {
+  const dynamics::JointLimits& l = model.bodies[joint].limits;
+  const double symmetric[] = {0, l.velocity, l.acceleration, l.effort};
+  const double lo = derivative == 0 ? l.lower : -symmetric[derivative];
+  const double hi = derivative == 0 ? l.upper : symmetric[derivative];
+  const std::string u = joint_unit(model, joint, derivative);
+  const std::string head =
+      joint_label(model, joint) + " " + kQuantity[derivative] + " " + number(z) + " " + u;
+  const double over = std::max(lo - z, z - hi);
+  const std::string limit = derivative == 0
+                                ? "its limits [" + number(lo) + ", " + number(hi) + "] " + u
+                                : "its " + number(hi) + " " + u + " limit";
+  if (over > 0) {
+    return head + (derivative == 0 ? " is outside " : " exceeds ") + limit + " by " + number(over) +
+           " " + u + " at " + at_time(t);
+  }
+  const double bound = z > 0 ? upper : lower;
+  return head + " is within " + limit + " but past the planner's margin (bound " + number(bound) +
+         " " + u + ") by " + number(violation) + " " + u + " at " + at_time(t);
+}
+
+std::string torque_text(const dynamics::Model& model, int joint, bool unactuated, double z,
+                        double lower, double upper, double violation, double t) {
+  if (unactuated) {
+    return joint_label(model, joint) + " is unactuated but needs " + number(z) + " " +
+           joint_unit(model, joint, 3) + " at " + at_time(t);
+  }
+  return limit_text(model, 3, joint, z, lower, upper, violation, t);
 }
 
 }  // namespace kinograph::planning

@@ -25,4 +25,15 @@ std::pair<std::string, std::string> distinct_numbers(double x, double y);
 /// "t = 5.5 s".
 std::string at_time(double t);
 
+/// A q, q̇, q̈ (derivative 0..2) or τ (3) value z of `joint` at time t against the joint's own
+/// limit; when z is inside that limit but past the planner's tightened bound [lower, upper] by
+/// `violation`, says so.
+std::string limit_text(const dynamics::Model& model, int derivative, int joint, double z,
+                       double lower, double upper, double violation, double t);
+
+/// A torque row of `joint`: on an unactuated joint (`unactuated`) the torque it would need,
+/// otherwise limit_text for the effort.
+std::string torque_text(const dynamics::Model& model, int joint, bool unactuated, double z,
+                        double lower, double upper, double violation, double t);
+
 }  // namespace kinograph::planning

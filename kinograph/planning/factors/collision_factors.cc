@@ -4,7 +4,9 @@
 #include <stdexcept>
 
 #include "kinograph/dynamics/kinematics.h"
+#include "kinograph/planning/clearance_world.h"
 #include "kinograph/planning/factors/trajectory_factors.h"
+#include "kinograph/planning/user_terms.h"
 
 namespace kinograph::planning {
 
@@ -117,6 +119,36 @@ void CollisionFactor::compute(const graph::FactorValues& x, Eigen::Ref<Eigen::Ve
       J->block(3).row(row) = h_[3] * dt_ * c.gradient.transpose();
     }
   }
+}
+
+namespace {
+// The pair of row `row` in the user's terms ("link 'a' and obstacle 3", "link 'a' and the
+// floor", "links 'a' and 'b'"), empty when the row is not in the context.
+std::string collision_pair(const CollisionContext& ctx, int row) {
+  const auto link = [&](size_t g) { return "'" + ctx.model->collision[g].link_name + "'"; };
+  for (size_t g = 0; g < ctx.row_of.size(); ++g) {
+    for (size_t slot = 0; slot < ctx.row_of[g].size(); ++slot) {
+      if (ctx.row_of[g][slot] != row) continue;
+      const int id = ctx.obstacle_ids[slot];
+      return "link " + link(g) +
+             (id == kFloorId ? std::string(" and the floor") : " and obstacle " + std::to_string(id));
+    }
+  }
+  for (size_t a = 0; a < ctx.self_row_of.size(); ++a) {
+    for (size_t b = a + 1; b < ctx.self_row_of[a].size(); ++b) {
+      if (ctx.self_row_of[a][b] == row) return "links " + link(a) + " and " + link(b);
+    }
+  }
+  return "";
+}
+}  // namespace
+
+std::string CollisionFactor::describe_row(int row, double z, const RowContext&) const {
+  const std::string pair = collision_pair(*ctx_, row);
+  if (pair.empty()) return "";
+  if (z < 0) return pair + " overlap by " + number(-z) + " m at " + at_time(t_);
+  return pair + " are " + number(z) + " m apart at " + at_time(t_) + ", inside the planner's " +
+         number(rows()[static_cast<size_t>(row)].lower) + " m safety distance";
 }
 
 }  // namespace kinograph::planning

@@ -61,6 +61,7 @@ class CollisionFactor final : public ConstrainedFactor {
                   std::shared_ptr<CollisionContext> context);
   void compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
                const graph::Jacobians* J) const override;
+  std::string describe_row(int row, double z, const RowContext& c) const override;
   /// The time (s) of the state the rows are checked at.
   double time() const { return t_; }
   /// The collision scene, whose row_of names each row's (geometry, obstacle) pair.

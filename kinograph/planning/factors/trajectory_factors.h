@@ -47,6 +47,7 @@ class CollocationFactor final : public ConstrainedFactor {
   CollocationFactor(int k, int n, double dt, double scale = 1.0);
   void compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
                const graph::Jacobians* J) const override;
+  std::string describe_row(int row, double z, const RowContext& c) const override;
   /// Number of joints n (rows 0..n−1 are positions, n..2n−1 velocities).
   int joints() const { return n_; }
 
@@ -69,6 +70,7 @@ class StateLimitFactor final : public ConstrainedFactor {
   StateLimitFactor(int k, int n, std::vector<Limit> limits, double scale = 1.0);
   void compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
                const graph::Jacobians* J) const override;
+  std::string describe_row(int row, double z, const RowContext& c) const override;
   /// What each row limits, in row order.
   const std::vector<Limit>& limits() const { return limits_; }
 
