@@ -2,15 +2,7 @@
 # multicast route (nothing leaves it), a work directory, and daemons started and awaited on
 # their own log line. Exit 77 (skipped) when not root.
 # The sourcing script sets BUILD and SRC and has been called with its own arguments in "$@".
-if [ -z "${KINOGRAPH_NETNS:-}" ]; then
-  if [ "$(id -u)" -ne 0 ] || ! command -v unshare >/dev/null; then
-    echo "SKIP: needs root for a private network namespace"; exit 77
-  fi
-  exec unshare -n env KINOGRAPH_NETNS=1 bash "$0" "$@"
-fi
-ip link set lo up
-ip link set lo multicast on
-ip route add 224.0.0.0/4 dev lo
+source "$SRC/tests/lib/private_netns.sh"
 
 KGD="$BUILD/daemon/kinographd"
 STORM="$BUILD/tests/daemon/goal_storm"
