@@ -64,6 +64,16 @@ TEST(UrdfBadInput, UnparsableNumberNamesLinkElementAndLine) {
                      "<cylinder length='abc'>", "not a number"});
 }
 
+TEST(UrdfBadInput, NonFiniteRadiusIsRefused) {
+  // A NaN or infinite collision radius would read as an infinite clearance and hide contact.
+  for (const char* v : {"nan", "inf"}) {
+    const std::string file = std::string(v) + "_radius.urdf";
+    expect_urdf_error(testing::data_path(file),
+                      {file, "line 13", "link 'arm'", "<collision><geometry>",
+                       "<sphere radius='" + std::string(v) + "'>", "not a number"});
+  }
+}
+
 TEST(UrdfBadInput, WrongNumberOfValues) {
   expect_urdf_error(testing::data_path("wrong_count.urdf"),
                     {"wrong_count.urdf", "line 7", "joint 'j1'", "<origin xyz='0 0.2'>",
