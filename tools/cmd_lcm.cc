@@ -1,10 +1,12 @@
 // LCM verbs of the CLI: talk to a running kinographd.
 //   kinograph send-goal     --prefix IIWA (--q ... | --frame F --position ... --quaternion ...)
+//                           [--utime US]
 //   kinograph send-obstacle --prefix IIWA --id box --shape box --size ... --position ...
-//   kinograph send-state    --prefix IIWA --scene S --q ... [--qd ...]
+//   kinograph send-state    --prefix IIWA --scene S --q ... [--qd ...] [--utime US]
 //   kinograph send-raw      CHANNEL --text BYTES
 //   kinograph log-plans     LOG.lcmlog --channel IIWA_PLAN --scene S --out-dir DIR
 // send-goal and send-obstacle can wait for the answering plan (--wait) and write it (--out).
+// --utime stamps a message on the robot's clock (e.g. sim time) instead of the wall clock.
 #include <chrono>
 #include <filesystem>
 #include <iostream>
@@ -53,12 +55,16 @@ lcm::LCM& open_lcm(const std::string& url) {
   return *lcm;
 }
 
-std::string summarize(const plan_t& p) {
-  static const char* kStatus[] = {"SUCCESS",       "FAILED",    "INVALID_GOAL",
-                                  "INVALID_STATE", "CANCELLED", "NOT_CONVERGED"};
+namespace {
+
+// Both plan versions share these fields.
+template <typename PlanMessage>
+std::string summarize_plan(const PlanMessage& p) {
+  static const char* kStatus[] = {"SUCCESS",   "FAILED",        "INVALID_GOAL", "INVALID_STATE",
+                                  "CANCELLED", "NOT_CONVERGED", "SUPERSEDED"};
   std::ostringstream s;
   s << "plan " << p.plan_id << " for goal " << p.goal_id << ": "
-    << (p.status >= 0 && p.status <= 5 ? kStatus[p.status] : "UNKNOWN");
+    << (p.status >= 0 && p.status <= 6 ? kStatus[p.status] : "UNKNOWN");
   if (!p.status_message.empty()) s << " (" << p.status_message << ")";
   if (p.num_steps > 0) {
     s << "\n  method " << p.method << ", " << p.num_steps << " states, " << p.iterations
@@ -70,7 +76,21 @@ std::string summarize(const plan_t& p) {
   return s.str();
 }
 
-namespace {
+}  // namespace
+
+std::string summarize(const plan_t& p) {
+  std::ostringstream s;
+  s << summarize_plan(p) << "\n  clock " << (p.clock == plan_t::CLOCK_ROBOT ? "robot" : "wall")
+    << ", published at " << p.utime << " us";
+  if (p.num_steps > 0) s << ", starts at " << p.start_utime << " us";
+  s << (p.state_utime >= 0 ? ", from the state at " + std::to_string(p.state_utime) + " us"
+                           : ", from the scene's start");
+  return s.str();
+}
+
+std::string summarize(const plan_v1_t& p) {
+  return summarize_plan(p) + "\n  (plan_t version 1: no clock; times are from the plan's start)";
+}
 
 std::vector<double> parse_list(const std::string& text, const std::string& option) {
   std::vector<double> values;
@@ -87,6 +107,8 @@ std::vector<double> parse_list(const std::string& text, const std::string& optio
   }
   return values;
 }
+
+namespace {
 
 std::vector<double> parse_fixed(const std::string& text, const std::string& option, size_t n) {
   auto v = parse_list(text, option);
@@ -152,8 +174,11 @@ const bool kSendGoal = register_command([](CLI::App& root) {
   auto goal_id = std::make_shared<int64_t>(-1);
   auto duration = std::make_shared<double>(0);
   auto robot = std::make_shared<std::string>();
+  auto utime = std::make_shared<int64_t>(-1);
   c->add(sub, true);
   sub->add_option("--id", *goal_id, "goal id (default: current time in µs)");
+  sub->add_option("--utime", *utime,
+                  "goal time on the robot's clock (µs), e.g. sim time (default: the wall clock)");
   sub->add_option("--q", *q, "joint goal, comma-separated");
   sub->add_option("--frame", *frame, "end-effector frame for a pose goal");
   sub->add_option("--position", *position, "pose goal position x,y,z (m)");
@@ -162,8 +187,8 @@ const bool kSendGoal = register_command([](CLI::App& root) {
   sub->add_option("--robot", *robot, "robot name in the message (default: empty = any)");
   sub->callback([=] {
     goal_t msg;
-    msg.utime = now_utime();
-    msg.goal_id = *goal_id >= 0 ? *goal_id : msg.utime;
+    msg.utime = *utime >= 0 ? *utime : now_utime();
+    msg.goal_id = *goal_id >= 0 ? *goal_id : now_utime();
     msg.robot = *robot;
     msg.duration_s = *duration;
     std::fill(std::begin(msg.ee_position), std::end(msg.ee_position), 0.0);
@@ -259,7 +284,10 @@ const bool kSendState = register_command([](CLI::App& root) {
   auto scene = std::make_shared<std::string>();
   auto q = std::make_shared<std::string>();
   auto qd = std::make_shared<std::string>();
+  auto utime = std::make_shared<int64_t>(-1);
   c->add(sub, false);
+  sub->add_option("--utime", *utime,
+                  "measurement time on the robot's clock (µs) (default: the wall clock)");
   sub->add_option("--scene", *scene, "scene with the robot (for the joint names)")->required();
   sub->add_option("--q", *q, "joint positions, comma-separated")->required();
   sub->add_option("--qd", *qd, "joint velocities (default zeros)");
@@ -267,7 +295,7 @@ const bool kSendState = register_command([](CLI::App& root) {
     const auto s = planning::load_scene(*scene);
     const auto& model = *s.problem.model;
     robot_state_t msg;
-    msg.utime = now_utime();
+    msg.utime = *utime >= 0 ? *utime : now_utime();
     msg.robot = model.name;
     msg.num_joints = model.nq();
     for (const auto& b : model.bodies) msg.joint_name.push_back(b.joint_name);
@@ -309,23 +337,36 @@ const bool kLogPlans = register_command([](CLI::App& root) {
     lcm::LogFile file(*log, "r");
     if (!file.good()) throw CommandFailure("cannot read LCM log " + *log);
     std::filesystem::create_directories(*out_dir);
-    int written = 0, rejected = 0;
-    while (const lcm::LogEvent* event = file.readNextEvent()) {
-      if (event->channel != *channel) continue;
-      plan_t msg;
-      if (!lcmtypes::safe_decode(event->data, event->datalen, msg).ok) {
-        ++rejected;
-        continue;
-      }
+    int written = 0, rejected = 0, old = 0;
+    // Prints one decoded plan of either version and writes it when it has a trajectory.
+    auto write = [&](const auto& msg) {
       std::cout << summarize(msg) << "\n";
-      if (msg.num_steps == 0) continue;
+      if (msg.num_steps == 0) return;
       const std::string path = *out_dir + "/plan_" + std::to_string(msg.goal_id) + "_" +
                                std::to_string(msg.plan_id) + ".json";
       planning::write_plan(messages::plan_from_message(msg), s, path);
       ++written;
+    };
+    while (const lcm::LogEvent* event = file.readNextEvent()) {
+      if (event->channel != *channel) continue;
+      // The fingerprint says which version of plan_t a message is (lcmtypes/README.md).
+      plan_t msg;
+      plan_v1_t v1;
+      const auto current = lcmtypes::safe_decode(event->data, event->datalen, msg);
+      if (current.ok) {
+        write(msg);
+      } else if (lcmtypes::safe_decode(event->data, event->datalen, v1).ok) {
+        write(v1);
+        ++old;
+      } else {
+        std::cerr << "kinograph: " << *channel << " message at " << event->timestamp
+                  << " us is not a plan_t of version 2 or 1 (" << current.reason << "); skipped\n";
+        ++rejected;
+      }
     }
     std::cout << written << " plans written to " << *out_dir;
-    if (rejected) std::cout << ", " << rejected << " malformed messages skipped";
+    if (old) std::cout << ", " << old << " of version 1 (no clock)";
+    if (rejected) std::cout << ", " << rejected << " messages that are not plans skipped";
     std::cout << "\n";
   });
 });

@@ -4,8 +4,10 @@
 #include <lcm/lcm-cpp.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "kinograph/plan_t.hpp"
+#include "kinograph/plan_v1_t.hpp"
 
 namespace kinograph::tools {
 
@@ -27,7 +29,13 @@ class PlanWaiter {
 /// Opens LCM on `url` (empty = default); throws CommandFailure if it cannot.
 lcm::LCM& open_lcm(const std::string& url);
 
-/// One line per plan: status, method, time, iterations, validation figures.
+/// The numbers of a comma-separated list given to `option`; throws CommandFailure naming
+/// the item that is not a number.
+std::vector<double> parse_list(const std::string& text, const std::string& option);
+
+/// One line per plan: status, method, time, iterations, validation figures, and its clock.
 std::string summarize(const plan_t& plan);
+/// The same for a plan of version 1 (old logs), which has no clock.
+std::string summarize(const plan_v1_t& plan);
 
 }  // namespace kinograph::tools

@@ -1,0 +1,33 @@
+#include "kinograph/sim/joint_controller.h"
+
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+#include "kinograph/dynamics/inverse_dynamics.h"
+
+namespace kinograph::sim {
+
+PdGains gains_for(const dynamics::Model& model, dynamics::Data& data, const Eigen::VectorXd& q,
+                  double frequency_hz, double damping_ratio) {
+  if (!(frequency_hz > 0) || !(damping_ratio > 0)) {
+    throw std::invalid_argument("PD gains need a natural frequency and a damping ratio > 0");
+  }
+  const double omega = 2 * std::numbers::pi * frequency_hz;
+  const Eigen::VectorXd inertia = dynamics::mass_matrix(model, data, q).diagonal();
+  return {inertia * omega * omega, inertia * 2 * damping_ratio * omega};
+}
+
+Eigen::VectorXd control_torque(const PdGains& gains, const Setpoint& setpoint,
+                               const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
+  return setpoint.tau + gains.kp.cwiseProduct(setpoint.q - q) +
+         gains.kd.cwiseProduct(setpoint.qd - qd);
+}
+
+Setpoint hold_setpoint(const dynamics::Model& model, dynamics::Data& data,
+                       const Eigen::VectorXd& q) {
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(model.nq());
+  return {q, zero, dynamics::rnea(model, data, q, zero, zero)};
+}
+
+}  // namespace kinograph::sim
