@@ -64,7 +64,8 @@ SimNode::SimNode(planning::Scene scene, SimNodeOptions options, lcm::LCM* shared
   data_ = std::make_unique<dynamics::Data>(model);
   sim_ = std::make_unique<RigidBodySim>(plant_);
   state_ = {scene_.problem.start_q, scene_.problem.start_qd};
-  // Gains and the first hold come from the model the planner knows, not from the plant.
+  // Gains and the first hold come from the model the planner knows, not from the plant; the
+  // gains are shaped by the mass matrix at each new setpoint.
   gains_ = gains_for(model, *data_, state_.q, kPdFrequencyHz, kDampingRatio);
   setpoint_ = hold_setpoint(model, *data_, state_.q);
   if (shared) {
@@ -101,6 +102,7 @@ void SimNode::on_command(const lcm::ReceiveBuffer* rbuf, const std::string& chan
     return;
   }
   ++commands_;
+  gains_ = gains_for(*scene_.problem.model, *data_, command.q, kPdFrequencyHz, kDampingRatio);
   setpoint_ = {std::move(command.q), std::move(command.qd), std::move(command.tau)};
 }
 
@@ -163,7 +165,13 @@ void SimNode::run(const std::atomic<bool>& stop) {
       window_ = {};
     }
     if (step == last_step) break;
-    sim_->step(kStepS, gains_, setpoint_, state_);
+    try {
+      sim_->step(kStepS, gains_, setpoint_, state_);
+    } catch (const std::runtime_error& e) {
+      throw std::runtime_error("at simulated time " +
+                               std::to_string(static_cast<double>(step) * kStepS) +
+                               " s: " + e.what());
+    }
     // The simulated time may fall behind the wall clock on a busy machine, never run ahead.
     std::this_thread::sleep_until(wall_start +
                                   std::chrono::duration_cast<std::chrono::steady_clock::duration>(

@@ -64,7 +64,7 @@ class SimNode {
  public:
   static constexpr double kStepS = 1e-3;        ///< RK4 step (1 kHz)
   static constexpr int kStepsPerState = 5;      ///< a state every 5 ms (200 Hz)
-  static constexpr double kPdFrequencyHz = 10;  ///< natural frequency of each joint's PD loop
+  static constexpr double kPdFrequencyHz = 10;  ///< natural frequency of the PD loop's modes
   static constexpr double kDampingRatio = 1;    ///< critically damped
   static constexpr double kLogPeriodS = 1;      ///< tracking error logged every simulated second
 
@@ -77,7 +77,8 @@ class SimNode {
   SimNode(const SimNode&) = delete;
   SimNode& operator=(const SimNode&) = delete;
 
-  /// Simulates, paced by the wall clock, until `stop` or the duration is reached.
+  /// Simulates, paced by the wall clock, until `stop` or the duration is reached. Throws
+  /// std::runtime_error, with the simulated time, if the motion diverges.
   void run(const std::atomic<bool>& stop);
 
   /// Full channel name for a suffix, e.g. channel("STATE") = "IIWA_STATE".

@@ -14,14 +14,13 @@ PdGains gains_for(const dynamics::Model& model, dynamics::Data& data, const Eige
     throw std::invalid_argument("PD gains need a natural frequency and a damping ratio > 0");
   }
   const double omega = 2 * std::numbers::pi * frequency_hz;
-  const Eigen::VectorXd inertia = dynamics::mass_matrix(model, data, q).diagonal();
-  return {inertia * omega * omega, inertia * 2 * damping_ratio * omega};
+  const Eigen::MatrixXd inertia = dynamics::mass_matrix(model, data, q);
+  return {inertia * (omega * omega), inertia * (2 * damping_ratio * omega)};
 }
 
 Eigen::VectorXd control_torque(const PdGains& gains, const Setpoint& setpoint,
                                const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
-  return setpoint.tau + gains.kp.cwiseProduct(setpoint.q - q) +
-         gains.kd.cwiseProduct(setpoint.qd - qd);
+  return setpoint.tau + gains.kp * (setpoint.q - q) + gains.kd * (setpoint.qd - qd);
 }
 
 Setpoint hold_setpoint(const dynamics::Model& model, dynamics::Data& data,

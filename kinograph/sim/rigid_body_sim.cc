@@ -35,6 +35,11 @@ void RigidBodySim::step(double dt, const PdGains& gains, const Setpoint& setpoin
   const Eigen::VectorXd a4 = acceleration(gains, setpoint, q + dt * v3, v4);
   state.q = q + dt / 6 * (v + 2 * v2 + 2 * v3 + v4);
   state.qd = v + dt / 6 * (a1 + 2 * a2 + 2 * a3 + a4);
+  if (!state.q.allFinite() || !state.qd.allFinite()) {
+    throw std::runtime_error(
+        "the simulated motion diverged (a joint position or velocity is "
+        "not finite): torques too large for the step");
+  }
 }
 
 dynamics::Model with_last_body_mass_change(const dynamics::Model& model, double delta_kg) {

@@ -22,7 +22,8 @@ class RigidBodySim {
   /// Borrows `plant`, which must outlive the simulator.
   explicit RigidBodySim(const dynamics::Model& plant);
 
-  /// Advances `state` by one RK4 step of `dt` seconds under the controllers.
+  /// Advances `state` by one RK4 step of `dt` seconds under the controllers. Throws
+  /// std::runtime_error when the new state is not finite (the motion diverged).
   void step(double dt, const PdGains& gains, const Setpoint& setpoint, JointState& state);
   /// The controllers' torque at `state` (what step() applies at the step's start).
   Eigen::VectorXd torque(const PdGains& gains, const Setpoint& setpoint,

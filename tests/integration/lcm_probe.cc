@@ -16,6 +16,7 @@
 #include <cstring>
 #include <iostream>
 #include <lcm/lcm-cpp.hpp>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -61,10 +62,14 @@ bool pump(lcm::LCM& lcm, double timeout_s, Done done) {
   return true;
 }
 
+// Largest |q − near| of a state; infinite when a position is not finite, so that a diverged
+// simulation never reads as "near".
 double deviation(const kinograph::robot_state_t& s, const std::vector<double>& near) {
   double worst = 0;
   for (size_t j = 0; j < near.size() && j < s.position.size(); ++j) {
-    worst = std::max(worst, std::abs(s.position[j] - near[j]));
+    const double d = std::abs(s.position[j] - near[j]);
+    if (!std::isfinite(d)) return std::numeric_limits<double>::infinity();
+    worst = std::max(worst, d);
   }
   return worst;
 }

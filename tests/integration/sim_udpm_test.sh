@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The simulated iiwa (`kinograph sim`) over real UDP multicast in a private network namespace,
-# watched by lcm_probe: before any command it holds the desk scene's start against gravity; a
+# watched by lcm_probe (and, first, `kinograph send-state --utime`): before any command it holds the desk scene's start against gravity; a
 # commanded posture with its gravity torque (the scene's goal, a step of up to 1.2 rad) is
 # reached and then held within 1e-5 rad; ten times slower than the wall clock its states carry
 # its own clock, 5 ms apart from the start time given, and kinographd stamps its plan on it.
@@ -10,6 +10,15 @@ BUILD=$1
 SRC=$2
 source "$SRC/tests/integration/sim_lib.sh"
 URL="udpm://239.255.76.67:7721?ttl=0&recv_buf_size=4194304"
+
+# `kinograph send-state --utime` stamps the state on the robot's clock it is given.
+"$PROBE" states --url "$URL" --channel IIWA_STATE --count 1 --timeout 60 >"$WORK/sent.out" &
+SENT_PROBE=$!
+PIDS+=($SENT_PROBE)
+wait_for_line "$WORK/sent.out" ready || fail "probe did not start"
+"$KG" send-state --prefix IIWA --lcm-url "$URL" --scene "$SCENE" --q "$START" --utime 777
+wait "$SENT_PROBE" || fail "the sent state did not arrive"
+[ "$(value "$WORK/sent.out" first_utime)" -eq 777 ] || fail "send-state --utime not used"
 
 start_sim "$URL"
 "$PROBE" states --url "$URL" --channel IIWA_STATE --count 200 --near "$START" >"$WORK/hold0.out" \
