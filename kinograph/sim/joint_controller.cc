@@ -15,12 +15,16 @@ PdGains gains_for(const dynamics::Model& model, dynamics::Data& data, const Eige
   }
   const double omega = 2 * std::numbers::pi * frequency_hz;
   const Eigen::MatrixXd inertia = dynamics::mass_matrix(model, data, q);
-  return {inertia * (omega * omega), inertia * (2 * damping_ratio * omega)};
+  Eigen::VectorXd actuated(model.nq());
+  for (int j = 0; j < model.nq(); ++j) actuated[j] = model.bodies[j].actuated ? 1.0 : 0.0;
+  return {inertia * (omega * omega), inertia * (2 * damping_ratio * omega), actuated};
 }
 
 Eigen::VectorXd control_torque(const PdGains& gains, const Setpoint& setpoint,
                                const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
-  return setpoint.tau + gains.kp * (setpoint.q - q) + gains.kd * (setpoint.qd - qd);
+  const Eigen::VectorXd tau =
+      setpoint.tau + gains.kp * (setpoint.q - q) + gains.kd * (setpoint.qd - qd);
+  return tau.cwiseProduct(gains.actuated);
 }
 
 Setpoint hold_setpoint(const dynamics::Model& model, dynamics::Data& data,

@@ -14,9 +14,11 @@ struct Setpoint {
   Eigen::VectorXd q, qd, tau;
 };
 
-/// PD gain matrices (N·m/rad and N·m·s/rad), joints in model order.
+/// PD gain matrices (N·m/rad and N·m·s/rad), joints in model order, and which joints have a
+/// motor (1) or are passive (0: no torque at all, e.g. the Acrobot's shoulder).
 struct PdGains {
   Eigen::MatrixXd kp, kd;
+  Eigen::VectorXd actuated;
 };
 
 /// Gains K_p = ω² M(q), K_d = 2 ζ ω M(q), ω = 2πf, with M the mass matrix at q (the setpoint):
@@ -27,7 +29,7 @@ struct PdGains {
 PdGains gains_for(const dynamics::Model& model, dynamics::Data& data, const Eigen::VectorXd& q,
                   double frequency_hz, double damping_ratio);
 
-/// The controllers' torque at state (q, q̇).
+/// The controllers' torque at state (q, q̇); 0 on passive joints.
 Eigen::VectorXd control_torque(const PdGains& gains, const Setpoint& setpoint,
                                const Eigen::VectorXd& q, const Eigen::VectorXd& qd);
 

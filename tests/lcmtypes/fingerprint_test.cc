@@ -100,6 +100,8 @@ TEST(Fingerprint, PlanVersionOneIsTheFirstPlanAndVersionTwoDiffers) {
   // The fingerprint the first plan_t had on the wire (kinographd's logs until version 2).
   EXPECT_EQ(static_cast<uint64_t>(plan_v1_t::getHash()), 0x9c87cb46fcfb0553u);
   EXPECT_EQ(plan_t::getHash(), fingerprint(plan_layout(true)));
+  // Version 2 as released (lcmtypes/README.md): a change to plan_t must be a version 3.
+  EXPECT_EQ(static_cast<uint64_t>(plan_t::getHash()), 0xe41f88a8e6fc3556u);
   EXPECT_NE(plan_t::getHash(), plan_v1_t::getHash());
 }
 

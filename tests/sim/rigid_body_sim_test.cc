@@ -114,6 +114,23 @@ TEST(RigidBodySim, AStepAcrossTheWorkspaceConverges) {
   EXPECT_LT(error_after_step(scene.problem.start_q, scene.problem.goal.q, 1.5, 2.5), 1e-6);
 }
 
+// Gains far too stiff for a 1 ms step (a 1 kHz loop) make the motion diverge: the simulator
+// says so instead of carrying on with NaN.
+TEST(RigidBodySim, ADivergingMotionIsReportedNotContinued) {
+  const dynamics::Model& model = *iiwa_desk().problem.model;
+  dynamics::Data data(model);
+  const Eigen::VectorXd q0 = iiwa_desk().problem.start_q;
+  const Setpoint target = hold_setpoint(model, data, q0.array() + 0.1);
+  const PdGains gains = gains_for(model, data, q0, 1000.0, 1.0);
+  RigidBodySim sim(model);
+  JointState state{q0, Eigen::VectorXd::Zero(7)};
+  EXPECT_THROW(
+      {
+        for (int k = 0; k < 1000; ++k) sim.step(1e-3, gains, target, state);
+      },
+      std::runtime_error);
+}
+
 // The mass change is a point mass at the last body's centre of mass: the same as a box of no
 // size attached there through the dynamics module's own payload function.
 TEST(MassChange, IsAPointMassAtTheLastBodysCentreOfMass) {
@@ -149,6 +166,22 @@ TEST(MassChange, ALinkLeftWithoutMassIsRefusedByName) {
     EXPECT_NE(std::string(e.what()).find("link " + model.bodies.back().name), std::string::npos)
         << e.what();
   }
+}
+
+// The Acrobot's shoulder has no motor: whatever the setpoint and the error, it gets no torque.
+TEST(Gains, APassiveJointGetsNoTorque) {
+  const planning::Scene acrobot = planning::load_scene(std::string(KINOGRAPH_SOURCE_DIR) +
+                                                       "/robots/scenes/acrobot_swingup.yaml");
+  const dynamics::Model& model = *acrobot.problem.model;
+  ASSERT_FALSE(model.bodies[0].actuated);
+  dynamics::Data data(model);
+  const Eigen::Vector2d q(0.3, -0.2);
+  const PdGains gains = gains_for(model, data, q, 10.0, 1.0);
+  const Setpoint setpoint{Eigen::Vector2d(1.0, 1.0), Eigen::Vector2d(0.5, 0.5),
+                          Eigen::Vector2d(2.0, 3.0)};
+  const Eigen::VectorXd tau = control_torque(gains, setpoint, q, Eigen::Vector2d::Zero());
+  EXPECT_EQ(tau[0], 0.0);
+  EXPECT_GT(std::abs(tau[1]), 3.0);
 }
 
 TEST(Gains, NeedAPositiveFrequencyAndDampingRatio) {
