@@ -26,6 +26,9 @@ const SimNodeOptions& checked(const SimNodeOptions& o) {
   if (!(std::isfinite(o.slowdown) && o.slowdown >= 1e-3 && o.slowdown <= 1e3)) {
     throw std::invalid_argument("--slowdown must be in [0.001, 1000] (wall s per simulated s)");
   }
+  if (o.start_utime < -1) {
+    throw std::invalid_argument("--start-utime must be >= 0 us (or -1: the wall clock)");
+  }
   if (!(std::isfinite(o.duration_s) && o.duration_s >= 0)) {
     throw std::invalid_argument("--duration must be >= 0 s");
   }

@@ -183,6 +183,12 @@ TEST(SimNodeOptions, OutOfRangeOptionsAreRefusedByName) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("--slowdown"), std::string::npos) << e.what();
   }
+  options.slowdown = 1;
+  options.start_utime = -5;
+  EXPECT_THROW(SimNode(iiwa_desk(), options, &lcm), std::invalid_argument);
+  options.start_utime = 0;
+  options.payload_mass_error_kg = -100;  // more than the last link weighs
+  EXPECT_THROW(SimNode(iiwa_desk(), options, &lcm), std::invalid_argument);
 }
 
 }  // namespace
