@@ -114,6 +114,7 @@ class WireReader {
     n = n16;
     return bounded(n, min_elem_bytes, field);
   }
+  /// Checks a count already read: not negative, and its elements fit in what remains.
   bool bounded(int32_t n, int64_t min_elem_bytes, const char* field) {
     if (n < 0) return fail(std::string(field) + " = " + std::to_string(n) + " is negative");
     if (static_cast<int64_t>(n) * min_elem_bytes > remaining()) {

@@ -38,6 +38,16 @@ const SimNodeOptions& checked(const SimNodeOptions& o) {
   return o;
 }
 
+// The plant the simulator moves: the model with the payload error, refused under the option's
+// name.
+dynamics::Model plant_for(const dynamics::Model& model, double payload_mass_error_kg) {
+  try {
+    return with_last_body_mass_change(model, payload_mass_error_kg);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(std::string("--payload-mass-error: ") + e.what());
+  }
+}
+
 std::vector<double> to_vector(const Eigen::VectorXd& v) {
   return std::vector<double>(v.data(), v.data() + v.size());
 }
@@ -57,7 +67,7 @@ void TrackingStats::add(double error) {
 SimNode::SimNode(planning::Scene scene, SimNodeOptions options, lcm::LCM* shared)
     : scene_(std::move(scene)),
       options_(checked(options)),
-      plant_(with_last_body_mass_change(*scene_.problem.model, options_.payload_mass_error_kg)),
+      plant_(plant_for(*scene_.problem.model, options_.payload_mass_error_kg)),
       noise_(options_.position_noise, options_.velocity_noise, options_.seed) {
   const dynamics::Model& model = *scene_.problem.model;
   identity_.model_name = model.name;

@@ -188,7 +188,13 @@ TEST(SimNodeOptions, OutOfRangeOptionsAreRefusedByName) {
   EXPECT_THROW(SimNode(iiwa_desk(), options, &lcm), std::invalid_argument);
   options.start_utime = 0;
   options.payload_mass_error_kg = -100;  // more than the last link weighs
-  EXPECT_THROW(SimNode(iiwa_desk(), options, &lcm), std::invalid_argument);
+  try {
+    SimNode node(iiwa_desk(), options, &lcm);
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("--payload-mass-error: "), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("link iiwa_link_7"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
