@@ -11,11 +11,11 @@ PACKAGES=(
   # numerics, collision, models, meshes
   libeigen3-dev libsuitesparse-dev libbullet-dev liburdfdom-dev libassimp-dev
   # rendering and plots
-  libosmesa6-dev libpng-dev libfreetype-dev fonts-dejavu-core libcairo2-dev
+  libosmesa6-dev libpng-dev fonts-dejavu-core libcairo2-dev
   # tools, config, logging
   nlohmann-json3-dev libyaml-cpp-dev libexpat1-dev libcli11-dev libspdlog-dev
-  # tests and benchmarks (KDL and Ceres are test/bench-only oracles; OMPL for the SST baseline)
-  libgtest-dev libgmock-dev libbenchmark-dev liborocos-kdl-dev libceres-dev libompl-dev
+  # tests and benchmarks (KDL and Ceres are test/bench-only oracles)
+  libgtest-dev libgmock-dev libbenchmark-dev liborocos-kdl-dev libceres-dev
   # third-party URDFs with real meshes for renderer tests
   dart-doc
   # network namespaces for LCM multicast tests
