@@ -8,6 +8,9 @@ PACKAGES=(
   cmake ninja-build pkg-config g++ git
   # messaging
   liblcm-dev liblcm-bin libglib2.0-dev
+  # lcm-spy with kinograph's types (the jar is built when a JDK, e.g. openjdk-17-jdk-headless,
+  # is present too; this script does not install one)
+  liblcm-java libjchart2d-java
   # numerics, collision, models, meshes
   libeigen3-dev libsuitesparse-dev libbullet-dev liburdfdom-dev libassimp-dev
   # rendering and plots

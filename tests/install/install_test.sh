@@ -14,7 +14,7 @@ PREFIX=$TMP/prefix
 case "$TMP" in "$SRC"/* | "$BUILD"/*) echo "FAIL: $TMP lies inside the trees it must hide"; exit 1 ;; esac
 
 cmake --install "$BUILD" --prefix "$PREFIX" >"$TMP/install.log"
-for f in bin/kinograph bin/kinographd include/kinograph/kinograph/goal_t.hpp \
+for f in bin/kinograph bin/kinographd bin/kinograph-spy include/kinograph/kinograph/goal_t.hpp \
          include/kinograph/kinograph/planning/io/scene.h include/kinograph/render/image.h \
          lib/cmake/kinograph/kinographConfig.cmake lib/cmake/kinograph/kinographConfigVersion.cmake \
          share/kinograph/robots/scenes/rr_reach.yaml share/kinograph/lcmtypes/goal_t.lcm \
