@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The installed package as a user gets it. Installs the build into a temporary prefix, builds
-# examples/ against it with find_package(kinograph 0.1) and runs it; then the installed CLI
-# plans, validates and renders a shipped scene from another working directory with the build
-# and source trees gone: empty directories are mounted over them in a private mount namespace.
+# examples/ against it with find_package(kinograph 0.1) and runs it; then, with the prefix
+# moved, the installed CLI plans, validates and renders a shipped scene from another working
+# directory with the build and source trees gone: empty directories are mounted over them in a
+# private mount namespace.
 # That needs root; without it the last step is skipped (exit 77) and says so.
 # Usage: install_test.sh BUILD_DIR SOURCE_DIR
 set -euo pipefail
@@ -51,7 +52,21 @@ if cmake -S "$TMP/v2" -B "$TMP/v2/build" -DCMAKE_PREFIX_PATH="$PREFIX" >"$TMP/v2
   echo "FAIL: find_package(kinograph 1.0) accepted version 0.x"; exit 1
 fi
 
-# The installed CLI with the trees hidden, from a working directory of its own.
+# The installed CLI with the trees hidden, from a working directory of its own, after the
+# prefix has moved (nothing may depend on where it was installed).
+mv "$PREFIX" "$TMP/moved"
+PREFIX=$TMP/moved
+mkdir -p "$TMP/moved_user"
+cat >"$TMP/moved_user/CMakeLists.txt" <<'CM'
+cmake_minimum_required(VERSION 3.18)
+project(moved_user LANGUAGES CXX)
+find_package(kinograph 0.1 REQUIRED)
+message(STATUS "data: ${kinograph_DATA_DIR}")
+CM
+cmake -S "$TMP/moved_user" -B "$TMP/moved_user/build" -DCMAKE_PREFIX_PATH="$PREFIX" >"$TMP/moved.log" 2>&1 ||
+  { cat "$TMP/moved.log"; echo "FAIL: find_package(kinograph) in the moved prefix"; exit 1; }
+grep -qF -- "-- data: $PREFIX/share/kinograph" "$TMP/moved.log" ||
+  { cat "$TMP/moved.log"; echo "FAIL: kinograph_DATA_DIR does not follow the moved prefix"; exit 1; }
 mkdir -p "$TMP/work"
 cat >"$TMP/cli.sh" <<CLI
 set -eu
@@ -62,6 +77,8 @@ env -u KINOGRAPH_DATA_DIR "$PREFIX/bin/kinograph" plan "$PREFIX/share/kinograph/
 env -u KINOGRAPH_DATA_DIR "$PREFIX/bin/kinograph" validate "$PREFIX/share/kinograph/robots/scenes/rr_reach.yaml" plan.json
 env -u KINOGRAPH_DATA_DIR "$PREFIX/bin/kinograph" render plan.json --frames 3 --width 600 --height 200 --out strip.png
 [ -s strip.png ]
+grep -q '"urdf": "robots/rr/rr.urdf"' plan.json
+grep -q '"scene": "robots/scenes/rr_reach.yaml"' plan.json
 CLI
 if [ "$(id -u)" -ne 0 ] || ! unshare -m true 2>/dev/null; then
   echo "SKIP: hiding the source and build trees needs root (a private mount namespace)"
