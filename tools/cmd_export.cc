@@ -52,11 +52,13 @@ void run_export(const ExportArgs& args) {
 const bool kRegistered = register_command([](CLI::App& root) {
   auto args = std::make_shared<ExportArgs>();
   CLI::App* cmd = root.add_subcommand(
-      "export",
-      "Write a plan's trajectory as CSV: t (s), then q:<joint> (rad or m), qd:<joint> (rad/s "
-      "or m/s), qdd:<joint> (rad/s² or m/s²), tau:<joint> (N·m or N), one row per state");
+      "export", "Write a plan's trajectory as CSV: t, then q, qd, qdd and tau of every joint");
   cmd->add_option("plan", args->plan, "Plan file (JSON)")->required();
-  cmd->add_option("--csv", args->csv, "CSV file to write")->required();
+  cmd->add_option("--csv", args->csv,
+                  "CSV file to write, one row per state: t (s), q:<joint> (rad or m), "
+                  "qd:<joint> (rad/s or m/s), qdd:<joint> (rad/s² or m/s²), tau:<joint> "
+                  "(N·m or N)")
+      ->required();
   cmd->callback([args] { run_export(*args); });
 });
 

@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 
 #include "kinograph/planning/io/data_dir.h"
 #include "kinograph/planning/io/plan_json.h"
@@ -37,10 +38,11 @@ std::optional<std::string> plan_scene_path(const std::string& plan_path) {
   const std::string scene = json["scene"].get<std::string>();
   const std::optional<std::string> path = planning::resolve_plan_path(scene, plan_path);
   if (!path) {
-    throw CommandFailure("plan '" + plan_path + "': its scene '" + scene +
-                         "' is not found (looked in the working directory, next to the plan "
-                         "and in " +
-                         planning::describe_data_dirs() + "); give --scene");
+    // Only the camera comes from the scene: say so and frame automatically.
+    std::cerr << "kinograph: note: plan '" << plan_path << "' names scene '" << scene
+              << "', which is not found (looked in the working directory, next to the plan and "
+                 "in "
+              << planning::describe_data_dirs() << "); framing automatically (--scene gives one)\n";
   }
   return path;
 }

@@ -20,8 +20,8 @@ void write_plan_json(const planning::Plan& plan, const planning::Scene& scene,
                      const std::string& path);
 
 /// The scene file a plan file names under "scene", resolved as the plan's other paths
-/// (planning::resolve_plan_path); nullopt when it names none.
-/// @throws CommandFailure when the plan cannot be read or names a scene that is nowhere.
+/// (planning::resolve_plan_path); nullopt when it names none, or (said on stderr) one that is
+/// nowhere. @throws CommandFailure when the plan cannot be read or "scene" is not a string.
 std::optional<std::string> plan_scene_path(const std::string& plan_path);
 
 }  // namespace kinograph::tools

@@ -194,6 +194,16 @@ TEST_F(CliContract, RenderUsesTheCameraOfTheScenePlanned) {
   ASSERT_EQ(run_cli("render " + forgetful.string() + common + automatic.string()).status, 0);
   EXPECT_EQ(read_file(remembered), read_file(given));
   EXPECT_NE(read_file(remembered), read_file(automatic));
+  // A scene the plan names but that is gone: said, and framed automatically.
+  json["scene"] = "/no/such/scene.yaml";
+  const fs::path orphan = dir_ / "orphan.json";
+  std::ofstream(orphan) << json.dump();
+  const fs::path framed = dir_ / "framed.png";
+  const CliRun r = run_cli("render " + orphan.string() + common + framed.string());
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "names scene '/no/such/scene.yaml', which is not found"))
+      << r.output;
+  EXPECT_EQ(read_file(framed), read_file(automatic));
 }
 
 TEST_F(CliContract, ExportWritesThePlanAsCsv) {
