@@ -16,6 +16,7 @@
 #include "sim/sim_node.h"
 #include "tools/command_registry.h"
 #include "tools/lcm_client.h"
+#include "tools/number_list.h"
 
 namespace kinograph::tools {
 namespace {
@@ -25,12 +26,7 @@ void on_signal(int) { g_stop = true; }
 
 // A comma-separated list of exactly n numbers for `option`, one per joint.
 Eigen::VectorXd parse_joints(const std::string& text, const std::string& option, int n) {
-  std::vector<double> values = parse_list(text, option);
-  if (static_cast<int>(values.size()) != n) {
-    throw CommandFailure(option + " needs " + std::to_string(n) +
-                         " comma-separated numbers, one per joint; got " +
-                         std::to_string(values.size()));
-  }
+  std::vector<double> values = parse_number_list(text, option, static_cast<std::size_t>(n));
   return Eigen::Map<Eigen::VectorXd>(values.data(), n);
 }
 

@@ -4,7 +4,6 @@
 #include <lcm/lcm-cpp.hpp>
 #include <optional>
 #include <string>
-#include <vector>
 
 #include "kinograph/plan_t.hpp"
 #include "kinograph/plan_v1_t.hpp"
@@ -28,10 +27,6 @@ class PlanWaiter {
 
 /// Opens LCM on `url` (empty = default); throws CommandFailure if it cannot.
 lcm::LCM& open_lcm(const std::string& url);
-
-/// The numbers of a comma-separated list given to `option`; throws CommandFailure naming
-/// the item that is not a number.
-std::vector<double> parse_list(const std::string& text, const std::string& option);
 
 /// One line per plan: status, method, time, iterations, validation figures, and its clock.
 std::string summarize(const plan_t& plan);
