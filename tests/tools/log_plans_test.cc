@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "tests/lcmtypes/sample_messages.h"
-#include "tests/lib/cli_run.h"
+#include "tests/tools/cli_run.h"
 
 namespace kinograph::tools {
 namespace {
@@ -18,11 +18,6 @@ namespace {
 namespace fs = std::filesystem;
 using namespace kinograph::lcmtypes::testing;
 
-using kinograph::testing::CliRun;
-
-CliRun run(const std::string& args) {
-  return kinograph::testing::run_command(std::string(KINOGRAPH_CLI) + " " + args);
-}
 
 void log_event(lcm::LogFile& log, int64_t timestamp, const std::vector<uint8_t>& bytes) {
   lcm::LogEvent event;
@@ -53,7 +48,7 @@ TEST(CliLogPlans, ReadsBothPlanVersionsAndSkipsWhatIsNeither) {
     log_event(log, 3, encode(make_planner_status()));  // another type on the plan channel
   }
   const std::string scene = std::string(KINOGRAPH_SOURCE_DIR) + "/robots/scenes/iiwa_desk.yaml";
-  const CliRun r = run("log-plans " + log_path + " --channel IIWA_PLAN --scene " + scene +
+  const CliRun r = run_cli("log-plans " + log_path + " --channel IIWA_PLAN --scene " + scene +
                        " --out-dir " + (dir / "plans").string());
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_TRUE(fs::exists(dir / "plans" / "plan_1_1.json")) << r.output;
