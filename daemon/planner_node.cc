@@ -3,7 +3,6 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
-#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -11,37 +10,25 @@
 #include <stdexcept>
 #include <thread>
 
+#include "kinograph/lcm/drake_convert.h"
+#include "kinograph/lcm/lcm_connection.h"
 #include "kinograph/planner_status_t.hpp"
 #include "lcmtypes/safe_decode.h"
 
 namespace kinograph::daemon {
-namespace {
-
-std::string upper(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
-  return s;
-}
-
-}  // namespace
 
 PlannerNode::PlannerNode(planning::Scene scene, PlannerNodeOptions options, lcm::LCM* shared)
     : scene_(std::move(scene)), options_(std::move(options)), replanner_(options_.replanning) {
   if (!scene_.problem.model) throw std::invalid_argument("PlannerNode: the scene has no robot");
   identity_.model_name = scene_.problem.model->name;
-  identity_.channel_prefix =
-      options_.channel_prefix.empty() ? upper(identity_.model_name) : options_.channel_prefix;
+  identity_.channel_prefix = options_.channel_prefix.empty()
+                                 ? messages::default_channel_prefix(identity_.model_name)
+                                 : options_.channel_prefix;
   if (shared) {
     lcm_ = shared;
   } else {
-    owned_lcm_ = std::make_unique<lcm::LCM>(options_.lcm_url);
+    owned_lcm_ = messages::open_lcm(options_.lcm_url);
     lcm_ = owned_lcm_.get();
-  }
-  if (!lcm_->good()) {
-    throw std::runtime_error(
-        "LCM could not start on \"" +
-        (options_.lcm_url.empty() ? std::string("default URL") : options_.lcm_url) +
-        "\" (for udpm a multicast route is needed, see docs/network.md)");
   }
   next_obstacle_id_ = static_cast<int>(scene_.problem.obstacles.size());
   for (const auto& o : scene_.problem.obstacles) {
@@ -50,7 +37,12 @@ PlannerNode::PlannerNode(planning::Scene scene, PlannerNodeOptions options, lcm:
   subscriptions_ = {lcm_->subscribe(channel("GOAL"), &PlannerNode::on_goal, this),
                     lcm_->subscribe(channel("OBSTACLES"), &PlannerNode::on_obstacles, this),
                     lcm_->subscribe(channel("STATE"), &PlannerNode::on_state, this)};
-  const int capacities[] = {kGoalQueueCapacity, kObstacleQueueCapacity, kStateQueueCapacity};
+  std::vector<int> capacities = {kGoalQueueCapacity, kObstacleQueueCapacity, kStateQueueCapacity};
+  if (!options_.iiwa_status_channel.empty()) {
+    subscriptions_.push_back(
+        lcm_->subscribe(options_.iiwa_status_channel, &PlannerNode::on_iiwa_status, this));
+    capacities.push_back(kStateQueueCapacity);
+  }
   for (std::size_t i = 0; i < subscriptions_.size(); ++i) {
     subscriptions_[i]->setQueueCapacity(capacities[i]);
   }
@@ -72,9 +64,33 @@ NodeCounters PlannerNode::counters() const {
   return counters_;
 }
 
-int64_t PlannerNode::now_utime() const {
+int64_t PlannerNode::wall_utime() {
   using namespace std::chrono;
   return duration_cast<microseconds>(system_clock::now().time_since_epoch()).count();
+}
+
+messages::PlanTime PlannerNode::clock_now_locked() const {
+  messages::PlanTime time;
+  if (latest_state_) {
+    time.clock = plan_t::CLOCK_ROBOT;
+    time.utime = latest_state_->utime;
+  } else {
+    time.clock = plan_t::CLOCK_WALL;
+    time.utime = wall_utime();
+  }
+  return time;
+}
+
+std::string PlannerNode::stale_state_reason(const GoalRequest& goal,
+                                            const MeasuredState& state) const {
+  const double age_s = static_cast<double>(goal.utime - state.utime) * 1e-6;
+  if (age_s <= options_.max_state_age_s) return {};
+  return "the latest measured state (utime " + std::to_string(state.utime) + " us) is " +
+         std::to_string(age_s) + " s older than goal " + std::to_string(goal.goal_id) + " (utime " +
+         std::to_string(goal.utime) + " us), more than the " +
+         std::to_string(options_.max_state_age_s) +
+         " s allowed (--max-state-age): has the robot's state stream stopped, or are the goal "
+         "and the states on different clocks?";
 }
 
 void PlannerNode::reject(const std::string& reason) {
@@ -87,18 +103,22 @@ void PlannerNode::reject(const std::string& reason) {
   publish_status();
 }
 
-void PlannerNode::answer_with_failure(int8_t status, const std::string& reason, int64_t goal_id) {
+void PlannerNode::answer_with_failure(int8_t status, const std::string& reason, int64_t goal_id,
+                                      bool first_answer) {
   int64_t plan_id;
+  messages::PlanTime time;
   {
     std::lock_guard lock(mutex_);
     plan_id = next_plan_id_++;
     ++counters_.plans_published;
     ++counters_.failures;
-    ++counters_.goals_answered;
+    if (first_answer) ++counters_.goals_answered;
     if (status == plan_t::SUPERSEDED) ++counters_.goals_superseded;
+    time = clock_now_locked();
+    if (latest_state_) time.state_utime = latest_state_->utime;
   }
-  plan_t answer = messages::failure_message(status, reason, identity_.model_name, plan_id, goal_id,
-                                            now_utime());
+  plan_t answer =
+      messages::failure_message(status, reason, identity_.model_name, plan_id, goal_id, time);
   lcm_->publish(channel("PLAN"), &answer);
 }
 
@@ -173,13 +193,31 @@ void PlannerNode::on_state(const lcm::ReceiveBuffer* rbuf, const std::string& ch
     reject(channel + ": malformed robot_state_t: " + s.reason);
     return;
   }
-  Intake arrived;
-  arrived.state.emplace();
-  if (Check c = messages::state_from_message(msg, *scene_.problem.model, identity_, *arrived.state);
-      !c.ok) {
+  MeasuredState state;
+  if (Check c = messages::state_from_message(msg, *scene_.problem.model, identity_, state); !c.ok) {
     reject(channel + ": " + c.reason);
     return;
   }
+  take_state(std::move(state));
+}
+
+void PlannerNode::on_iiwa_status(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+  drake::lcmt_iiwa_status msg;
+  if (auto s = lcmtypes::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), msg); !s.ok) {
+    reject(channel + ": malformed lcmt_iiwa_status: " + s.reason);
+    return;
+  }
+  MeasuredState state;
+  if (Check c = messages::state_from_iiwa_status(msg, *scene_.problem.model, state); !c.ok) {
+    reject(channel + ": " + c.reason);
+    return;
+  }
+  take_state(std::move(state));
+}
+
+void PlannerNode::take_state(MeasuredState&& state) {
+  Intake arrived;
+  arrived.state = std::move(state);
   arrived.states = 1;
   intake_.absorb(std::move(arrived));
 }
@@ -253,16 +291,32 @@ bool PlannerNode::apply_obstacles(const std::vector<ObstacleUpdate>& updates, bo
 void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan) {
   planning::Problem problem = scene_.problem;
   bool new_state = false;
+  std::optional<int64_t> state_utime;  // of the measured state the plan starts from
+  std::string stale;
   {
     std::lock_guard lock(mutex_);
-    state_ = planner_status_t::PLANNING;
-    // A measured state, when there is one, is where the robot is: plan from it.
-    if (latest_state_) {
-      problem.start_q = latest_state_->q;
-      problem.start_qd = latest_state_->qd;
+    if (latest_state_) stale = stale_state_reason(goal, *latest_state_);
+    if (stale.empty()) {
+      state_ = planner_status_t::PLANNING;
+      // A measured state, when there is one, is where the robot is: plan from it.
+      if (latest_state_) {
+        problem.start_q = latest_state_->q;
+        problem.start_qd = latest_state_->qd;
+        state_utime = latest_state_->utime;
+      }
+      new_state = state_count_ != used_state_count_;
+      used_state_count_ = state_count_;
     }
-    new_state = state_count_ != used_state_count_;
-    used_state_count_ = state_count_;
+  }
+  if (!stale.empty()) {
+    spdlog::warn("goal {}: not planned: {}", goal.goal_id, stale);
+    answer_with_failure(plan_t::INVALID_STATE, stale, goal.goal_id, /*first_answer=*/!replan);
+    {
+      std::lock_guard lock(mutex_);
+      last_message_ = stale;
+    }
+    publish_status();
+    return;
   }
   for (const auto& [name, obstacle] : live_obstacles_) problem.obstacles.push_back(obstacle);
   problem.goal = goal.goal;
@@ -285,8 +339,10 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan) {
   }
 
   int64_t plan_id;
+  messages::PlanTime time;
   {
     std::lock_guard lock(mutex_);
+    time = clock_now_locked();
     plan_id = next_plan_id_++;
     last_plan_id_ = plan_id;
     ++counters_.plans_published;
@@ -298,20 +354,29 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan) {
     state_ = threw ? planner_status_t::ERROR : planner_status_t::IDLE;
     last_message_ = threw ? error : (plan.success() ? "" : plan.stats.reason);
   }
+  // Knot 0 is the measured state, at its own time; without a state the plan starts when it
+  // is published. Until replans join the motion under way, a plan takes over at its start.
+  time.state_utime = state_utime.value_or(-1);
+  time.start_utime = state_utime.value_or(time.utime);
+  time.takeover_utime = time.start_utime;
   plan_t msg;
   if (threw) {
     spdlog::error("goal {}: planner error: {}", goal.goal_id, error);
     msg = messages::failure_message(plan_t::FAILED, "planner error: " + error, identity_.model_name,
-                                    plan_id, goal.goal_id, now_utime());
+                                    plan_id, goal.goal_id, time);
   } else {
     msg = messages::plan_to_message(plan, *problem.model, identity_.model_name, plan_id,
-                                    goal.goal_id, now_utime());
+                                    goal.goal_id, time);
     msg.method = report.method;
     spdlog::info("goal {}: plan {} {} ({}, {} iterations, {:.1f} ms)", goal.goal_id, plan_id,
                  plan.success() ? "valid" : "INVALID", msg.method, plan.stats.iterations,
                  plan.stats.solve_time_s * 1e3);
   }
   lcm_->publish(channel("PLAN"), &msg);
+  if (!options_.drake_plan_channel.empty() && msg.status == plan_t::SUCCESS) {
+    drake::lcmt_robot_plan drake_plan = messages::robot_plan_from_plan(msg);
+    lcm_->publish(options_.drake_plan_channel, &drake_plan);
+  }
   publish_status();
 }
 
@@ -341,7 +406,7 @@ void PlannerNode::publish_status() {
   planner_status_t msg;
   {
     std::lock_guard lock(mutex_);
-    msg.utime = now_utime();
+    msg.utime = wall_utime();
     msg.robot = identity_.model_name;
     msg.state = state_;
     msg.last_goal_id = last_goal_id_;
@@ -360,6 +425,14 @@ void PlannerNode::publish_status() {
 void PlannerNode::run(const std::atomic<bool>& stop) {
   spdlog::info("kinographd: robot {} on channels {}_*", identity_.model_name,
                identity_.channel_prefix);
+  if (!options_.iiwa_status_channel.empty()) {
+    spdlog::info("kinographd: Drake's lcmt_iiwa_status on {} is the robot's state too",
+                 options_.iiwa_status_channel);
+  }
+  if (!options_.drake_plan_channel.empty()) {
+    spdlog::info("kinographd: valid plans also as Drake's lcmt_robot_plan on {}",
+                 options_.drake_plan_channel);
+  }
   // The worker stops on `done`, not on `stop`, so that an LCM failure also ends it.
   std::atomic<bool> done{false};
   std::thread worker([&] { worker_loop(done); });

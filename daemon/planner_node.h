@@ -55,6 +55,15 @@ struct PlannerNodeOptions {
   /// the way and are answered SUPERSEDED and counted as dropped. Off when several senders
   /// share the channel or ids are not consecutive (then no id means a loss).
   bool answer_goal_id_gaps = true;
+  /// Oldest measured state a goal is planned from (s, robot clock): when the goal's utime is
+  /// later than the latest state's by more, the goal is answered INVALID_STATE instead.
+  double max_state_age_s = 0.5;
+  /// Channel of Drake's lcmt_iiwa_status (e.g. "IIWA_STATUS") read as the measured state too,
+  /// joints in the URDF's order; empty = none.
+  std::string iiwa_status_channel;
+  /// Channel on which every valid plan is also published as Drake's lcmt_robot_plan (e.g.
+  /// "COMMITTED_ROBOT_PLAN"); empty = none.
+  std::string drake_plan_channel;
 };
 
 /// What a node has done since it started (for its status and for tests).
@@ -104,9 +113,16 @@ class PlannerNode {
   void on_goal(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   void on_obstacles(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   void on_state(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void on_iiwa_status(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  /// Hands a checked measured state to the intake (LCM thread).
+  void take_state(MeasuredState&& state);
   void reject(const std::string& reason);
-  /// Publishes a plan_t without trajectory that answers `goal_id` with a failure status.
-  void answer_with_failure(int8_t status, const std::string& reason, int64_t goal_id);
+  /// Publishes a plan_t without trajectory that answers `goal_id` with a failure status; a
+  /// second answer to a goal (a replan's) is not counted as an answered goal again.
+  void answer_with_failure(int8_t status, const std::string& reason, int64_t goal_id,
+                           bool first_answer = true);
+  /// Why a goal must not be planned from `state` (older than max_state_age_s), or empty.
+  std::string stale_state_reason(const GoalRequest& goal, const MeasuredState& state) const;
   /// Answers the goals a newer one replaced and the ids that never arrived (worker thread).
   void answer_superseded(const Intake& taken);
   /// Hands what the handlers took off LCM to the worker, in one go (LCM thread).
@@ -115,7 +131,11 @@ class PlannerNode {
   bool apply_obstacles(const std::vector<ObstacleUpdate>& updates, bool replace_all);
   void plan_and_publish(const GoalRequest& goal, bool replan);
   void publish_status();
-  int64_t now_utime() const;
+  /// The wall clock (epoch, µs): the heartbeat's, and the plans' while no state has arrived.
+  static int64_t wall_utime();
+  /// The plans' clock: the latest measured state's utime, or the wall clock before any state
+  /// arrived. Caller holds mutex_.
+  messages::PlanTime clock_now_locked() const;
 
   planning::Scene scene_;
   PlannerNodeOptions options_;

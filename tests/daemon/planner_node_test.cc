@@ -128,8 +128,9 @@ class NodeFixture : public ::testing::Test {
     stop_ = true;
     if (thread_.joinable()) thread_.join();
   }
-  void send_goal(int64_t id, std::vector<double> q) {
+  void send_goal(int64_t id, std::vector<double> q, int64_t utime = 0) {
     goal_t g{};
+    g.utime = utime;
     g.goal_id = id;
     g.kind = goal_t::KIND_JOINT_CONFIGURATION;
     g.num_joints = static_cast<int32_t>(q.size());
@@ -154,6 +155,18 @@ class NodeFixture : public ::testing::Test {
     lcm_.publish("RR_OBSTACLES", &list);
   }
 
+  // A measured state of the RR arm at `utime` on the robot's clock.
+  void send_state(int64_t utime, std::vector<double> q, std::vector<double> qd = {0, 0}) {
+    robot_state_t state{};
+    state.utime = utime;
+    state.robot = "rr";
+    state.num_joints = 2;
+    state.joint_name = {"joint1", "joint2"};
+    state.position = std::move(q);
+    state.velocity = std::move(qd);
+    lcm_.publish("RR_STATE", &state);
+  }
+
   lcm::LCM lcm_{"memq://"};
   bool defer_start_ = false;  // set by fixtures that create and run the node themselves
   std::atomic<bool> stop_{false};
@@ -174,6 +187,77 @@ TEST_F(NodeFixture, AnswersAGoalWithAValidPlanThatEndsThere) {
   EXPECT_NEAR(p.q.back()[1], -0.5, 1e-3);
   EXPECT_NEAR(p.q.front()[0], -0.8, 1e-6);
   EXPECT_TRUE(p.valid);
+}
+
+// Before any state the plan is on the daemon's wall clock and starts when it is published.
+TEST_F(NodeFixture, WithoutStatesAPlanIsOnTheWallClock) {
+  send_goal(15, {0.9, -0.5});
+  const auto plans = listener_->wait_plans(1);
+  ASSERT_EQ(plans.size(), 1u);
+  const plan_t& p = plans[0];
+  ASSERT_EQ(p.status, plan_t::SUCCESS) << p.status_message;
+  EXPECT_EQ(p.clock, plan_t::CLOCK_WALL);
+  EXPECT_EQ(p.state_utime, -1);
+  EXPECT_EQ(p.start_utime, p.utime);
+  EXPECT_EQ(p.takeover_utime, p.start_utime);
+  EXPECT_GT(p.utime, 1'600'000'000'000'000);  // an epoch time, not a sim time
+}
+
+// Sim time: a state at 5 s and a goal at 5.1 s on the robot's clock give a plan stamped on
+// that clock, knot 0 at the state's time, whatever the wall clock says.
+TEST_F(NodeFixture, WithStatesAPlanIsOnTheRobotClock) {
+  send_state(5'000'000, {-0.8, 0.4});
+  send_goal(16, {0.9, -0.5}, 5'100'000);
+  const auto plans = listener_->wait_plans(1);
+  ASSERT_EQ(plans.size(), 1u);
+  const plan_t& p = plans[0];
+  ASSERT_EQ(p.status, plan_t::SUCCESS) << p.status_message;
+  EXPECT_EQ(p.clock, plan_t::CLOCK_ROBOT);
+  EXPECT_EQ(p.state_utime, 5'000'000);
+  EXPECT_EQ(p.start_utime, 5'000'000);
+  EXPECT_EQ(p.takeover_utime, 5'000'000);
+  EXPECT_EQ(p.utime, 5'000'000);  // the robot's clock as the daemon last saw it
+  EXPECT_EQ(p.t[0], 0.0);
+}
+
+// A goal issued longer after the latest state than the bound (0.5 s by default) is refused,
+// with a reason that says how old the state was; the next fresh state lets it plan again.
+TEST_F(NodeFixture, AStaleStateRefusesTheGoalWithItsAge) {
+  send_state(5'000'000, {-0.8, 0.4});
+  send_goal(17, {0.9, -0.5}, 5'600'000);
+  auto plans = listener_->wait_plans(1);
+  ASSERT_EQ(plans.size(), 1u);
+  EXPECT_EQ(plans[0].goal_id, 17);
+  EXPECT_EQ(plans[0].status, plan_t::INVALID_STATE);
+  EXPECT_EQ(plans[0].state_utime, 5'000'000);
+  EXPECT_EQ(plans[0].clock, plan_t::CLOCK_ROBOT);
+  EXPECT_NE(plans[0].status_message.find("0.600000 s older than goal 17"), std::string::npos)
+      << plans[0].status_message;
+  send_state(5'500'000, {-0.8, 0.4});
+  send_goal(18, {0.9, -0.5}, 5'600'000);
+  plans = listener_->wait_plans(2);
+  ASSERT_EQ(plans.size(), 2u);
+  EXPECT_EQ(plans[1].status, plan_t::SUCCESS) << plans[1].status_message;
+  EXPECT_EQ(plans[1].start_utime, 5'500'000);
+  EXPECT_EQ(node_->counters().goals_answered, 2);
+}
+
+class StateAgeFixture : public NodeFixture {
+ protected:
+  StateAgeFixture() { defer_start_ = true; }
+};
+
+// --max-state-age: the same 0.6 s old state is accepted under a 1 s bound.
+TEST_F(StateAgeFixture, TheStateAgeBoundIsTheOptionsOne) {
+  PlannerNodeOptions options;
+  options.max_state_age_s = 1.0;
+  start(default_scene(), options);
+  send_state(5'000'000, {-0.8, 0.4});
+  send_goal(19, {0.9, -0.5}, 5'600'000);
+  const auto plans = listener_->wait_plans(1);
+  ASSERT_EQ(plans.size(), 1u);
+  EXPECT_EQ(plans[0].status, plan_t::SUCCESS) << plans[0].status_message;
+  EXPECT_EQ(plans[0].start_utime, 5'000'000);
 }
 
 TEST_F(NodeFixture, MalformedBytesGetAStatusAndTheNodeKeepsServing) {
