@@ -1,6 +1,7 @@
 #pragma once
 // DFGP batch planning: the problem's factor graph solved by Levenberg–Marquardt inside an
 // augmented-Lagrangian outer loop, then validated independently.
+#include "kinograph/planning/batch/path_search.h"
 #include "kinograph/planning/formulation/dfg_builder.h"
 #include "kinograph/planning/formulation/initialization.h"
 #include "kinograph/planning/formulation/planning_graph.h"
@@ -52,6 +53,9 @@ struct BatchPlannerOptions {
   /// does not (the straight line is then the first restart).
   bool detour_first = true;
   DetourOptions detour;
+  /// When the straight line collides, the first attempt starts from a collision-free path
+  /// (search_path, through path_trajectory) if one is found; it takes one of the max_restarts.
+  PathSearchOptions path_search;
 };
 
 /// Where the solve of a plan ended: its graph, values and the constraint state (final
