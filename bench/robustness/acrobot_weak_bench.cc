@@ -5,6 +5,7 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <memory>
 #include <cmath>
 #include <fstream>
 #include <iostream>
@@ -15,7 +16,6 @@
 
 #include "bench/common/bench_stats.h"
 #include "kinograph/planning/batch/batch_planner.h"
-#include "kinograph/planning/batch/continuation.h"
 #include "kinograph/planning/io/scene.h"
 
 namespace kinograph::bench {
@@ -32,6 +32,35 @@ std::vector<double> parse_list(const std::string& s) {
   std::stringstream in(s);
   for (std::string item; std::getline(in, item, ',');) out.push_back(std::stod(item));
   return out;
+}
+
+// The problem with every finite effort and velocity limit multiplied by `scale` (model copied).
+Problem with_scaled_limits(const Problem& problem, double scale) {
+  Problem p = problem;
+  auto model = std::make_shared<dynamics::Model>(*problem.model);
+  for (dynamics::Body& b : model->bodies) {
+    if (std::isfinite(b.limits.effort)) b.limits.effort *= scale;
+    if (std::isfinite(b.limits.velocity)) b.limits.velocity *= scale;
+  }
+  p.model = std::move(model);
+  return p;
+}
+
+// Continuation in the limits through the planner's API: the problem with its limits scaled by
+// each of `scales` in turn, each stage warm-started from the plan before it (valid or not), the
+// first from the planner's own initialization, then the problem itself from the last stage.
+// `stages_valid` gets whether each stage's plan validated (against its own scaled limits).
+Plan plan_with_continuation(const planning::BatchPlanner& planner, const Problem& problem,
+                            const std::vector<double>& scales, std::vector<bool>& stages_valid) {
+  Plan last;
+  bool have_last = false;
+  stages_valid.clear();
+  for (double s : scales) {
+    last = planner.plan(with_scaled_limits(problem, s), have_last ? &last : nullptr);
+    have_last = last.q.rows() == problem.steps + 1;
+    stages_valid.push_back(last.success());
+  }
+  return planner.plan(problem, have_last ? &last : nullptr);
 }
 
 // The horizon and steps of `p` (10 steps per second) and its start variant.
@@ -105,12 +134,14 @@ int run(int argc, char** argv) {
         const Plan eight = planner.plan(variant(strong, T, starts[v]));
         return planner.plan(p, &eight);
       });
-      const Timed cont = timed([&] { return planning::plan_with_continuation(planner, p, scales); });
+      std::vector<bool> stages;
+      const Timed cont = timed([&] { return plan_with_continuation(planner, p, scales, stages); });
       json r = {{"horizon_s", T},
                 {"start_q", {starts[v][0], starts[v][1]}},
                 {"direct", record(direct)},
                 {"warm_from_8Nm", record(warm)},
-                {"continuation", record(cont)}};
+                {"continuation", record(cont)},
+                {"continuation_stages_valid", stages}};
       std::cerr << r.dump() << "\n";
       runs.push_back(r);
     }
