@@ -5,10 +5,10 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
-#include <memory>
 #include <cmath>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>

@@ -43,8 +43,8 @@ void fit_horizon(Problem& p) {
   double t = 0;
   for (int j = 0; j < p.model->nq(); ++j) {
     const dynamics::JointLimits& l = p.model->bodies[j].limits;
-    t = std::max(t, planning::min_time_to_rest(p.goal.q[j] - p.start_q[j], 0, l.velocity,
-                                               l.acceleration));
+    t = std::max(
+        t, planning::min_time_to_rest(p.goal.q[j] - p.start_q[j], 0, l.velocity, l.acceleration));
   }
   p.horizon = std::max(3.0, std::ceil(2 * t * 10 - 1e-9) / 10);
   p.steps = static_cast<int>(std::lround(10 * p.horizon));

@@ -1,6 +1,8 @@
 // The joint-space path search that seeds the batch planner, and the trajectories through its
 // waypoints: clearance checked by dense sampling of our own, determinism by seed, and each option
 // against a run without it.
+#include "kinograph/planning/batch/path_search.h"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
@@ -14,7 +16,6 @@
 #include "kinograph/collision/collision_world.h"
 #include "kinograph/dynamics/kinematics.h"
 #include "kinograph/planning/batch/batch_planner.h"
-#include "kinograph/planning/batch/path_search.h"
 #include "kinograph/planning/clearance_world.h"
 #include "kinograph/planning/formulation/initialization.h"
 #include "kinograph/planning/io/scene.h"

@@ -4,8 +4,8 @@
 
 #include <algorithm>
 #include <chrono>
-#include <optional>
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 #include "kinograph/planning/formulation/initialization.h"
@@ -33,7 +33,8 @@ Plan solved_plan(const Problem& problem, const PlanningGraph& pg, const OuterLoo
 OuterLoopOptions outer_loop_options(const BatchPlannerOptions& options) {
   OuterLoopOptions loop = options.outer_loop;
   if (options.formulation == Formulation::kDynamicFactorGraph) {
-    loop.constraint_tolerance = std::min(loop.constraint_tolerance, options.dfg_constraint_tolerance);
+    loop.constraint_tolerance =
+        std::min(loop.constraint_tolerance, options.dfg_constraint_tolerance);
     loop.inner_tolerance_final =
         std::min(loop.inner_tolerance_final, options.dfg_inner_tolerance_final);
   }

@@ -16,8 +16,8 @@ namespace kinograph::planning {
 namespace {
 
 constexpr double kStep = 0.6;         // rad (m): longest joint move of one tree extension
-constexpr double kResolution = 0.07;   // rad (m): largest joint change between checked states
-constexpr int kShortcutRounds = 40;    // random shortcut attempts on a found path
+constexpr double kResolution = 0.07;  // rad (m): largest joint change between checked states
+constexpr int kShortcutRounds = 40;   // random shortcut attempts on a found path
 
 // Whether configurations keep their clearance: obstacles (their own threshold) and the floor
 // and self pairs (theirs), each in a world of its own so the thresholds can differ.
@@ -29,7 +29,8 @@ class ClearanceTest {
       obstacles_ = std::make_unique<collision::CollisionWorld>(model_);
       for (const collision::Obstacle& o : problem.obstacles) {
         const collision::Status s = obstacles_->add_obstacle(o);
-        if (!s.ok) throw std::invalid_argument("obstacle " + std::to_string(o.id) + ": " + s.reason);
+        if (!s.ok)
+          throw std::invalid_argument("obstacle " + std::to_string(o.id) + ": " + s.reason);
       }
     }
     obstacle_threshold_ = options.obstacle_clearance;
@@ -57,7 +58,8 @@ class ClearanceTest {
 
   // The segment a → b, sampled every `resolution` (b included, a assumed clear).
   bool clear(const Eigen::VectorXd& a, const Eigen::VectorXd& b, double resolution) {
-    const int n = std::max(1, static_cast<int>(std::ceil((b - a).cwiseAbs().maxCoeff() / resolution)));
+    const int n =
+        std::max(1, static_cast<int>(std::ceil((b - a).cwiseAbs().maxCoeff() / resolution)));
     for (int i = 1; i <= n; ++i) {
       if (!clear(a + (b - a) * (static_cast<double>(i) / n))) return false;
     }

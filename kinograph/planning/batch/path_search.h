@@ -23,10 +23,10 @@ struct PathSearchOptions {
 };
 
 /// A path start_q → q_goal (both included) whose straight joint-space segments keep the
-/// obstacle clearance of the options and are free of self-collision and the floor by the self ε (each
-/// sampled every 0.07 rad of its largest joint move); empty when none is found within max_samples. Static obstacles only:
-/// obstacles that move are taken at their pose at time 0. Throws std::invalid_argument for an
-/// obstacle the collision world refuses.
+/// obstacle clearance of the options and are free of self-collision and the floor by the self ε
+/// (each sampled every 0.07 rad of its largest joint move); empty when none is found within
+/// max_samples. Static obstacles only: obstacles that move are taken at their pose at time 0.
+/// Throws std::invalid_argument for an obstacle the collision world refuses.
 std::optional<std::vector<Eigen::VectorXd>> search_path(const Problem& problem,
                                                         const Eigen::VectorXd& q_goal,
                                                         const PathSearchOptions& options = {});
