@@ -36,7 +36,9 @@ void mark_failed(Image& image, const std::string& text) {
   cairo_set_line_width(cr, 2 * border);  // half of the stroke falls outside the picture
   cairo_rectangle(cr, 0, 0, image.width, image.height);
   cairo_stroke(cr);
-  cairo_rectangle(cr, 0, 0, image.width, banner_h);
+  // At the bottom: the top carries the panels' time labels and the legends.
+  const double banner_y = image.height - banner_h;
+  cairo_rectangle(cr, 0, banner_y, image.width, banner_h);
   cairo_fill(cr);
   cairo_select_font_face(cr, "DejaVu Sans", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_BOLD);
   cairo_set_font_size(cr, font_px);
@@ -52,7 +54,7 @@ void mark_failed(Image& image, const std::string& text) {
   cairo_font_extents(cr, &font);
   cairo_set_source_rgb(cr, 1, 1, 1);
   cairo_move_to(cr, 0.5 * (image.width - ext.x_advance),
-                0.5 * (banner_h + font.ascent - font.descent));
+                banner_y + 0.5 * (banner_h + font.ascent - font.descent));
   cairo_show_text(cr, text.c_str());
   cairo_destroy(cr);
   image = detail::from_cairo(surface);

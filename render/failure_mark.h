@@ -1,6 +1,6 @@
 #pragma once
 // Pictures of failed plans are marked as such: a red frame round the picture and a red
-// banner across its top saying why, so a failed plan never passes for a valid one.
+// banner across its bottom saying why, so a failed plan never passes for a valid one.
 #include <optional>
 #include <string>
 
