@@ -10,6 +10,8 @@
 #include <stdexcept>
 #include <thread>
 
+#include "daemon/state_limits.h"
+#include "daemon/wire_strings.h"
 #include "kinograph/lcm/drake_convert.h"
 #include "kinograph/lcm/lcm_connection.h"
 #include "kinograph/planner_status_t.hpp"
@@ -93,14 +95,41 @@ std::string PlannerNode::stale_state_reason(const GoalRequest& goal,
          "and the states on different clocks?";
 }
 
-void PlannerNode::reject(const std::string& reason) {
-  spdlog::warn("rejected: {}", reason);
+void PlannerNode::reject(const std::string& channel, const std::string& reason) {
+  bool log;
+  std::vector<std::string> summaries;
   {
     std::lock_guard lock(mutex_);
     ++counters_.messages_rejected;
     last_message_ = reason;
+    log = reject_log_.admit(channel, LogLimiter::Clock::now(), summaries);
   }
+  for (const std::string& line : summaries) spdlog::warn("{}", line);
+  if (log) spdlog::warn("rejected: {}", reason);
   publish_status();
+}
+
+void PlannerNode::flush_reject_log() {
+  std::vector<std::string> summaries;
+  {
+    std::lock_guard lock(mutex_);
+    summaries = reject_log_.flush(LogLimiter::Clock::now());
+  }
+  for (const std::string& line : summaries) spdlog::warn("{}", line);
+}
+
+template <class Message>
+void PlannerNode::publish(const std::string& channel, const Message& msg) {
+  const int status = lcm_->publish(channel, &msg);
+  if (status == 0) return;
+  int64_t failures;
+  {
+    std::lock_guard lock(mutex_);
+    failures = ++counters_.publish_failures;
+    last_publish_failure_ = channel;
+  }
+  spdlog::error("publishing {} on {} failed (LCM returned {}); {} publishes failed since start",
+                Message::getTypeName(), channel, status, failures);
 }
 
 void PlannerNode::answer_with_failure(int8_t status, const std::string& reason, int64_t goal_id,
@@ -119,7 +148,7 @@ void PlannerNode::answer_with_failure(int8_t status, const std::string& reason, 
   }
   plan_t answer =
       messages::failure_message(status, reason, identity_.model_name, plan_id, goal_id, time);
-  lcm_->publish(channel("PLAN"), &answer);
+  publish(channel("PLAN"), answer);
 }
 
 void PlannerNode::answer_superseded(const Intake& taken) {
@@ -145,7 +174,7 @@ void PlannerNode::answer_superseded(const Intake& taken) {
 void PlannerNode::on_goal(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
   goal_t msg;
   if (auto s = lcmtypes::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), msg); !s.ok) {
-    reject(channel + ": malformed goal_t: " + s.reason);
+    reject(channel, channel + ": malformed goal_t: " + s.reason);
     return;
   }
   if (msg.goal_id >= 0) {
@@ -160,9 +189,15 @@ void PlannerNode::on_goal(const lcm::ReceiveBuffer* rbuf, const std::string& cha
     }
   }
   GoalRequest request;
-  if (Check c = messages::goal_from_message(msg, *scene_.problem.model, identity_, request);
-      !c.ok) {
-    reject(channel + ": " + c.reason);
+  // Names are bounded first, so that no reason echoes an unbounded string.
+  Check c;
+  if (std::string overlong = overlong_name(msg); !overlong.empty()) {
+    c = Check::fail(overlong);
+  } else {
+    c = messages::goal_from_message(msg, *scene_.problem.model, identity_, request);
+  }
+  if (!c.ok) {
+    reject(channel, channel + ": " + c.reason);
     // The sender named a goal: answer it, so no goal ever goes unanswered.
     if (msg.goal_id >= 0) answer_with_failure(plan_t::INVALID_GOAL, c.reason, msg.goal_id);
     return;
@@ -175,12 +210,16 @@ void PlannerNode::on_goal(const lcm::ReceiveBuffer* rbuf, const std::string& cha
 void PlannerNode::on_obstacles(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
   obstacle_list_t msg;
   if (auto s = lcmtypes::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), msg); !s.ok) {
-    reject(channel + ": malformed obstacle_list_t: " + s.reason);
+    reject(channel, channel + ": malformed obstacle_list_t: " + s.reason);
+    return;
+  }
+  if (std::string overlong = overlong_name(msg); !overlong.empty()) {
+    reject(channel, channel + ": " + overlong);
     return;
   }
   Intake arrived;
   if (Check c = messages::obstacles_from_message(msg, arrived.obstacles); !c.ok) {
-    reject(channel + ": " + c.reason);
+    reject(channel, channel + ": " + c.reason);
     return;
   }
   arrived.replace_all = msg.replace_all;
@@ -190,35 +229,62 @@ void PlannerNode::on_obstacles(const lcm::ReceiveBuffer* rbuf, const std::string
 void PlannerNode::on_state(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
   robot_state_t msg;
   if (auto s = lcmtypes::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), msg); !s.ok) {
-    reject(channel + ": malformed robot_state_t: " + s.reason);
+    reject(channel, channel + ": malformed robot_state_t: " + s.reason);
     return;
+  }
+  if (std::string overlong = overlong_name(msg); !overlong.empty()) {
+    reject(channel, channel + ": " + overlong);
+    return;
+  }
+  // A state of this robot with NaN or Inf in it is a sensor fault: goals get INVALID_STATE.
+  if (identity_.matches(msg.robot)) {
+    if (std::string bad = non_finite_joint(msg); !bad.empty()) {
+      refuse_state(channel, msg.utime, bad);
+      return;
+    }
   }
   MeasuredState state;
   if (Check c = messages::state_from_message(msg, *scene_.problem.model, identity_, state); !c.ok) {
-    reject(channel + ": " + c.reason);
+    reject(channel, channel + ": " + c.reason);
     return;
   }
-  take_state(std::move(state));
+  take_state(channel, std::move(state));
 }
 
 void PlannerNode::on_iiwa_status(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
   drake::lcmt_iiwa_status msg;
   if (auto s = lcmtypes::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), msg); !s.ok) {
-    reject(channel + ": malformed lcmt_iiwa_status: " + s.reason);
+    reject(channel, channel + ": malformed lcmt_iiwa_status: " + s.reason);
     return;
   }
   MeasuredState state;
   if (Check c = messages::state_from_iiwa_status(msg, *scene_.problem.model, state); !c.ok) {
-    reject(channel + ": " + c.reason);
+    reject(channel, channel + ": " + c.reason);
     return;
   }
-  take_state(std::move(state));
+  take_state(channel, std::move(state));
 }
 
-void PlannerNode::take_state(MeasuredState&& state) {
+void PlannerNode::take_state(const std::string& channel, MeasuredState&& state) {
+  if (std::string beyond = state_beyond_limits(state, *scene_.problem.model); !beyond.empty()) {
+    refuse_state(channel, state.utime, beyond);
+    return;
+  }
   Intake arrived;
   arrived.state = std::move(state);
   arrived.states = 1;
+  intake_.absorb(std::move(arrived));
+}
+
+void PlannerNode::refuse_state(const std::string& channel, int64_t utime, std::string reason) {
+  {
+    std::lock_guard lock(mutex_);
+    ++counters_.states_refused;
+  }
+  reject(channel, channel + ": measured state at utime " + std::to_string(utime) +
+                      " cannot be a start: " + reason);
+  Intake arrived;
+  arrived.state_refused = std::move(reason);
   intake_.absorb(std::move(arrived));
 }
 
@@ -226,10 +292,15 @@ void PlannerNode::hand_over() {
   if (intake_.empty()) return;
   {
     std::lock_guard lock(mutex_);
-    if (intake_.state) latest_state_ = std::move(intake_.state);
+    if (intake_.state) {
+      latest_state_ = std::move(intake_.state);
+      state_refusal_.clear();
+    }
+    if (!intake_.state_refused.empty()) state_refusal_ = std::move(intake_.state_refused);
     state_count_ += intake_.states;
     intake_.state.reset();
     intake_.states = 0;
+    intake_.state_refused.clear();
     pending_.absorb(std::move(intake_));
   }
   intake_ = Intake{};
@@ -268,7 +339,7 @@ bool PlannerNode::apply_obstacles(const std::vector<ObstacleUpdate>& updates, bo
         live_obstacles_.erase(it);
         changed = true;
       } else {
-        spdlog::info("obstacle \"{}\" to remove is not known; ignored", u.id);
+        spdlog::info("obstacle \"{}\" to remove is not known; ignored", truncated(u.id));
       }
       continue;
     }
@@ -280,7 +351,7 @@ bool PlannerNode::apply_obstacles(const std::vector<ObstacleUpdate>& updates, bo
     changed = true;
   }
   if (!refused.empty()) {
-    reject("obstacle \"" + refused.front() + "\"" +
+    reject(channel("OBSTACLES"), "obstacle \"" + truncated(refused.front()) + "\"" +
            (refused.size() > 1 ? " and " + std::to_string(refused.size() - 1) + " more" : "") +
            " not added: the world holds the most obstacles it may, " +
            std::to_string(collision::kMaxObstacles) + " (scene and LCM together)");
@@ -295,7 +366,11 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan) {
   std::string stale;
   {
     std::lock_guard lock(mutex_);
-    if (latest_state_) stale = stale_state_reason(goal, *latest_state_);
+    if (!state_refusal_.empty()) {
+      stale = "the robot's latest measured state cannot be a start, " + state_refusal_;
+    } else if (latest_state_) {
+      stale = stale_state_reason(goal, *latest_state_);
+    }
     if (stale.empty()) {
       state_ = planner_status_t::PLANNING;
       // A measured state, when there is one, is where the robot is: plan from it.
@@ -372,10 +447,10 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan) {
                  plan.success() ? "valid" : "INVALID", msg.method, plan.stats.iterations,
                  plan.stats.solve_time_s * 1e3);
   }
-  lcm_->publish(channel("PLAN"), &msg);
+  publish(channel("PLAN"), msg);
   if (!options_.drake_plan_channel.empty() && msg.status == plan_t::SUCCESS) {
     drake::lcmt_robot_plan drake_plan = messages::robot_plan_from_plan(msg);
-    lcm_->publish(options_.drake_plan_channel, &drake_plan);
+    publish(options_.drake_plan_channel, drake_plan);
   }
   publish_status();
 }
@@ -412,6 +487,12 @@ void PlannerNode::publish_status() {
     msg.last_goal_id = last_goal_id_;
     msg.last_plan_id = last_plan_id_;
     msg.message = last_message_;
+    // planner_status_t has no field for failed publishes: the text carries them.
+    if (counters_.publish_failures > 0) {
+      msg.message += (msg.message.empty() ? "" : "; ") +
+                     std::to_string(counters_.publish_failures) +
+                     " publishes failed since start, the last on " + last_publish_failure_;
+    }
     msg.num_plans = counters_.plans_published;
     msg.num_failures = counters_.failures;
     msg.num_goals_received = counters_.goals_received;
@@ -419,7 +500,7 @@ void PlannerNode::publish_status() {
     msg.num_goals_superseded = counters_.goals_superseded;
     msg.num_goals_dropped = counters_.goals_dropped;
   }
-  lcm_->publish(channel("PLANNER_STATUS"), &msg);
+  publish(channel("PLANNER_STATUS"), msg);
 }
 
 void PlannerNode::run(const std::atomic<bool>& stop) {
@@ -441,6 +522,7 @@ void PlannerNode::run(const std::atomic<bool>& stop) {
   while (!stop.load()) {
     if (std::chrono::steady_clock::now() >= next_status) {
       publish_status();
+      flush_reject_log();
       next_status += std::chrono::duration_cast<std::chrono::steady_clock::duration>(
           std::chrono::duration<double>(options_.status_period_s));
     }
