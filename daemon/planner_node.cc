@@ -8,6 +8,7 @@
 #include <cstring>
 #include <lcm/lcm-cpp.hpp>
 #include <stdexcept>
+#include <string_view>
 #include <thread>
 
 #include "daemon/state_limits.h"
@@ -39,7 +40,10 @@ PlannerNode::PlannerNode(planning::Scene scene, PlannerNodeOptions options, lcm:
   subscriptions_ = {lcm_->subscribe(channel("GOAL"), &PlannerNode::on_goal, this),
                     lcm_->subscribe(channel("OBSTACLES"), &PlannerNode::on_obstacles, this),
                     lcm_->subscribe(channel("STATE"), &PlannerNode::on_state, this)};
-  std::vector<int> capacities = {kGoalQueueCapacity, kObstacleQueueCapacity, kStateQueueCapacity};
+  subscriptions_.push_back(
+      lcm_->subscribe(channel("PLANNER_STATUS"), &PlannerNode::on_heartbeat, this));
+  std::vector<int> capacities = {kGoalQueueCapacity, kObstacleQueueCapacity, kStateQueueCapacity,
+                                 kHeartbeatQueueCapacity};
   if (!options_.iiwa_status_channel.empty()) {
     subscriptions_.push_back(
         lcm_->subscribe(options_.iiwa_status_channel, &PlannerNode::on_iiwa_status, this));
@@ -120,7 +124,14 @@ void PlannerNode::flush_reject_log() {
 
 template <class Message>
 void PlannerNode::publish(const std::string& channel, const Message& msg) {
-  const int status = lcm_->publish(channel, &msg);
+  std::vector<uint8_t> bytes(static_cast<std::size_t>(msg.getEncodedSize()));
+  msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  publish_bytes(Message::getTypeName(), channel, bytes.data(), static_cast<unsigned>(bytes.size()));
+}
+
+void PlannerNode::publish_bytes(const char* type, const std::string& channel, const void* data,
+                                unsigned size) {
+  const int status = lcm_->publish(channel, data, size);
   if (status == 0) return;
   int64_t failures;
   {
@@ -129,7 +140,7 @@ void PlannerNode::publish(const std::string& channel, const Message& msg) {
     last_publish_failure_ = channel;
   }
   spdlog::error("publishing {} on {} failed (LCM returned {}); {} publishes failed since start",
-                Message::getTypeName(), channel, status, failures);
+                type, channel, status, failures);
 }
 
 void PlannerNode::answer_with_failure(int8_t status, const std::string& reason, int64_t goal_id,
@@ -263,6 +274,34 @@ void PlannerNode::on_iiwa_status(const lcm::ReceiveBuffer* rbuf, const std::stri
     return;
   }
   take_state(channel, std::move(state));
+}
+
+void PlannerNode::on_heartbeat(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+  planner_status_t msg;
+  if (auto s = lcmtypes::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), msg); !s.ok) {
+    reject(channel, channel + ": malformed planner_status_t: " + s.reason);
+    return;
+  }
+  const std::size_t hash = std::hash<std::string_view>{}(
+      std::string_view(static_cast<const char*>(rbuf->data), rbuf->data_size));
+  std::string report;
+  {
+    std::lock_guard lock(mutex_);
+    if (own_heartbeats_.judge(msg.utime, hash) != OwnHeartbeats::Verdict::kForeign) return;
+    ++counters_.foreign_heartbeats;
+    foreign_daemon_ = "another planner daemon publishes on " + channel + " (robot \"" +
+                      truncated(msg.robot) + "\", its last plan id " +
+                      std::to_string(msg.last_plan_id) +
+                      "): both answer every goal, with colliding plan ids";
+    const int64_t now = wall_utime();
+    // Reported at once, then once a minute while it lasts.
+    if (foreign_logged_utime_ == 0 || now - foreign_logged_utime_ >= 60'000'000) {
+      foreign_logged_utime_ = now;
+      report = foreign_daemon_ + " (" + std::to_string(counters_.foreign_heartbeats) +
+               " of its heartbeats seen)";
+    }
+  }
+  if (!report.empty()) spdlog::warn("{}", report);
 }
 
 void PlannerNode::take_state(const std::string& channel, MeasuredState&& state) {
@@ -479,28 +518,40 @@ void PlannerNode::worker_loop(const std::atomic<bool>& stop) {
 
 void PlannerNode::publish_status() {
   planner_status_t msg;
+  std::vector<uint8_t> bytes;
   {
     std::lock_guard lock(mutex_);
-    msg.utime = wall_utime();
+    msg.utime = own_heartbeats_.next_utime(wall_utime());
     msg.robot = identity_.model_name;
     msg.state = state_;
     msg.last_goal_id = last_goal_id_;
     msg.last_plan_id = last_plan_id_;
     msg.message = last_message_;
-    // planner_status_t has no field for failed publishes: the text carries them.
+    // planner_status_t has no fields for failed publishes or a second daemon: the text says.
+    const auto append = [&](const std::string& text) {
+      msg.message += (msg.message.empty() ? "" : "; ") + text;
+    };
     if (counters_.publish_failures > 0) {
-      msg.message += (msg.message.empty() ? "" : "; ") +
-                     std::to_string(counters_.publish_failures) +
-                     " publishes failed since start, the last on " + last_publish_failure_;
+      append(std::to_string(counters_.publish_failures) +
+             " publishes failed since start, the last on " + last_publish_failure_);
     }
+    if (!foreign_daemon_.empty()) append(foreign_daemon_);
     msg.num_plans = counters_.plans_published;
     msg.num_failures = counters_.failures;
     msg.num_goals_received = counters_.goals_received;
     msg.num_goals_answered = counters_.goals_answered;
     msg.num_goals_superseded = counters_.goals_superseded;
     msg.num_goals_dropped = counters_.goals_dropped;
+    // Recorded before it is sent, under the lock that gave it its utime, so that its
+    // loop-back is always recognised as ours.
+    bytes.resize(static_cast<std::size_t>(msg.getEncodedSize()));
+    msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+    own_heartbeats_.record(msg.utime, std::hash<std::string_view>{}(std::string_view(
+                                          reinterpret_cast<const char*>(bytes.data()),
+                                          bytes.size())));
   }
-  publish(channel("PLANNER_STATUS"), msg);
+  publish_bytes(planner_status_t::getTypeName(), channel("PLANNER_STATUS"), bytes.data(),
+                static_cast<unsigned>(bytes.size()));
 }
 
 void PlannerNode::run(const std::atomic<bool>& stop) {

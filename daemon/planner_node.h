@@ -20,6 +20,7 @@
 
 #include "daemon/intake.h"
 #include "daemon/log_limiter.h"
+#include "daemon/own_heartbeats.h"
 #include "kinograph/lcm/message_convert.h"
 #include "kinograph/planning/io/scene.h"
 #include "kinograph/planning/replanner.h"
@@ -81,6 +82,7 @@ struct NodeCounters {
   int fallbacks = 0;             ///< incremental replans redone by a batch solve
   int64_t publish_failures = 0;  ///< messages LCM failed to send (lcm_publish returned non-zero)
   int64_t states_refused = 0;    ///< states beyond the limits or not finite (never a start)
+  int64_t foreign_heartbeats = 0;  ///< heartbeats on this daemon's channel published by another
 };
 
 /// The planner daemon's node: scene (robot, defaults, fixed obstacles) + LCM + worker thread.
@@ -92,6 +94,11 @@ class PlannerNode {
   static constexpr int kGoalQueueCapacity = 10000;
   static constexpr int kObstacleQueueCapacity = 2000;
   static constexpr int kStateQueueCapacity = 2000;
+  /// Heartbeats read back from the daemon's own status channel (to find a second daemon);
+  /// dropping some only delays finding it.
+  static constexpr int kHeartbeatQueueCapacity = 100;
+  /// Own heartbeats remembered to tell them from another daemon's (over an hour at 1 Hz).
+  static constexpr std::size_t kOwnHeartbeatMemory = 4096;
   /// Log lines about rejected messages allowed per second and channel; the rest are counted
   /// and summarised in one line.
   static constexpr int kRejectLogLinesPerSecond = 10;
@@ -120,6 +127,8 @@ class PlannerNode {
   void on_obstacles(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   void on_state(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   void on_iiwa_status(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  /// A heartbeat on this daemon's status channel: its own, or another daemon's (reported).
+  void on_heartbeat(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   /// Hands a decoded measured state to the intake (LCM thread); one beyond the robot's limits
   /// is refused, and goals are answered INVALID_STATE until a usable state arrives.
   void take_state(const std::string& channel, MeasuredState&& state);
@@ -131,6 +140,9 @@ class PlannerNode {
   /// Publishes `msg` on `channel`; a failure is logged as an error and counted in the heartbeat.
   template <class Message>
   void publish(const std::string& channel, const Message& msg);
+  /// Publishes encoded bytes of type `type`, checked as publish() does.
+  void publish_bytes(const char* type, const std::string& channel, const void* data,
+                     unsigned size);
   /// Logs the summaries of rejections the rate limit left out.
   void flush_reject_log();
   /// Publishes a plan_t without trajectory that answers `goal_id` with a failure status; a
@@ -179,6 +191,9 @@ class PlannerNode {
   std::string last_publish_failure_;  // channel of the last failed publish
   std::string state_refusal_;  // why the newest measured state cannot be a start, or empty
   LogLimiter reject_log_{kRejectLogLinesPerSecond, 1.0};
+  OwnHeartbeats own_heartbeats_{kOwnHeartbeatMemory};
+  std::string foreign_daemon_;  // what the last foreign heartbeat said about its daemon
+  int64_t foreign_logged_utime_ = 0;  // wall clock of the last log line about it
   int64_t next_plan_id_ = 1;
 
   // Owned by the worker thread.

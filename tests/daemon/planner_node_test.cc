@@ -81,6 +81,12 @@ class Listener {
     });
     return found;
   }
+  // Waits until `count` heartbeats have arrived.
+  bool wait_statuses(size_t count, double timeout_s = 30) {
+    std::unique_lock lock(mutex_);
+    return cv_.wait_for(lock, std::chrono::duration<double>(timeout_s),
+                        [&] { return statuses_.size() >= count; });
+  }
   // Waits until some status message mentions `text`.
   bool wait_status_containing(const std::string& text, double timeout_s = 10) {
     std::unique_lock lock(mutex_);
@@ -308,6 +314,24 @@ TEST_F(NodeFixture, AnOverlongNameIsRefusedAndNotEchoed) {
   const auto status = listener_->wait_status_answered(1);
   ASSERT_TRUE(status);
   EXPECT_LT(status->message.size(), 300u);
+}
+
+// A node hears its own heartbeats and takes them as its own; a heartbeat on its status channel
+// that it did not publish (here the test's, standing in for a second daemon on prefix RR; two
+// real daemons: tests/daemon/second_daemon_test.sh) is reported in its heartbeat.
+TEST_F(NodeFixture, AHeartbeatOfASecondDaemonIsReported) {
+  ASSERT_TRUE(listener_->wait_statuses(5));  // the node's own heartbeats, read back by it too
+  EXPECT_EQ(node_->counters().foreign_heartbeats, 0);
+  planner_status_t other{};
+  other.utime = std::chrono::duration_cast<std::chrono::microseconds>(
+                    std::chrono::system_clock::now().time_since_epoch())
+                    .count();
+  other.robot = "rr";
+  other.last_plan_id = 7;
+  lcm_.publish("RR_PLANNER_STATUS", &other);
+  EXPECT_TRUE(listener_->wait_status_containing(
+      "another planner daemon publishes on RR_PLANNER_STATUS (robot \"rr\", its last plan id 7)"));
+  EXPECT_EQ(node_->counters().foreign_heartbeats, 1);
 }
 
 class StateAgeFixture : public NodeFixture {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "daemon/log_limiter.h"
+#include "daemon/own_heartbeats.h"
 #include "daemon/state_limits.h"
 #include "daemon/wire_strings.h"
 #include "kinograph/planning/io/scene.h"
@@ -123,6 +124,23 @@ TEST(LogLimiter, FlushSummarisesABurstThatStopped) {
   ASSERT_EQ(flushed.size(), 1u);
   EXPECT_EQ(flushed[0], "… 4 more rejected messages on RR_OBSTACLES in the last 2.0 s");
   EXPECT_TRUE(limiter.flush(t0 + std::chrono::seconds(4)).empty());  // said once
+}
+
+TEST(OwnHeartbeats, OursAreKnownOthersAreForeignTooOldIsNotJudged) {
+  OwnHeartbeats own(3);
+  EXPECT_EQ(own.judge(100, 1), OwnHeartbeats::Verdict::kTooOld);  // nothing published yet
+  EXPECT_EQ(own.next_utime(100), 100);
+  own.record(100, 1);
+  EXPECT_EQ(own.next_utime(100), 101);  // strictly increasing, so a utime names one heartbeat
+  own.record(101, 2);
+  own.record(150, 3);
+  EXPECT_EQ(own.judge(101, 2), OwnHeartbeats::Verdict::kOurs);
+  EXPECT_EQ(own.judge(101, 9), OwnHeartbeats::Verdict::kForeign);  // same time, other bytes
+  EXPECT_EQ(own.judge(120, 2), OwnHeartbeats::Verdict::kForeign);  // a time we never used
+  EXPECT_EQ(own.judge(200, 3), OwnHeartbeats::Verdict::kForeign);
+  own.record(160, 4);  // forgets 100
+  EXPECT_EQ(own.judge(100, 1), OwnHeartbeats::Verdict::kTooOld);
+  EXPECT_EQ(own.judge(150, 3), OwnHeartbeats::Verdict::kOurs);
 }
 
 }  // namespace
