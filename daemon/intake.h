@@ -40,7 +40,8 @@ struct Intake {
   /// Nothing arrived.
   bool empty() const;
   /// Adds what arrived after this intake: a newer goal supersedes the one held here, a
-  /// replace_all discards the obstacle changes held here, a newer state, usable or refused, replaces the old one.
+  /// replace_all discards the obstacle changes held here, a newer state, usable or refused,
+  /// replaces the old one.
   void absorb(Intake&& newer);
 };
 

@@ -6,7 +6,8 @@ namespace kinograph::daemon {
 
 LogLimiter::LogLimiter(int lines_per_window, double window_s)
     : lines_per_window_(lines_per_window),
-      window_(std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(window_s))) {}
+      window_(
+          std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(window_s))) {}
 
 std::string LogLimiter::summary(const std::string& kind, const Window& w,
                                 Clock::time_point now) const {

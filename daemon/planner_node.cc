@@ -390,10 +390,11 @@ bool PlannerNode::apply_obstacles(const std::vector<ObstacleUpdate>& updates, bo
     changed = true;
   }
   if (!refused.empty()) {
-    reject(channel("OBSTACLES"), "obstacle \"" + truncated(refused.front()) + "\"" +
-           (refused.size() > 1 ? " and " + std::to_string(refused.size() - 1) + " more" : "") +
-           " not added: the world holds the most obstacles it may, " +
-           std::to_string(collision::kMaxObstacles) + " (scene and LCM together)");
+    reject(channel("OBSTACLES"),
+           "obstacle \"" + truncated(refused.front()) + "\"" +
+               (refused.size() > 1 ? " and " + std::to_string(refused.size() - 1) + " more" : "") +
+               " not added: the world holds the most obstacles it may, " +
+               std::to_string(collision::kMaxObstacles) + " (scene and LCM together)");
   }
   return changed;
 }
@@ -546,9 +547,9 @@ void PlannerNode::publish_status() {
     // loop-back is always recognised as ours.
     bytes.resize(static_cast<std::size_t>(msg.getEncodedSize()));
     msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
-    own_heartbeats_.record(msg.utime, std::hash<std::string_view>{}(std::string_view(
-                                          reinterpret_cast<const char*>(bytes.data()),
-                                          bytes.size())));
+    own_heartbeats_.record(msg.utime,
+                           std::hash<std::string_view>{}(std::string_view(
+                               reinterpret_cast<const char*>(bytes.data()), bytes.size())));
   }
   publish_bytes(planner_status_t::getTypeName(), channel("PLANNER_STATUS"), bytes.data(),
                 static_cast<unsigned>(bytes.size()));

@@ -70,18 +70,18 @@ struct PlannerNodeOptions {
 
 /// What a node has done since it started (for its status and for tests).
 struct NodeCounters {
-  int64_t goals_received = 0;    ///< goal_t messages decoded with a goal_id (valid or not)
-  int64_t goals_answered = 0;    ///< goals answered once: planned, refused or superseded
-  int64_t goals_superseded = 0;  ///< of which SUPERSEDED: a newer goal was planned instead
-  int64_t goals_dropped = 0;     ///< goal ids skipped in the sender's sequence (lost), answered
-  int messages_rejected = 0;     ///< messages of any type that failed to decode or check
-  int plans_published = 0;       ///< plan_t messages sent (successes and failures)
-  int failures = 0;              ///< of which not SUCCESS
-  int replans = 0;               ///< plans triggered by an obstacle change for the current goal
-  int incremental = 0;           ///< plans answered by an incremental replan (validated or not)
-  int fallbacks = 0;             ///< incremental replans redone by a batch solve
-  int64_t publish_failures = 0;  ///< messages LCM failed to send (lcm_publish returned non-zero)
-  int64_t states_refused = 0;    ///< states beyond the limits or not finite (never a start)
+  int64_t goals_received = 0;      ///< goal_t messages decoded with a goal_id (valid or not)
+  int64_t goals_answered = 0;      ///< goals answered once: planned, refused or superseded
+  int64_t goals_superseded = 0;    ///< of which SUPERSEDED: a newer goal was planned instead
+  int64_t goals_dropped = 0;       ///< goal ids skipped in the sender's sequence (lost), answered
+  int messages_rejected = 0;       ///< messages of any type that failed to decode or check
+  int plans_published = 0;         ///< plan_t messages sent (successes and failures)
+  int failures = 0;                ///< of which not SUCCESS
+  int replans = 0;                 ///< plans triggered by an obstacle change for the current goal
+  int incremental = 0;             ///< plans answered by an incremental replan (validated or not)
+  int fallbacks = 0;               ///< incremental replans redone by a batch solve
+  int64_t publish_failures = 0;    ///< messages LCM failed to send (lcm_publish returned non-zero)
+  int64_t states_refused = 0;      ///< states beyond the limits or not finite (never a start)
   int64_t foreign_heartbeats = 0;  ///< heartbeats on this daemon's channel published by another
 };
 
@@ -141,8 +141,7 @@ class PlannerNode {
   template <class Message>
   void publish(const std::string& channel, const Message& msg);
   /// Publishes encoded bytes of type `type`, checked as publish() does.
-  void publish_bytes(const char* type, const std::string& channel, const void* data,
-                     unsigned size);
+  void publish_bytes(const char* type, const std::string& channel, const void* data, unsigned size);
   /// Logs the summaries of rejections the rate limit left out.
   void flush_reject_log();
   /// Publishes a plan_t without trajectory that answers `goal_id` with a failure status; a
@@ -189,10 +188,10 @@ class PlannerNode {
   int64_t last_plan_id_ = -1;
   std::string last_message_;
   std::string last_publish_failure_;  // channel of the last failed publish
-  std::string state_refusal_;  // why the newest measured state cannot be a start, or empty
+  std::string state_refusal_;         // why the newest measured state cannot be a start, or empty
   LogLimiter reject_log_{kRejectLogLinesPerSecond, 1.0};
   OwnHeartbeats own_heartbeats_{kOwnHeartbeatMemory};
-  std::string foreign_daemon_;  // what the last foreign heartbeat said about its daemon
+  std::string foreign_daemon_;        // what the last foreign heartbeat said about its daemon
   int64_t foreign_logged_utime_ = 0;  // wall clock of the last log line about it
   int64_t next_plan_id_ = 1;
 

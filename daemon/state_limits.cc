@@ -1,9 +1,9 @@
 #include "daemon/state_limits.h"
 
+#include <spdlog/fmt/fmt.h>
+
 #include <cmath>
 #include <string>
-
-#include <spdlog/fmt/fmt.h>
 
 #include "daemon/wire_strings.h"
 

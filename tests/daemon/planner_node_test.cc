@@ -259,9 +259,13 @@ TEST_F(NodeFixture, AStateBeyondTheLimitsIsNeverAStart) {
     std::string says;
   };
   const std::vector<Case> cases = {
-      {{-0.8, 3.5}, {0, 0}, plan_t::INVALID_STATE,  // joint2 is limited to [-pi, pi]
+      {{-0.8, 3.5},
+       {0, 0},
+       plan_t::INVALID_STATE,  // joint2 is limited to [-pi, pi]
        "joint joint2: measured position 3.5 is 0.358407 beyond"},
-      {{-0.8, 0.4}, {4.0, 0}, plan_t::INVALID_STATE,  // joint1's velocity limit is 3 rad/s
+      {{-0.8, 0.4},
+       {4.0, 0},
+       plan_t::INVALID_STATE,  // joint1's velocity limit is 3 rad/s
        "joint joint1: measured velocity 4 is 1 above"},
       {{-0.7, 0.4}, {0, 0}, plan_t::SUCCESS, ""},
   };

@@ -19,8 +19,8 @@ namespace {
 
 // The RR arm as the daemon's integration tests serve it.
 const dynamics::Model& rr() {
-  static const planning::Scene scene = planning::load_scene(
-      std::string(KINOGRAPH_SOURCE_DIR) + "/tests/integration/rr_daemon.yaml");
+  static const planning::Scene scene =
+      planning::load_scene(std::string(KINOGRAPH_SOURCE_DIR) + "/tests/integration/rr_daemon.yaml");
   return *scene.problem.model;
 }
 
