@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/common/bench_flags.h"
 #include "bench/common/bench_stats.h"
 #include "kinograph/planning/batch/batch_planner.h"
 #include "kinograph/planning/io/scene.h"
@@ -24,8 +25,6 @@ namespace {
 using nlohmann::json;
 using planning::Plan;
 using planning::Problem;
-
-const std::string kScenes = std::string(KINOGRAPH_SOURCE_DIR) + "/robots/scenes/";
 
 std::vector<double> parse_list(const std::string& s) {
   std::vector<double> out;
@@ -105,19 +104,12 @@ json record(const Timed& t) {
 int run(int argc, char** argv) {
   std::vector<double> horizons{8, 10, 12, 15, 20}, scales{2, 1.5, 1.25};
   std::string json_path;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--horizons" && i + 1 < argc) {
-      horizons = parse_list(argv[++i]);
-    } else if (a == "--scales" && i + 1 < argc) {
-      scales = parse_list(argv[++i]);
-    } else if (a == "--json" && i + 1 < argc) {
-      json_path = argv[++i];
-    } else {
-      std::cerr << "usage: acrobot_weak_bench [--horizons 8,10,...] [--scales 2,1.5,...] "
-                   "[--json FILE]\n";
-      return 1;
-    }
+  if (!Flags("acrobot_weak_bench")
+           .value("--horizons", "8,10,...", [&](const std::string& s) { horizons = parse_list(s); })
+           .value("--scales", "2,1.5,...", [&](const std::string& s) { scales = parse_list(s); })
+           .value("--json", &json_path)
+           .parse(argc, argv)) {
+    return 1;
   }
   spdlog::set_level(spdlog::level::warn);
   const Problem weak = planning::load_scene(kScenes + "acrobot_swingup_4nm.yaml").problem;

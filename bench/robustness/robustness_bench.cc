@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/common/bench_flags.h"
 #include "bench/common/bench_stats.h"
 #include "bench/common/clearance_walk.h"
 #include "bench/common/iiwa_goals.h"
@@ -33,7 +34,6 @@ using nlohmann::json;
 using planning::Plan;
 using planning::Problem;
 
-const std::string kScenes = std::string(KINOGRAPH_SOURCE_DIR) + "/robots/scenes/";
 constexpr int kWalkSamples = 40;  // points per interval of the benchmark's own clearance walk
 
 // The horizon of a move: twice the least time its slowest joint needs alone at its velocity and
@@ -134,22 +134,14 @@ json plan_case(const Problem& p, const Run& r, Tally& t) {
   return c;
 }
 
-// A JSON number, NaN for null (NaN is written as null).
-double num(const json& j) { return j.is_number() ? j.get<double>() : std::nan(""); }
-
 int run(int argc, char** argv) {
   int count = 50;
   std::string json_path;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--count" && i + 1 < argc) {
-      count = std::stoi(argv[++i]);
-    } else if (a == "--json" && i + 1 < argc) {
-      json_path = argv[++i];
-    } else {
-      std::cerr << "usage: robustness_bench [--count N] [--json FILE]\n";
-      return 1;
-    }
+  if (!Flags("robustness_bench")
+           .value("--count", &count)
+           .value("--json", &json_path)
+           .parse(argc, argv)) {
+    return 1;
   }
   spdlog::set_level(spdlog::level::warn);
   const planning::Scene desk = planning::load_scene(kScenes + "iiwa_desk.yaml");
@@ -215,10 +207,11 @@ int run(int argc, char** argv) {
       }
       std::cout << "| " << key << " | " << mode << " | " << s["successes"] << "/" << s["runs"]
                 << " | " << s["successes_clear"] << " | "
-                << cell(num(s["min_self_clearance_m"]), 1e3, 1) << " / "
-                << cell(num(s["min_floor_clearance_m"]), 1e3, 1) << " | "
-                << cell(num(s["time_s_median"]), 1e3) << " | " << cell(num(s["time_s_max"]), 1e3)
-                << " | " << (kinds.empty() ? "–" : kinds) << " |\n";
+                << cell(json_number(s["min_self_clearance_m"]), 1e3, 1) << " / "
+                << cell(json_number(s["min_floor_clearance_m"]), 1e3, 1) << " | "
+                << cell(json_number(s["time_s_median"]), 1e3) << " | "
+                << cell(json_number(s["time_s_max"]), 1e3) << " | " << (kinds.empty() ? "–" : kinds)
+                << " |\n";
     }
   }
   return 0;

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/common/bench_flags.h"
 #include "bench/common/bench_stats.h"
 #include "bench/common/clearance_walk.h"
 #include "bench/common/iiwa_goals.h"
@@ -32,7 +33,6 @@ using nlohmann::json;
 using planning::Plan;
 using planning::Problem;
 
-const std::string kScenes = std::string(KINOGRAPH_SOURCE_DIR) + "/robots/scenes/";
 // Points per interval of the clearance walk (the validator samples 10 and walks adaptively).
 constexpr int kWalkSamples = 40;
 
@@ -69,22 +69,14 @@ json times(const std::vector<Run>& runs) {
           {"time_s_max", max_of(ok)},    {"time_s_median_all", median(all)}};
 }
 
-// A JSON number, NaN for null (NaN is written as null).
-double num(const json& j) { return j.is_number() ? j.get<double>() : std::nan(""); }
-
 int run(int argc, char** argv) {
   int count = 50;
   std::string json_path;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--count" && i + 1 < argc) {
-      count = std::stoi(argv[++i]);
-    } else if (a == "--json" && i + 1 < argc) {
-      json_path = argv[++i];
-    } else {
-      std::cerr << "usage: self_collision_bench [--count N] [--json FILE]\n";
-      return 1;
-    }
+  if (!Flags("self_collision_bench")
+           .value("--count", &count)
+           .value("--json", &json_path)
+           .parse(argc, argv)) {
+    return 1;
   }
   spdlog::set_level(spdlog::level::warn);
   const planning::BatchPlanner planner;
@@ -224,25 +216,28 @@ int run(int argc, char** argv) {
                "|---|---|---|---|---|---|---|---|\n";
   std::cout << "| " << r["cases"] << " | " << r["successes"] << " | "
             << r["successes_without_self_and_floor"] << " | " << r["successes_clear"] << " | "
-            << cell(num(r["min_self_clearance_m"]), 1e3, 1) << " | "
-            << cell(num(r["min_floor_clearance_m"]), 1e3, 1) << " | "
-            << cell(num(r["time_s_median"]), 1e3) << " | " << cell(num(r["horizon_s_median"]), 1, 1)
-            << " |\n\n";
+            << cell(json_number(r["min_self_clearance_m"]), 1e3, 1) << " | "
+            << cell(json_number(r["min_floor_clearance_m"]), 1e3, 1) << " | "
+            << cell(json_number(r["time_s_median"]), 1e3) << " | "
+            << cell(json_number(r["horizon_s_median"]), 1, 1) << " |\n\n";
   std::cout << "| problem | checks | success | median time (ms) | mean (ms) | max (ms) | median "
                "all runs (ms) | both valid: median (ms), ratio |\n"
                "|---|---|---|---|---|---|---|---|\n";
   for (const char* key : {"iiwa_task1", "iiwa_task2"}) {
     for (const char* mode : {"with", "without"}) {
       const json& s = result[key][mode];
-      std::cout << "| " << key << " | " << mode << " | " << s["successes"] << "/" << s["runs"]
-                << " | " << cell(num(s["time_s_median"]), 1e3) << " | "
-                << cell(num(s["time_s_mean"]), 1e3) << " | " << cell(num(s["time_s_max"]), 1e3)
-                << " | " << cell(num(s["time_s_median_all"]), 1e3) << " | "
-                << cell(num(result[key][std::string("both_valid_") + mode + "_time_s_median"]), 1e3)
-                << (std::string(mode) == "with"
-                        ? ", " + cell(num(result[key]["both_valid_time_ratio_median"]), 1, 2)
-                        : std::string())
-                << " |\n";
+      std::cout
+          << "| " << key << " | " << mode << " | " << s["successes"] << "/" << s["runs"] << " | "
+          << cell(json_number(s["time_s_median"]), 1e3) << " | "
+          << cell(json_number(s["time_s_mean"]), 1e3) << " | "
+          << cell(json_number(s["time_s_max"]), 1e3) << " | "
+          << cell(json_number(s["time_s_median_all"]), 1e3) << " | "
+          << cell(json_number(result[key][std::string("both_valid_") + mode + "_time_s_median"]),
+                  1e3)
+          << (std::string(mode) == "with"
+                  ? ", " + cell(json_number(result[key]["both_valid_time_ratio_median"]), 1, 2)
+                  : std::string())
+          << " |\n";
     }
   }
   return 0;
