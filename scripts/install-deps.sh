@@ -19,6 +19,8 @@ PACKAGES=(
   nlohmann-json3-dev libyaml-cpp-dev libexpat1-dev libcli11-dev libspdlog-dev
   # tests and benchmarks (KDL and Ceres are test/bench-only oracles)
   libgtest-dev libgmock-dev libbenchmark-dev liborocos-kdl-dev libceres-dev
+  # the side-by-side benchmark against OMPL's control planners (bench/peers)
+  libompl-dev
   # third-party URDFs with real meshes for renderer tests
   dart-doc
   # the Python client's tests (the client needs only python3 and liblcm1)
