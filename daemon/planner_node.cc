@@ -182,35 +182,55 @@ void PlannerNode::answer_superseded(const Intake& taken) {
   }
 }
 
+namespace {
+
+// Bounds the names of a decoded goal of either version, then converts it.
+template <typename GoalMessage>
+Check convert_goal(const GoalMessage& msg, const dynamics::Model& model,
+                   const RobotIdentity& identity, GoalRequest& request) {
+  // Names are bounded first, so that no reason echoes an unbounded string.
+  if (std::string overlong = overlong_name(msg); !overlong.empty()) return Check::fail(overlong);
+  return messages::goal_from_message(msg, model, identity, request);
+}
+
+}  // namespace
+
 void PlannerNode::on_goal(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
-  goal_t msg;
-  if (auto s = lcmtypes::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), msg); !s.ok) {
-    reject(channel, channel + ": malformed goal_t: " + s.reason);
+  // Both goal versions share the channel; the fingerprint says which one came.
+  const int size = static_cast<int>(rbuf->data_size);
+  goal_v2_t v2;
+  goal_t v1;
+  const bool is_v1 = lcmtypes::has_fingerprint<goal_t>(rbuf->data, size);
+  if (!is_v1 && !lcmtypes::has_fingerprint<goal_v2_t>(rbuf->data, size)) {
+    reject(channel, channel + ": malformed goal_t (or goal_v2_t): its fingerprint is neither's");
     return;
   }
-  if (msg.goal_id >= 0) {
+  const auto s = is_v1 ? lcmtypes::safe_decode(rbuf->data, size, v1)
+                       : lcmtypes::safe_decode(rbuf->data, size, v2);
+  if (!s.ok) {
+    reject(channel, channel + ": malformed " + (is_v1 ? "goal_t" : "goal_v2_t") + ": " + s.reason);
+    return;
+  }
+  const int64_t goal_id = is_v1 ? v1.goal_id : v2.goal_id;
+  if (goal_id >= 0) {
     std::optional<LostGoals> lost;
-    if (options_.answer_goal_id_gaps) lost = goal_ids_.next(msg.goal_id);
+    if (options_.answer_goal_id_gaps) lost = goal_ids_.next(goal_id);
     std::lock_guard lock(mutex_);
     ++counters_.goals_received;
-    last_goal_id_ = msg.goal_id;
+    last_goal_id_ = goal_id;
     if (lost) {
       counters_.goals_dropped += lost->count();
       intake_.lost.push_back(*lost);
     }
   }
   GoalRequest request;
-  // Names are bounded first, so that no reason echoes an unbounded string.
-  Check c;
-  if (std::string overlong = overlong_name(msg); !overlong.empty()) {
-    c = Check::fail(overlong);
-  } else {
-    c = messages::goal_from_message(msg, *scene_.problem.model, identity_, request);
-  }
+  const dynamics::Model& model = *scene_.problem.model;
+  const Check c = is_v1 ? convert_goal(v1, model, identity_, request)
+                        : convert_goal(v2, model, identity_, request);
   if (!c.ok) {
     reject(channel, channel + ": " + c.reason);
     // The sender named a goal: answer it, so no goal ever goes unanswered.
-    if (msg.goal_id >= 0) answer_with_failure(plan_t::INVALID_GOAL, c.reason, msg.goal_id);
+    if (goal_id >= 0) answer_with_failure(plan_t::INVALID_GOAL, c.reason, goal_id);
     return;
   }
   Intake arrived;
@@ -434,7 +454,10 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan) {
     return;
   }
   for (const auto& [name, obstacle] : live_obstacles_) problem.obstacles.push_back(obstacle);
-  problem.goal = goal.goal;
+  // Joints a goal does not name stay where this plan starts.
+  problem.goal = messages::goal_for_start(goal, problem.start_q);
+  problem.task_constraints.insert(problem.task_constraints.end(), goal.task_constraints.begin(),
+                                  goal.task_constraints.end());
   if (goal.duration_s > 0) problem.horizon = goal.duration_s;
 
   planning::Plan plan;

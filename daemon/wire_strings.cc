@@ -24,6 +24,21 @@ std::string overlong_name(const goal_t& msg) {
   return check("goal_t.ee_frame", msg.ee_frame);
 }
 
+std::string overlong_name(const goal_v2_t& msg) {
+  if (std::string r = check("goal_v2_t.robot", msg.robot); !r.empty()) return r;
+  if (std::string r = check("goal_v2_t.ee_frame", msg.ee_frame); !r.empty()) return r;
+  for (std::size_t i = 0; i < msg.joint_name.size(); ++i) {
+    std::string r = check("goal_v2_t.joint_name[" + std::to_string(i) + "]", msg.joint_name[i]);
+    if (!r.empty()) return r;
+  }
+  for (std::size_t i = 0; i < msg.task_constraint.size(); ++i) {
+    std::string r = check("goal_v2_t.task_constraint[" + std::to_string(i) + "].frame",
+                          msg.task_constraint[i].frame);
+    if (!r.empty()) return r;
+  }
+  return {};
+}
+
 std::string overlong_name(const robot_state_t& msg) {
   if (std::string r = check("robot_state_t.robot", msg.robot); !r.empty()) return r;
   for (std::size_t i = 0; i < msg.joint_name.size(); ++i) {

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "kinograph/goal_t.hpp"
+#include "kinograph/goal_v2_t.hpp"
 #include "kinograph/obstacle_list_t.hpp"
 #include "kinograph/robot_state_t.hpp"
 
@@ -22,6 +23,7 @@ std::string truncated(const std::string& s, std::size_t max = kMaxQuoted);
 /// Why a message cannot be taken because a name in it is longer than kMaxWireName (the field,
 /// its length and its truncated start), or empty.
 std::string overlong_name(const goal_t& msg);
+std::string overlong_name(const goal_v2_t& msg);
 std::string overlong_name(const robot_state_t& msg);
 std::string overlong_name(const obstacle_list_t& msg);
 

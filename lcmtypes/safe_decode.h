@@ -18,6 +18,7 @@
 #include "drake/lcmt_robot_plan.hpp"
 #include "drake/lcmt_robot_state.hpp"
 #include "kinograph/goal_t.hpp"
+#include "kinograph/goal_v2_t.hpp"
 #include "kinograph/joint_command_t.hpp"
 #include "kinograph/obstacle_list_t.hpp"
 #include "kinograph/obstacle_t.hpp"
@@ -25,6 +26,7 @@
 #include "kinograph/plan_v1_t.hpp"
 #include "kinograph/planner_status_t.hpp"
 #include "kinograph/robot_state_t.hpp"
+#include "kinograph/task_constraint_t.hpp"
 
 namespace kinograph::lcmtypes {
 
@@ -161,6 +163,32 @@ inline bool check_fields(WireReader& r, const goal_t*) {
          r.string("goal_t.ee_frame") && r.skip(3 + 4 + 1, 8, "goal_t.ee_pose/duration_s");
 }
 
+// A task constraint inside a goal carries no fingerprint of its own.
+inline bool check_fields(WireReader& r, const task_constraint_t*) {
+  return r.string("task_constraint_t.frame") && r.boolean("task_constraint_t.orientation_only") &&
+         r.skip(3 + 4 + 1, 8, "task_constraint_t.position/quaternion/tolerance");
+}
+constexpr int64_t kMinTaskConstraintBytes = kMinStringBytes + 1 + 8 * 8;
+
+inline bool check_fields(WireReader& r, const goal_v2_t*) {
+  int64_t i64 = 0;
+  int32_t n = 0, constraints = 0;
+  if (!(r.read_i64(i64, "goal_v2_t.utime") && r.read_i64(i64, "goal_v2_t.goal_id") &&
+        r.string("goal_v2_t.robot") && r.skip(1, 1, "goal_v2_t.kind") &&
+        r.count(n, kMinStringBytes + 8, "goal_v2_t.num_joints")))
+    return false;
+  for (int32_t i = 0; i < n; ++i)
+    if (!r.string("goal_v2_t.joint_name")) return false;
+  if (!(r.skip(n, 8, "goal_v2_t.joint_position") && r.string("goal_v2_t.ee_frame") &&
+        r.skip(3 + 4, 8, "goal_v2_t.ee_position/ee_quaternion") &&
+        r.boolean("goal_v2_t.position_only") && r.skip(1, 8, "goal_v2_t.duration_s") &&
+        r.count(constraints, kMinTaskConstraintBytes, "goal_v2_t.num_task_constraints")))
+    return false;
+  for (int32_t i = 0; i < constraints; ++i)
+    if (!check_fields(r, static_cast<const task_constraint_t*>(nullptr))) return false;
+  return true;
+}
+
 // An obstacle inside a list carries no fingerprint of its own.
 inline bool check_fields(WireReader& r, const obstacle_t*) {
   return r.string("obstacle_t.id") && r.skip(2, 1, "obstacle_t.action/shape") &&
@@ -262,6 +290,15 @@ inline bool check_fields(WireReader& r, const planner_status_t*) {
 }
 
 }  // namespace detail
+
+/// Whether received bytes begin with the fingerprint of `Msg`: tells the versions of a type
+/// that share a channel apart (goal_v2_t and goal_t) before decoding.
+template <typename Msg>
+bool has_fingerprint(const void* data, int size) {
+  detail::WireReader reader(data, size);
+  int64_t hash = 0;
+  return reader.read_i64(hash, "fingerprint") && hash == Msg::getHash();
+}
 
 /// Decodes a received kinograph (or Drake) message into `out` (replacing it wholly) only if it is
 /// well formed: right fingerprint, every count and string length consistent with the bytes,

@@ -165,13 +165,11 @@ Image plot_torques(const std::vector<PlotSeries>& series, const TorquePlotOption
     const double limit = j < static_cast<int>(options.limits.size())
                              ? options.limits[j]
                              : std::numeric_limits<double>::infinity();
+    // The axes span the data, not the limits: a limit far above two plans' torques would
+    // squash both into one flat band.
     Range y_range;
     for (const PlotSeries& s : series) {
       for (const Eigen::VectorXd& v : s.values) y_range.add(v[j]);
-    }
-    if (std::isfinite(limit)) {
-      y_range.add(limit);
-      y_range.add(-limit);
     }
     y_range.settle();
     const double pad = 0.06 * (y_range.hi - y_range.lo);
@@ -212,18 +210,22 @@ Image plot_torques(const std::vector<PlotSeries>& series, const TorquePlotOption
       cairo_line_to(cr, x1, py(0));
       cairo_stroke(cr);
     }
-    // Limits, dashed.
+    // Limits, dashed where they fall within the axes; one beyond them is named at that edge.
     if (std::isfinite(limit)) {
       const double dash[] = {6, 4};
       cairo_set_dash(cr, dash, 2, 0);
       cairo_set_source_rgb(cr, 0.8, 0.1, 0.1);
       cairo_set_line_width(cr, 1.5);
       for (double v : {limit, -limit}) {
+        if (v < y_range.lo || v > y_range.hi) continue;
         cairo_move_to(cr, x0, py(v));
         cairo_line_to(cr, x1, py(v));
         cairo_stroke(cr);
       }
       cairo_set_dash(cr, nullptr, 0, 0);
+      const std::string value = fmt::format("{:g}", limit);
+      if (limit > y_range.hi) text(cr, "limit " + value + " \u2191", x1 - 4, y0 + 3, 11, 1.0, 0);
+      if (-limit < y_range.lo) text(cr, "limit -" + value + " \u2193", x1 - 4, y1 - 3, 11, 1.0, 1.0);
     }
     // Curves, clipped to the axes.
     cairo_save(cr);

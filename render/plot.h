@@ -1,6 +1,7 @@
 #pragma once
-// Torque plots of plans (the paper's torque figure): one subplot per joint, the effort limits
-// dashed, several plans overlaid in different colours with a legend. Drawn with cairo.
+// Torque plots of plans (the paper's torque figure): one subplot per joint, its axes spanning
+// the data, the effort limits dashed where they fall within (named at the edge where they lie
+// beyond), several plans overlaid in different colours with a legend. Drawn with cairo.
 #include <Eigen/Core>
 #include <string>
 #include <vector>
@@ -24,7 +25,8 @@ struct TorquePlotOptions {
   std::string title = "Joint torques";
   std::string y_label = "\u03c4 [N\u00b7m]";
   std::vector<std::string> joint_names;  ///< subplot titles; "joint i" when empty
-  std::vector<double> limits;            ///< ±limit per joint drawn dashed; inf or empty = none
+  /// ±limit per joint, dashed within the axes, else named at the edge; inf or empty = none
+  std::vector<double> limits;
 };
 
 /// Round tick values covering [lo, hi] (about `target` of them, steps of 1, 2 or 5 × 10^k).

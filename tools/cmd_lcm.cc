@@ -1,6 +1,6 @@
 // LCM verbs of the CLI: talk to a running kinographd.
-//   kinograph send-goal     --prefix IIWA (--q ... | --frame F --position ... --quaternion ...)
-//                           [--utime US]
+//   kinograph send-goal     --prefix IIWA (--q ... | --joint NAME=V ... | --frame F
+//                           --position ... (--quaternion ... | --position-only)) [--utime US]
 //   kinograph send-obstacle --prefix IIWA --id box --shape box --size ... --position ...
 //   kinograph send-state    --prefix IIWA --scene S --q ... [--qd ...] [--utime US]
 //   kinograph send-raw      CHANNEL --text BYTES
@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "kinograph/goal_t.hpp"
+#include "kinograph/goal_v2_t.hpp"
 #include "kinograph/lcm/message_convert.h"
 #include "kinograph/obstacle_list_t.hpp"
 #include "kinograph/planning/io/plan_json.h"
@@ -164,13 +165,26 @@ int finish(PlanWaiter& waiter, const Common& c, int64_t goal_id,
   return plan->status == plan_t::SUCCESS ? kExitOk : kExitInvalidPlan;
 }
 
+// "NAME=VALUE" of --joint; the value may use pi. @throws CommandFailure naming the item.
+std::pair<std::string, double> parse_named_joint(const std::string& item) {
+  const std::size_t eq = item.find('=');
+  if (eq == std::string::npos || eq == 0) {
+    throw CommandFailure("--joint: '" + item + "' is not NAME=VALUE (e.g. iiwa_joint_2=pi/4)");
+  }
+  const std::string name = item.substr(0, eq);
+  return {name, parse_number_list(item.substr(eq + 1), "--joint " + name, 1)[0]};
+}
+
 const bool kSendGoal = register_command([](CLI::App& root) {
-  auto* sub = root.add_subcommand("send-goal", "publish a goal_t to a kinographd");
+  auto* sub = root.add_subcommand(
+      "send-goal", "publish a goal to a kinographd (goal_t for --q, goal_v2_t otherwise)");
   auto c = std::make_shared<Common>();
   auto q = std::make_shared<std::string>();
+  auto joints = std::make_shared<std::vector<std::string>>();
   auto frame = std::make_shared<std::string>();
   auto position = std::make_shared<std::string>();
   auto quaternion = std::make_shared<std::string>();
+  auto position_only = std::make_shared<bool>(false);
   auto goal_id = std::make_shared<int64_t>(-1);
   auto duration = std::make_shared<double>(0);
   auto robot = std::make_shared<std::string>();
@@ -179,55 +193,94 @@ const bool kSendGoal = register_command([](CLI::App& root) {
   sub->add_option("--id", *goal_id, "goal id (default: current time in µs)");
   sub->add_option("--utime", *utime,
                   "goal time on the robot's clock (µs), e.g. sim time (default: the wall clock)");
-  sub->add_option("--q", *q, "joint goal (rad), comma-separated; angles may use pi");
+  sub->add_option("--q", *q,
+                  "joint goal (rad), every joint in URDF order, comma-separated; angles may "
+                  "use pi");
+  sub->add_option("--joint", *joints,
+                  "joint goal by name, NAME=VALUE (rad), repeatable; joints not named are held "
+                  "at their start");
   sub->add_option("--frame", *frame, "end-effector frame for a pose goal");
   sub->add_option("--position", *position, "pose goal position x,y,z (m)");
   sub->add_option("--quaternion", *quaternion,
-                  "pose goal orientation w,x,y,z (required with --frame; 1,0,0,0 = the "
-                  "world's axes)");
+                  "pose goal orientation w,x,y,z (required with --frame unless --position-only; "
+                  "1,0,0,0 = the world's axes)");
+  sub->add_flag("--position-only", *position_only,
+                "pose goal: reach --position in any orientation");
   sub->add_option("--duration", *duration, "plan duration (s), 0 = the daemon's default");
   sub->add_option("--robot", *robot, "robot name in the message (default: empty = any)");
   sub->callback([=] {
-    goal_t msg;
-    msg.utime = *utime >= 0 ? *utime : now_utime();
-    msg.goal_id = *goal_id >= 0 ? *goal_id : now_utime();
-    msg.robot = *robot;
-    msg.duration_s = *duration;
-    std::fill(std::begin(msg.ee_position), std::end(msg.ee_position), 0.0);
-    std::fill(std::begin(msg.ee_quaternion), std::end(msg.ee_quaternion), 0.0);
-    msg.ee_quaternion[0] = 1;
     const bool pose = !frame->empty() || !position->empty() || !quaternion->empty();
-    if (!q->empty() && pose) {
+    const int kinds = !q->empty() + !joints->empty() + pose;
+    if (kinds > 1) {
       throw CommandFailure(
-          "send-goal: give a joint goal (--q) or a pose goal (--frame, "
-          "--position, --quaternion), not both");
+          "send-goal: give one goal: --q, --joint, or a pose goal (--frame, --position, "
+          "--quaternion), not both");
     }
+    if (kinds == 0) {
+      throw CommandFailure(
+          "send-goal needs --q, --joint, or --frame with --position and --quaternion");
+    }
+    if (*position_only && !pose) throw CommandFailure("--position-only is for pose goals");
+    const int64_t id = *goal_id >= 0 ? *goal_id : now_utime();
+    const int64_t when = *utime >= 0 ? *utime : now_utime();
+    // Every joint in URDF order is what the first goal type says; names need version 2.
+    goal_t v1{};
+    goal_v2_t v2{};
     if (!q->empty()) {
-      msg.kind = goal_t::KIND_JOINT_CONFIGURATION;
-      msg.joint_position = parse_number_list(*q, "--q");
-      msg.num_joints = static_cast<int32_t>(msg.joint_position.size());
-    } else if (pose) {
-      if (frame->empty() || position->empty() || quaternion->empty()) {
-        throw CommandFailure(
-            "send-goal: a pose goal needs --frame, --position and --quaternion "
-            "(--quaternion 1,0,0,0 keeps the world's axes)");
-      }
-      msg.kind = goal_t::KIND_END_EFFECTOR_POSE;
-      msg.num_joints = 0;
-      msg.ee_frame = *frame;
-      auto p = parse_number_list(*position, "--position", 3);
-      auto r = parse_number_list(*quaternion, "--quaternion", 4);
-      std::copy(p.begin(), p.end(), msg.ee_position);
-      std::copy(r.begin(), r.end(), msg.ee_quaternion);
+      v1.utime = when;
+      v1.goal_id = id;
+      v1.robot = *robot;
+      v1.duration_s = *duration;
+      v1.ee_quaternion[0] = 1;
+      v1.kind = goal_t::KIND_JOINT_CONFIGURATION;
+      v1.joint_position = parse_number_list(*q, "--q");
+      v1.num_joints = static_cast<int32_t>(v1.joint_position.size());
     } else {
-      throw CommandFailure("send-goal needs --q, or --frame with --position and --quaternion");
+      v2.utime = when;
+      v2.goal_id = id;
+      v2.robot = *robot;
+      v2.duration_s = *duration;
+      v2.ee_quaternion[0] = 1;
+      if (!joints->empty()) {
+        v2.kind = goal_v2_t::KIND_JOINT_CONFIGURATION;
+        for (const std::string& item : *joints) {
+          const auto [name, value] = parse_named_joint(item);
+          v2.joint_name.push_back(name);
+          v2.joint_position.push_back(value);
+        }
+        v2.num_joints = static_cast<int32_t>(v2.joint_name.size());
+      } else {
+        if (frame->empty() || position->empty() || (quaternion->empty() && !*position_only)) {
+          throw CommandFailure(
+              "send-goal: a pose goal needs --frame, --position and --quaternion "
+              "(--quaternion 1,0,0,0 keeps the world's axes; --position-only ignores it)");
+        }
+        if (*position_only && !quaternion->empty()) {
+          throw CommandFailure("send-goal: --position-only ignores the orientation: drop "
+                               "--quaternion");
+        }
+        v2.kind = goal_v2_t::KIND_END_EFFECTOR_POSE;
+        v2.ee_frame = *frame;
+        v2.position_only = *position_only;
+        auto p = parse_number_list(*position, "--position", 3);
+        std::copy(p.begin(), p.end(), v2.ee_position);
+        if (!quaternion->empty()) {
+          auto r = parse_number_list(*quaternion, "--quaternion", 4);
+          std::copy(r.begin(), r.end(), v2.ee_quaternion);
+        }
+      }
     }
     std::optional<planning::Scene> scene = c->output_scene();
     lcm::LCM& lcm = open_lcm(c->url);
     PlanWaiter waiter(lcm, c->prefix + "_PLAN");
-    lcm.publish(c->prefix + "_GOAL", &msg);
-    std::cout << "sent goal " << msg.goal_id << " on " << c->prefix << "_GOAL\n";
-    if (int code = finish(waiter, *c, msg.goal_id, std::move(scene)); code != 0) {
+    if (!q->empty()) {
+      lcm.publish(c->prefix + "_GOAL", &v1);
+    } else {
+      lcm.publish(c->prefix + "_GOAL", &v2);
+    }
+    std::cout << "sent goal " << id << " on " << c->prefix << "_GOAL ("
+              << (q->empty() ? "goal_v2_t" : "goal_t") << ")\n";
+    if (int code = finish(waiter, *c, id, std::move(scene)); code != 0) {
       throw CommandFailure("", code);
     }
   });

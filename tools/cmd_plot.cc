@@ -1,5 +1,6 @@
 // `kinograph plot plan.json [other.json] --out torque.png`: joint torques over time, one
-// subplot per joint, effort limits dashed, a second plan overlaid for comparison.
+// subplot per joint, axes spanning the torques, effort limits dashed where within them (else
+// named at the edge), a second plan overlaid for comparison.
 #include <spdlog/spdlog.h>
 
 #include <cmath>

@@ -1,9 +1,11 @@
 // `kinograph render plan.json --frames 5 --style strip|ghost --out strip.png`: draws a plan
 // headlessly (OSMesa) as a frame strip or a ghost overlay; `--compare after.json` draws a plan
 // and its replan in one view (the replanning figure). A failed plan's picture is marked failed.
+// `kinograph render scene.yaml` or `robot.urdf` draws the start pose (or the robot at rest).
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <filesystem>
 #include <optional>
 #include <string>
 
@@ -13,6 +15,7 @@
 #include "render/plan_scene.h"
 #include "render/scene_camera.h"
 #include "render/scene_renderer.h"
+#include "render/start_scene.h"
 #include "tools/command_registry.h"
 #include "tools/plan_file.h"
 #include "tools/png_path.h"
@@ -37,9 +40,53 @@ struct RenderArgs {
   bool no_floor = false;
 };
 
+render::SceneRenderer make_renderer(const RenderArgs& args) {
+  return render::SceneRenderer(render::RendererOptions{.samples = args.samples});
+}
+
+render::FrameOptions frame_options(const RenderArgs& args, int frames) {
+  render::FrameOptions options;
+  options.frames = frames;
+  options.width = args.width;
+  options.height = args.height;
+  options.labels = !args.no_labels;
+  options.floor = !args.no_floor;
+  return options;
+}
+
+// A scene file's start pose among its obstacles, or a URDF's robot at rest: one picture.
+void render_still(const RenderArgs& args, const std::string& extension) {
+  if (!args.compare.empty()) throw CommandFailure("--compare needs two plan files (.json)");
+  std::optional<planning::Scene> scene;
+  dynamics::Model robot;
+  render::RenderScene picture;
+  if (extension == ".urdf") {
+    robot = dynamics::Model::from_urdf_file(args.plan);
+    picture = render::robot_scene(robot);
+  } else {
+    scene = planning::load_scene(args.plan);
+    picture = render::start_scene(*scene);
+  }
+  if (!args.scene.empty()) picture.camera = render::read_scene_camera(args.scene);
+  picture.end_effector_frame = args.ee_frame;
+  render::SceneRenderer renderer = make_renderer(args);
+  render::write_png(renderer.strip(picture, frame_options(args, 1)).image, args.out);
+}
+
 void run_render(const RenderArgs& args) {
   const auto start = std::chrono::steady_clock::now();
+  const std::string extension = std::filesystem::path(args.plan).extension().string();
+  if (extension != ".json" && extension != ".yaml" && extension != ".yml" &&
+      extension != ".urdf") {
+    throw CommandFailure(args.plan + ": not a plan (.json), scene (.yaml) or robot (.urdf)");
+  }
   try {
+    if (extension != ".json") {
+      render_still(args, extension);
+      spdlog::info("render: wrote {} ({}x{}, the start pose of {})", args.out, args.width,
+                   args.height, args.plan);
+      return;
+    }
     const planning::PlanFile plan = planning::read_plan_file(args.plan);
     render::RenderScene scene = render::plan_scene(plan);
     scene.end_effector_frame = args.ee_frame;
@@ -47,13 +94,8 @@ void run_render(const RenderArgs& args) {
     const std::optional<std::string> scene_file =
         args.scene.empty() ? plan_scene_path(args.plan) : std::optional<std::string>(args.scene);
     if (scene_file) scene.camera = render::read_scene_camera(*scene_file);
-    render::FrameOptions options;
-    options.frames = args.frames;
-    options.width = args.width;
-    options.height = args.height;
-    options.labels = !args.no_labels;
-    options.floor = !args.no_floor;
-    render::SceneRenderer renderer(render::RendererOptions{.samples = args.samples});
+    const render::FrameOptions options = frame_options(args, args.frames);
+    render::SceneRenderer renderer = make_renderer(args);
     render::RenderResult result;
     std::optional<std::string> failure = render::failure_text(plan.plan);
     if (!args.compare.empty()) {
@@ -86,8 +128,13 @@ void run_render(const RenderArgs& args) {
 const bool kRegistered = register_command([](CLI::App& root) {
   auto args = std::make_shared<RenderArgs>();
   CLI::App* cmd = root.add_subcommand(
-      "render", "Draw a plan as a frame strip or a ghost overlay PNG (headless, OSMesa)");
-  cmd->add_option("plan", args->plan, "Plan file (JSON) written by the planner")->required();
+      "render",
+      "Draw a plan as a frame strip or a ghost overlay PNG, or a scene's start pose or a robot "
+      "(headless, OSMesa)");
+  cmd->add_option("plan", args->plan,
+                  "Plan file (.json) written by the planner; or a scene (.yaml: its start pose "
+                  "among its obstacles) or a robot (.urdf: at rest), drawn as one picture")
+      ->required();
   cmd->add_option("--compare", args->compare,
                   "Second plan file (e.g. the replan): both in one view, the first as grey "
                   "ghosts, the second in colour among its obstacles (changed ones highlighted)");

@@ -47,21 +47,74 @@ bool RobotIdentity::matches(const std::string& robot) const {
   return r == lower(model_name) || r == lower(channel_prefix);
 }
 
-Check goal_from_message(const goal_t& msg, const dynamics::Model& model,
-                        const RobotIdentity& identity, GoalRequest& out) {
-  if (Check c = robot_field(msg.robot, identity, "goal_t"); !c.ok) return c;
-  if (msg.goal_id < 0) return Check::fail("goal_t.goal_id must be >= 0");
+namespace {
+
+bool is_frame(const dynamics::Model& model, const std::string& name) {
+  return std::any_of(model.frames.begin(), model.frames.end(),
+                     [&](const auto& f) { return f.name == name; });
+}
+
+// The fields both goal versions share: robot, id, duration.
+template <class GoalMessage>
+Check goal_header(const std::string& type, const GoalMessage& msg, const RobotIdentity& identity,
+                  GoalRequest& request) {
+  if (Check c = robot_field(msg.robot, identity, type); !c.ok) return c;
+  if (msg.goal_id < 0) return Check::fail(type + ".goal_id must be >= 0");
   if (!std::isfinite(msg.duration_s) || msg.duration_s < 0 || msg.duration_s > 3600) {
-    return Check::fail("goal_t.duration_s must be in [0, 3600] s (0 = default horizon)");
+    return Check::fail(type + ".duration_s must be in [0, 3600] s (0 = default horizon)");
   }
-  GoalRequest request;
   request.goal_id = msg.goal_id;
   request.utime = msg.utime;
   request.duration_s = msg.duration_s;
+  return {};
+}
+
+// A pose goal of either version: a known frame, a finite position, a unit quaternion.
+Check pose_goal(const std::string& type, const dynamics::Model& model, const std::string& frame,
+                const double* position, const double* quaternion, planning::Goal& goal) {
+  if (!is_frame(model, frame)) {
+    return Check::fail(type + ".ee_frame \"" + frame + "\" is not a frame of " + model.name);
+  }
+  if (!all_finite(position, position + 3)) return Check::fail(type + ".ee_position is not finite");
+  Eigen::Quaterniond rotation;
+  if (Check c = quaternion_from(quaternion, type + ".ee_quaternion", rotation); !c.ok) return c;
+  goal.kind = planning::Goal::Kind::kPose;
+  goal.frame = frame;
+  goal.pose = Eigen::Translation3d(position[0], position[1], position[2]) * rotation;
+  return {};
+}
+
+Check task_constraint_from(const task_constraint_t& msg, const std::string& field,
+                           const dynamics::Model& model, planning::TaskConstraint& out) {
+  if (!is_frame(model, msg.frame)) {
+    return Check::fail(field + ".frame \"" + msg.frame + "\" is not a frame of " + model.name);
+  }
+  if (!all_finite(msg.position, msg.position + 3)) {
+    return Check::fail(field + ".position is not finite");
+  }
+  if (!std::isfinite(msg.tolerance) || msg.tolerance <= 0) {
+    return Check::fail(field + ".tolerance must be > 0 (rad, and m)");
+  }
+  Eigen::Quaterniond rotation;
+  if (Check c = quaternion_from(msg.quaternion, field + ".quaternion", rotation); !c.ok) return c;
+  out.frame = msg.frame;
+  out.orientation_only = msg.orientation_only;
+  out.target = Eigen::Translation3d(msg.position[0], msg.position[1], msg.position[2]) * rotation;
+  out.tolerance = msg.tolerance;
+  return {};
+}
+
+}  // namespace
+
+Check goal_from_message(const goal_t& msg, const dynamics::Model& model,
+                        const RobotIdentity& identity, GoalRequest& out) {
+  GoalRequest request;
+  if (Check c = goal_header("goal_t", msg, identity, request); !c.ok) return c;
   if (msg.kind == goal_t::KIND_JOINT_CONFIGURATION) {
     if (msg.num_joints != model.nq()) {
       return Check::fail("goal_t.num_joints is " + std::to_string(msg.num_joints) + ", robot " +
-                         model.name + " has " + std::to_string(model.nq()) + " joints");
+                         model.name + " has " + std::to_string(model.nq()) +
+                         " joints (goal_v2_t names its joints)");
     }
     if (!all_finite(msg.joint_position.begin(), msg.joint_position.end())) {
       return Check::fail("goal_t.joint_position is not finite");
@@ -69,26 +122,77 @@ Check goal_from_message(const goal_t& msg, const dynamics::Model& model,
     request.goal.kind = planning::Goal::Kind::kJoint;
     request.goal.q = Eigen::Map<const Eigen::VectorXd>(msg.joint_position.data(), model.nq());
   } else if (msg.kind == goal_t::KIND_END_EFFECTOR_POSE) {
-    const auto& frames = model.frames;
-    const bool known = std::any_of(frames.begin(), frames.end(),
-                                   [&](const auto& f) { return f.name == msg.ee_frame; });
-    if (!known) return Check::fail("goal_t.ee_frame \"" + msg.ee_frame + "\" is not a frame");
-    if (!all_finite(msg.ee_position, msg.ee_position + 3)) {
-      return Check::fail("goal_t.ee_position is not finite");
-    }
-    Eigen::Quaterniond rotation;
-    if (Check c = quaternion_from(msg.ee_quaternion, "goal_t.ee_quaternion", rotation); !c.ok) {
+    if (Check c = pose_goal("goal_t", model, msg.ee_frame, msg.ee_position, msg.ee_quaternion,
+                            request.goal);
+        !c.ok) {
       return c;
     }
-    request.goal.kind = planning::Goal::Kind::kPose;
-    request.goal.frame = msg.ee_frame;
-    request.goal.pose =
-        Eigen::Translation3d(msg.ee_position[0], msg.ee_position[1], msg.ee_position[2]) * rotation;
   } else {
     return Check::fail("goal_t.kind " + std::to_string(msg.kind) + " is unknown");
   }
   out = std::move(request);
   return {};
+}
+
+Check goal_from_message(const goal_v2_t& msg, const dynamics::Model& model,
+                        const RobotIdentity& identity, GoalRequest& out) {
+  GoalRequest request;
+  if (Check c = goal_header("goal_v2_t", msg, identity, request); !c.ok) return c;
+  if (msg.kind == goal_v2_t::KIND_JOINT_CONFIGURATION) {
+    if (msg.joint_name.empty()) return Check::fail("goal_v2_t.joint_name names no joint");
+    std::unordered_map<std::string, int> index;
+    for (int j = 0; j < model.nq(); ++j) index[model.bodies[j].joint_name] = j;
+    request.goal.kind = planning::Goal::Kind::kJoint;
+    request.goal.q.setZero(model.nq());
+    request.joint_named.assign(model.nq(), false);
+    for (std::size_t i = 0; i < msg.joint_name.size(); ++i) {
+      const std::string field = "goal_v2_t.joint_name[" + std::to_string(i) + "] \"" +
+                                msg.joint_name[i] + "\"";
+      const auto it = index.find(msg.joint_name[i]);
+      if (it == index.end()) return Check::fail(field + " is not a joint of " + model.name);
+      if (request.joint_named[it->second]) return Check::fail(field + " appears twice");
+      if (!std::isfinite(msg.joint_position[i])) {
+        return Check::fail("goal_v2_t.joint_position of \"" + msg.joint_name[i] +
+                           "\" is not finite");
+      }
+      request.joint_named[it->second] = true;
+      request.goal.q[it->second] = msg.joint_position[i];
+    }
+  } else if (msg.kind == goal_v2_t::KIND_END_EFFECTOR_POSE) {
+    if (Check c = pose_goal("goal_v2_t", model, msg.ee_frame, msg.ee_position,
+                            msg.ee_quaternion, request.goal);
+        !c.ok) {
+      return c;
+    }
+    request.goal.position_only = msg.position_only;
+  } else {
+    return Check::fail("goal_v2_t.kind " + std::to_string(msg.kind) + " is unknown");
+  }
+  if (msg.task_constraint.size() > static_cast<std::size_t>(kMaxTaskConstraintsPerGoal)) {
+    return Check::fail("goal_v2_t.num_task_constraints is " +
+                       std::to_string(msg.task_constraint.size()) + ", more than the " +
+                       std::to_string(kMaxTaskConstraintsPerGoal) + " one goal may carry");
+  }
+  for (std::size_t i = 0; i < msg.task_constraint.size(); ++i) {
+    planning::TaskConstraint task;
+    const std::string field = "goal_v2_t.task_constraint[" + std::to_string(i) + "]";
+    if (Check c = task_constraint_from(msg.task_constraint[i], field, model, task); !c.ok) {
+      return c;
+    }
+    request.task_constraints.push_back(std::move(task));
+  }
+  out = std::move(request);
+  return {};
+}
+
+planning::Goal goal_for_start(const GoalRequest& request, const Eigen::VectorXd& start_q) {
+  planning::Goal goal = request.goal;
+  if (goal.kind != planning::Goal::Kind::kJoint || request.joint_named.empty()) return goal;
+  for (std::size_t j = 0; j < request.joint_named.size(); ++j) {
+    if (!request.joint_named[j] && static_cast<Eigen::Index>(j) < start_q.size())
+      goal.q[j] = start_q[j];
+  }
+  return goal;
 }
 
 Check obstacles_from_message(const obstacle_list_t& msg, std::vector<ObstacleUpdate>& out) {
@@ -190,20 +294,43 @@ Check joint_count(int32_t count, const dynamics::Model& model, const std::string
 Check state_from_message(const robot_state_t& msg, const dynamics::Model& model,
                          const RobotIdentity& identity, MeasuredState& out) {
   if (Check c = robot_field(msg.robot, identity, "robot_state_t"); !c.ok) return c;
-  if (Check c = joint_count(msg.num_joints, model, "robot_state_t"); !c.ok) return c;
   if (!all_finite(msg.position.begin(), msg.position.end()) ||
       !all_finite(msg.velocity.begin(), msg.velocity.end())) {
     return Check::fail("robot_state_t.position or velocity is not finite");
   }
-  std::vector<int> index;
-  if (Check c = joint_indices(msg.joint_name, model, "robot_state_t", index); !c.ok) return c;
+  const int n = model.nq();
+  std::unordered_map<std::string, int> index;
+  for (int j = 0; j < n; ++j) index[model.bodies[j].joint_name] = j;
   MeasuredState state;
   state.utime = msg.utime;
-  state.q.setZero(model.nq());
-  state.qd.setZero(model.nq());
-  for (size_t i = 0; i < index.size(); ++i) {
-    state.q[index[i]] = msg.position[i];
-    state.qd[index[i]] = msg.velocity[i];
+  state.q.setZero(n);
+  state.qd.setZero(n);
+  std::vector<bool> seen(n, false);
+  std::vector<std::string> ignored;  // joints of the robot the model does not have
+  for (std::size_t i = 0; i < msg.joint_name.size(); ++i) {
+    const auto it = index.find(msg.joint_name[i]);
+    if (it == index.end()) {
+      ignored.push_back(msg.joint_name[i]);
+      continue;
+    }
+    if (seen[it->second]) {
+      return Check::fail("robot_state_t.joint_name \"" + msg.joint_name[i] + "\" appears twice");
+    }
+    seen[it->second] = true;
+    state.q[it->second] = msg.position[i];
+    state.qd[it->second] = msg.velocity[i];
+  }
+  for (int j = 0; j < n; ++j) {
+    if (seen[j]) continue;
+    std::string why = "robot_state_t names no joint \"" + model.bodies[j].joint_name +
+                      "\" of " + model.name;
+    // A misspelt name is among those ignored: say which they were.
+    if (!ignored.empty()) {
+      why += " (it names " + std::to_string(ignored.size()) + " joint" +
+             (ignored.size() == 1 ? "" : "s") + " the robot does not have, e.g. \"" +
+             ignored.front() + "\")";
+    }
+    return Check::fail(why);
   }
   out = std::move(state);
   return {};

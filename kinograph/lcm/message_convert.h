@@ -11,6 +11,7 @@
 #include "kinograph/collision/shape.h"
 #include "kinograph/dynamics/model.h"
 #include "kinograph/goal_t.hpp"
+#include "kinograph/goal_v2_t.hpp"
 #include "kinograph/joint_command_t.hpp"
 #include "kinograph/obstacle_list_t.hpp"
 #include "kinograph/plan_t.hpp"
@@ -42,6 +43,11 @@ struct GoalRequest {
   int64_t utime = 0;
   planning::Goal goal;
   double duration_s = 0;  ///< 0 = the scene's horizon
+  /// Joint goals: which joints (model order) the goal names; the others are held at the
+  /// plan's start (goal_for_start). Empty = every joint named.
+  std::vector<bool> joint_named;
+  /// Task constraints the goal adds to the scene's (goal_v2_t).
+  std::vector<planning::TaskConstraint> task_constraints;
 };
 
 /// One obstacle change from an obstacle_list_t.
@@ -70,6 +76,19 @@ struct CommandSetpoint {
 Check goal_from_message(const goal_t& msg, const dynamics::Model& model,
                         const RobotIdentity& identity, GoalRequest& out);
 
+/// Most task constraints one goal_v2_t may carry (each adds a factor per step).
+inline constexpr int kMaxTaskConstraintsPerGoal = 16;
+
+/// Checks a goal_v2_t against the model and converts it: joints by name (any order, a subset;
+/// unknown or repeated names refused, naming them), position-only pose goals and task
+/// constraints (frames known, unit quaternions, tolerance > 0).
+Check goal_from_message(const goal_v2_t& msg, const dynamics::Model& model,
+                        const RobotIdentity& identity, GoalRequest& out);
+
+/// The goal to plan from `start_q`: a joint goal's joints the request does not name are held
+/// at their start position.
+planning::Goal goal_for_start(const GoalRequest& request, const Eigen::VectorXd& start_q);
+
 /// Most obstacle changes one obstacle_list_t may carry.
 inline constexpr int kMaxObstaclesPerMessage = 256;
 
@@ -78,7 +97,9 @@ inline constexpr int kMaxObstaclesPerMessage = 256;
 /// outside the collision engine's faithful range (collision/shape.h), naming the obstacle.
 Check obstacles_from_message(const obstacle_list_t& msg, std::vector<ObstacleUpdate>& out);
 
-/// Checks a robot_state_t (joint names may come in any order) and converts it to model order.
+/// Checks a robot_state_t and converts it to model order. Its joints may come in any order,
+/// and joints the model does not have (a gripper's) are ignored; a model joint it does not
+/// name, or names twice, is refused naming it.
 Check state_from_message(const robot_state_t& msg, const dynamics::Model& model,
                          const RobotIdentity& identity, MeasuredState& out);
 

@@ -4,7 +4,7 @@ the plan_t on <PREFIX>_PLAN that answers its goal_id."""
 import struct
 import time
 
-from kinograph import goal_t, plan_t
+from kinograph import goal_t, goal_v2_t, plan_t
 
 from .lcm_ctypes import Lcm
 
@@ -20,20 +20,63 @@ def now_utime():
     return time.time_ns() // 1000
 
 
-def joint_goal(q, goal_id=None, duration_s=0.0, robot=""):
-    """A goal_t for the joint configuration `q` (rad, the robot's URDF joint order).
-    goal_id defaults to the time in µs; duration_s 0 is the daemon's horizon; robot ""
-    is any robot."""
-    goal = goal_t()
+def _goal_header(goal, goal_id, duration_s, robot):
     goal.utime = now_utime()
     goal.goal_id = goal.utime if goal_id is None else goal_id
     goal.robot = robot
-    goal.kind = goal_t.KIND_JOINT_CONFIGURATION
-    goal.joint_position = [float(x) for x in q]
-    goal.num_joints = len(goal.joint_position)
+    goal.duration_s = float(duration_s)
+    return goal
+
+
+def joint_goal(q, goal_id=None, duration_s=0.0, robot=""):
+    """A joint goal: `q` a mapping {joint name: rad}, any order, a subset (the joints not
+    named are held at their start), as a goal_v2_t; or a sequence of every joint in the
+    robot's URDF order, as a goal_t. goal_id defaults to the time in µs; duration_s 0 is the
+    daemon's horizon; robot "" is any robot."""
+    if hasattr(q, "items"):
+        goal = _goal_header(goal_v2_t(), goal_id, duration_s, robot)
+        goal.kind = goal_v2_t.KIND_JOINT_CONFIGURATION
+        goal.joint_name = [str(name) for name in q]
+        goal.joint_position = [float(x) for x in q.values()]
+        goal.num_joints = len(goal.joint_name)
+        goal.task_constraint = []
+        goal.num_task_constraints = 0
+    else:
+        goal = _goal_header(goal_t(), goal_id, duration_s, robot)
+        goal.kind = goal_t.KIND_JOINT_CONFIGURATION
+        goal.joint_position = [float(x) for x in q]
+        goal.num_joints = len(goal.joint_position)
     goal.ee_position = [0.0, 0.0, 0.0]
     goal.ee_quaternion = [1.0, 0.0, 0.0, 0.0]
-    goal.duration_s = float(duration_s)
+    return goal
+
+
+def pose_goal(frame, position, quaternion=None, position_only=False, goal_id=None,
+              duration_s=0.0, robot=""):
+    """A goal_v2_t for the world pose of `frame` (a URDF link or frame): `position` (x, y, z)
+    in m and `quaternion` (w, x, y, z); with position_only the orientation is free and
+    `quaternion` must be left out. Raises ValueError for a missing or extra orientation or a
+    wrong length."""
+    position = [float(x) for x in position]
+    if len(position) != 3:
+        raise ValueError(f"pose_goal: position has {len(position)} values, needs x, y, z")
+    if position_only and quaternion is not None:
+        raise ValueError("pose_goal: position_only ignores the orientation: leave out quaternion")
+    if not position_only and quaternion is None:
+        raise ValueError("pose_goal: give quaternion (w, x, y, z; 1, 0, 0, 0 = the world's "
+                         "axes) or position_only=True")
+    quaternion = [1.0, 0.0, 0.0, 0.0] if quaternion is None else [float(x) for x in quaternion]
+    if len(quaternion) != 4:
+        raise ValueError(f"pose_goal: quaternion has {len(quaternion)} values, needs w, x, y, z")
+    goal = _goal_header(goal_v2_t(), goal_id, duration_s, robot)
+    goal.kind = goal_v2_t.KIND_END_EFFECTOR_POSE
+    goal.joint_name, goal.joint_position, goal.num_joints = [], [], 0
+    goal.ee_frame = str(frame)
+    goal.ee_position = position
+    goal.ee_quaternion = quaternion
+    goal.position_only = bool(position_only)
+    goal.task_constraint = []
+    goal.num_task_constraints = 0
     return goal
 
 
@@ -56,7 +99,7 @@ class PlannerClient:
         self.close()
 
     def send(self, goal):
-        """Publishes `goal` (a goal_t) on <prefix>_GOAL."""
+        """Publishes `goal` (a goal_v2_t or goal_t) on <prefix>_GOAL."""
         self.lcm.publish(f"{self.prefix}_GOAL", goal.encode())
 
     def wait_for_plan(self, goal_id, timeout_s):

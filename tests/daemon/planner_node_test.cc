@@ -16,11 +16,13 @@
 #include <set>
 #include <thread>
 
+#include "kinograph/dynamics/data.h"
 #include "kinograph/dynamics/kinematics.h"
 #include "kinograph/planner_status_t.hpp"
 #include "kinograph/planning/io/scene.h"
 #include "kinograph/planning/validate.h"
 #include "lcmtypes/safe_decode.h"
+#include "tests/lcmtypes/sample_messages.h"
 
 namespace kinograph::daemon {
 namespace {
@@ -180,6 +182,106 @@ class NodeFixture : public ::testing::Test {
   std::unique_ptr<Listener> listener_;
   std::thread thread_;
 };
+
+// Goals of version 2 (goal_v2_t): joints by name, a pose goal or task constraints.
+goal_v2_t goal_v2(int64_t id, std::vector<std::string> names, std::vector<double> q) {
+  return lcmtypes::testing::joint_goal_by_name(id, std::move(names), std::move(q));
+}
+
+// The arm's state with a gripper finger it does not model: the finger is ignored, the goal
+// names one joint and the other is held where the state has it.
+TEST_F(NodeFixture, GoalByNameMovesTheNamedJointAndHoldsTheOthers) {
+  robot_state_t state{};
+  state.robot = "rr";
+  state.num_joints = 3;
+  state.joint_name = {"gripper_finger", "joint2", "joint1"};
+  state.position = {0.02, 0.4, -0.8};
+  state.velocity = {0, 0, 0};
+  lcm_.publish("RR_STATE", &state);
+  const goal_v2_t g = goal_v2(21, {"joint1"}, {0.6});
+  lcm_.publish("RR_GOAL", &g);
+  const auto plans = listener_->wait_plans(1);
+  ASSERT_EQ(plans.size(), 1u);
+  const plan_t& p = plans[0];
+  ASSERT_EQ(p.status, plan_t::SUCCESS) << p.status_message;
+  EXPECT_EQ(p.state_utime, 0);  // planned from the state with the finger in it
+  EXPECT_NEAR(p.q.back()[0], 0.6, 1e-3);
+  EXPECT_NEAR(p.q.back()[1], 0.4, 1e-3);
+  EXPECT_EQ(node_->counters().messages_rejected, 0);
+}
+
+TEST_F(NodeFixture, GoalNamingAnUnknownOrRepeatedJointIsRefusedNamingIt) {
+  const goal_v2_t unknown = goal_v2(22, {"joint1", "elbow"}, {0.5, 0.2});
+  lcm_.publish("RR_GOAL", &unknown);
+  const goal_v2_t twice = goal_v2(23, {"joint2", "joint2"}, {0.5, 0.2});
+  lcm_.publish("RR_GOAL", &twice);
+  const auto plans = listener_->wait_plans(2);
+  ASSERT_EQ(plans.size(), 2u);
+  EXPECT_EQ(plans[0].status, plan_t::INVALID_GOAL);
+  EXPECT_NE(plans[0].status_message.find("\"elbow\" is not a joint of rr"), std::string::npos)
+      << plans[0].status_message;
+  EXPECT_EQ(plans[1].status, plan_t::INVALID_GOAL);
+  EXPECT_NE(plans[1].status_message.find("\"joint2\" appears twice"), std::string::npos)
+      << plans[1].status_message;
+}
+
+TEST_F(NodeFixture, StateMissingAJointIsRefusedNamingIt) {
+  robot_state_t state{};
+  state.robot = "rr";
+  state.num_joints = 2;
+  state.joint_name = {"joint1", "joint_2"};
+  state.position = {0.1, 0.2};
+  state.velocity = {0, 0};
+  lcm_.publish("RR_STATE", &state);
+  EXPECT_TRUE(listener_->wait_status_containing(
+      "robot_state_t names no joint \"joint2\" of rr (it names 1 joint the robot does not "
+      "have, e.g. \"joint_2\")"));
+}
+
+// The tip's position at (0.8, -0.4) in any orientation: with 2 joints the orientation is
+// fixed by the position, so the identity asked for is out of reach unless it is ignored.
+TEST_F(NodeFixture, PositionOnlyPoseGoalReachesThePosition) {
+  const planning::Scene scene = default_scene();
+  const dynamics::Model& model = *scene.problem.model;
+  dynamics::Data data(model);
+  dynamics::forward_kinematics(model, data, Eigen::Vector2d(0.8, -0.4));
+  const Eigen::Vector3d tip = dynamics::frame_pose(model, data, model.frame_index("ee")).translation();
+  goal_v2_t g = goal_v2(24, {}, {});
+  g.kind = goal_v2_t::KIND_END_EFFECTOR_POSE;
+  g.ee_frame = "ee";
+  for (int i = 0; i < 3; ++i) g.ee_position[i] = tip[i];
+  g.position_only = true;
+  lcm_.publish("RR_GOAL", &g);
+  const auto plans = listener_->wait_plans(1);
+  ASSERT_EQ(plans.size(), 1u);
+  const plan_t& p = plans[0];
+  ASSERT_EQ(p.status, plan_t::SUCCESS) << p.status_message;
+  dynamics::forward_kinematics(model, data, Eigen::Vector2d(p.q.back()[0], p.q.back()[1]));
+  EXPECT_LT((dynamics::frame_pose(model, data, model.frame_index("ee")).translation() - tip).norm(),
+            1e-2);
+}
+
+// A goal's task constraint holds the tip's orientation at the start's; the joint goal turns
+// it by 0.8 rad, so no plan can keep it: the constraint is not ignored.
+TEST_F(NodeFixture, GoalTaskConstraintIsPlannedFor) {
+  goal_v2_t g = goal_v2(25, {"joint1", "joint2"}, {0.8, -0.4});
+  task_constraint_t task{};
+  task.frame = "ee";
+  task.orientation_only = true;
+  const Eigen::Quaterniond start(Eigen::AngleAxisd(-0.4, Eigen::Vector3d::UnitY()));
+  task.quaternion[0] = start.w();
+  task.quaternion[1] = start.x();
+  task.quaternion[2] = start.y();
+  task.quaternion[3] = start.z();
+  task.tolerance = 0.05;
+  g.task_constraint = {task};
+  g.num_task_constraints = 1;
+  lcm_.publish("RR_GOAL", &g);
+  const auto plans = listener_->wait_plans(1);
+  ASSERT_EQ(plans.size(), 1u);
+  EXPECT_NE(plans[0].status, plan_t::SUCCESS);
+  EXPECT_NE(plans[0].status_message.find("'ee'"), std::string::npos) << plans[0].status_message;
+}
 
 TEST_F(NodeFixture, AnswersAGoalWithAValidPlanThatEndsThere) {
   send_goal(11, {0.9, -0.5});

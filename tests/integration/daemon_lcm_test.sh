@@ -56,6 +56,17 @@ grep -q "malformed goal_t" "$WORK/daemon1.log" || fail "malformed goal not repor
 "$KG" send-goal --prefix RR --lcm-url "$URL" --id 3 --q 0.3 --wait 30 && fail "bad goal accepted"
 grep -q "num_joints is 1" "$WORK/daemon1.log" || fail "wrong joint count not reported"
 
+# Goals by joint name (goal_v2_t), in any order; a name the robot lacks is refused by name.
+"$KG" send-goal --prefix RR --lcm-url "$URL" --id 4 --joint joint2=0.3 --joint joint1=pi/10 \
+  --wait 60 | tee "$WORK/goal4.txt" || fail "goal 4 (by joint name) not answered with a valid plan"
+grep -q "goal_v2_t" "$WORK/goal4.txt" || fail "goal 4 was not sent as a goal_v2_t"
+set +e
+"$KG" send-goal --prefix RR --lcm-url "$URL" --id 5 --joint joint1=0.3 --joint elbow=1 --wait 30
+code=$?
+set -e
+[ "$code" -eq 2 ] || fail "goal 5 naming joint elbow: exit $code, expected 2 (invalid plan)"
+grep -q '"elbow" is not a joint of rr' "$WORK/daemon1.log" || fail "unknown joint not named"
+
 kill -TERM "$DAEMON"
 wait "$DAEMON" || fail "daemon did not exit cleanly on SIGTERM"
 kill -INT "$LOGGER"

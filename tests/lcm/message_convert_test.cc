@@ -7,6 +7,8 @@
 #include <cmath>
 #include <limits>
 
+#include "tests/lcmtypes/sample_messages.h"
+
 namespace kinograph::messages {
 namespace {
 
@@ -195,7 +197,7 @@ TEST(ObstaclesFromMessage, RefusesMoreObstaclesThanOneMessageMayCarry) {
   EXPECT_TRUE(none.empty());
 }
 
-TEST(StateFromMessage, ReordersByJointNameAndRejectsUnknownNames) {
+TEST(StateFromMessage, ReordersByJointNameAndRefusesAMisspeltJoint) {
   robot_state_t s{};
   s.robot = rr().name;
   s.num_joints = 2;
@@ -216,6 +218,123 @@ TEST(StateFromMessage, ReordersByJointNameAndRejectsUnknownNames) {
 
   s.joint_name = {rr().bodies[0].joint_name, rr().bodies[0].joint_name};
   EXPECT_FALSE(state_from_message(s, rr(), identity(), out).ok);
+}
+
+// A real arm's state names its gripper too: joints the model lacks are ignored by name.
+TEST(StateFromMessage, IgnoresJointsTheModelDoesNotHave) {
+  robot_state_t s{};
+  s.robot = rr().name;
+  s.num_joints = 4;
+  s.joint_name = {"finger_left", rr().bodies[1].joint_name, "finger_right",
+                  rr().bodies[0].joint_name};
+  s.position = {0.01, 0.2, 0.02, 0.1};
+  s.velocity = {5, -2, 6, -1};
+  MeasuredState out;
+  const Check c = state_from_message(s, rr(), identity(), out);
+  ASSERT_TRUE(c.ok) << c.reason;
+  EXPECT_EQ(out.q, Eigen::Vector2d(0.1, 0.2));
+  EXPECT_EQ(out.qd, Eigen::Vector2d(-1, -2));
+
+  s.joint_name[3] = "finger_middle";  // joint1 now missing
+  const Check missing = state_from_message(s, rr(), identity(), out);
+  EXPECT_FALSE(missing.ok);
+  EXPECT_NE(missing.reason.find("names no joint \"" + rr().bodies[0].joint_name + "\""),
+            std::string::npos)
+      << missing.reason;
+}
+
+goal_v2_t named_goal(std::vector<std::string> names, std::vector<double> q) {
+  return lcmtypes::testing::joint_goal_by_name(8, std::move(names), std::move(q));
+}
+
+TEST(GoalV2FromMessage, JointsByNameInAnyOrderTheOthersHeldAtTheStart) {
+  GoalRequest out;
+  Check c = goal_from_message(named_goal({"joint2", "joint1"}, {0.2, 0.1}), rr(), identity(), out);
+  ASSERT_TRUE(c.ok) << c.reason;
+  EXPECT_EQ(goal_for_start(out, Eigen::Vector2d(5, 6)).q, Eigen::Vector2d(0.1, 0.2));
+
+  c = goal_from_message(named_goal({"joint2"}, {0.3}), rr(), identity(), out);
+  ASSERT_TRUE(c.ok) << c.reason;
+  EXPECT_EQ(out.goal.kind, planning::Goal::Kind::kJoint);
+  EXPECT_EQ(goal_for_start(out, Eigen::Vector2d(-0.7, 9)).q, Eigen::Vector2d(-0.7, 0.3));
+}
+
+TEST(GoalV2FromMessage, RefusesUnknownRepeatedMissingAndNonFiniteJoints) {
+  GoalRequest out;
+  Check c = goal_from_message(named_goal({"joint1", "wrist"}, {0.1, 0.2}), rr(), identity(), out);
+  EXPECT_FALSE(c.ok);
+  EXPECT_NE(c.reason.find("goal_v2_t.joint_name[1] \"wrist\" is not a joint of rr"),
+            std::string::npos)
+      << c.reason;
+  c = goal_from_message(named_goal({"joint1", "joint1"}, {0.1, 0.2}), rr(), identity(), out);
+  EXPECT_NE(c.reason.find("\"joint1\" appears twice"), std::string::npos) << c.reason;
+  c = goal_from_message(named_goal({}, {}), rr(), identity(), out);
+  EXPECT_NE(c.reason.find("names no joint"), std::string::npos) << c.reason;
+  c = goal_from_message(named_goal({"joint2"}, {std::nan("")}), rr(), identity(), out);
+  EXPECT_NE(c.reason.find("\"joint2\" is not finite"), std::string::npos) << c.reason;
+}
+
+TEST(GoalV2FromMessage, PositionOnlyPoseGoal) {
+  goal_v2_t g = named_goal({}, {});
+  g.kind = goal_v2_t::KIND_END_EFFECTOR_POSE;
+  g.ee_frame = "ee";
+  g.ee_position[2] = 1.0;
+  g.position_only = true;
+  GoalRequest out;
+  const Check c = goal_from_message(g, rr(), identity(), out);
+  ASSERT_TRUE(c.ok) << c.reason;
+  EXPECT_EQ(out.goal.kind, planning::Goal::Kind::kPose);
+  EXPECT_TRUE(out.goal.position_only);
+  g.ee_frame = "hand";
+  EXPECT_NE(goal_from_message(g, rr(), identity(), out).reason.find("\"hand\" is not a frame"),
+            std::string::npos);
+}
+
+task_constraint_t level(const std::string& frame) {
+  task_constraint_t t{};
+  t.frame = frame;
+  t.orientation_only = true;
+  t.quaternion[0] = 1;
+  t.tolerance = 0.05;
+  return t;
+}
+
+TEST(GoalV2FromMessage, TaskConstraintsConvertedAndChecked) {
+  goal_v2_t g = named_goal({"joint1"}, {0.1});
+  task_constraint_t full = level("ee");
+  full.orientation_only = false;
+  full.position[0] = 0.4;
+  g.task_constraint = {level("link1"), full};
+  g.num_task_constraints = 2;
+  GoalRequest out;
+  Check c = goal_from_message(g, rr(), identity(), out);
+  ASSERT_TRUE(c.ok) << c.reason;
+  ASSERT_EQ(out.task_constraints.size(), 2u);
+  EXPECT_EQ(out.task_constraints[0].frame, "link1");
+  EXPECT_TRUE(out.task_constraints[0].orientation_only);
+  EXPECT_FALSE(out.task_constraints[1].orientation_only);
+  EXPECT_DOUBLE_EQ(out.task_constraints[1].target.translation().x(), 0.4);
+  EXPECT_DOUBLE_EQ(out.task_constraints[1].tolerance, 0.05);
+
+  g.task_constraint = {level("ee"), level("gripper")};
+  c = goal_from_message(g, rr(), identity(), out);
+  EXPECT_NE(c.reason.find("task_constraint[1].frame \"gripper\" is not a frame"),
+            std::string::npos)
+      << c.reason;
+  g.task_constraint[1] = level("ee");
+  g.task_constraint[1].tolerance = 0;
+  c = goal_from_message(g, rr(), identity(), out);
+  EXPECT_NE(c.reason.find("task_constraint[1].tolerance must be > 0"), std::string::npos)
+      << c.reason;
+  g.task_constraint[1].tolerance = 0.1;
+  g.task_constraint[1].quaternion[1] = 1;
+  c = goal_from_message(g, rr(), identity(), out);
+  EXPECT_NE(c.reason.find("task_constraint[1].quaternion is not a unit quaternion"),
+            std::string::npos)
+      << c.reason;
+  g.task_constraint.assign(kMaxTaskConstraintsPerGoal + 1, level("ee"));
+  c = goal_from_message(g, rr(), identity(), out);
+  EXPECT_NE(c.reason.find("more than the 16 one goal may carry"), std::string::npos) << c.reason;
 }
 
 TEST(PlanMessage, RoundTripsTrajectoryAndMapsStatus) {

@@ -10,10 +10,13 @@
 #include "drake/lcmt_iiwa_status.hpp"
 #include "drake/lcmt_robot_plan.hpp"
 #include "drake/lcmt_robot_state.hpp"
+#include "kinograph/goal_t.hpp"
+#include "kinograph/goal_v2_t.hpp"
 #include "kinograph/joint_command_t.hpp"
 #include "kinograph/plan_t.hpp"
 #include "kinograph/plan_v1_t.hpp"
 #include "kinograph/robot_state_t.hpp"
+#include "kinograph/task_constraint_t.hpp"
 #include "tests/lcmtypes/lcm_fingerprint.h"
 
 namespace kinograph::lcmtypes::testing {
@@ -103,6 +106,36 @@ TEST(Fingerprint, PlanVersionOneIsTheFirstPlanAndVersionTwoDiffers) {
   // Version 2 as released (lcmtypes/README.md): a change to plan_t must be a version 3.
   EXPECT_EQ(static_cast<uint64_t>(plan_t::getHash()), 0xe41f88a8e6fc3556u);
   EXPECT_NE(plan_t::getHash(), plan_v1_t::getHash());
+}
+
+// goal_v2_t names its joints and nests task constraints; the first goal_t stays as released, so
+// that senders built before version 2 are still understood on the same channel.
+TEST(Fingerprint, GoalVersionTwoMatchesItsLayoutAndTheFirstGoalIsUnchanged) {
+  const StructSpec task{{member("frame", "string"), member("orientation_only", "boolean"),
+                         member("position", "double", {fixed(3)}),
+                         member("quaternion", "double", {fixed(4)}),
+                         member("tolerance", "double")}};
+  EXPECT_EQ(task_constraint_t::getHash(), fingerprint(task));
+  const StructSpec v2{{member("utime", "int64_t"), member("goal_id", "int64_t"),
+                       member("robot", "string"), member("kind", "int8_t"),
+                       member("num_joints", "int32_t"), per_joint("joint_name", "string"),
+                       per_joint("joint_position", "double"), member("ee_frame", "string"),
+                       member("ee_position", "double", {fixed(3)}),
+                       member("ee_quaternion", "double", {fixed(4)}),
+                       member("position_only", "boolean"), member("duration_s", "double"),
+                       member("num_task_constraints", "int32_t"),
+                       nested("task_constraint", task, {var("num_task_constraints")})}};
+  EXPECT_EQ(goal_v2_t::getHash(), fingerprint(v2));
+  const StructSpec v1{{member("utime", "int64_t"), member("goal_id", "int64_t"),
+                       member("robot", "string"), member("kind", "int8_t"),
+                       member("num_joints", "int32_t"), per_joint("joint_position", "double"),
+                       member("ee_frame", "string"), member("ee_position", "double", {fixed(3)}),
+                       member("ee_quaternion", "double", {fixed(4)}),
+                       member("duration_s", "double")}};
+  EXPECT_EQ(goal_t::getHash(), fingerprint(v1));
+  // As released (lcmtypes/README.md): goal_t must never change.
+  EXPECT_EQ(static_cast<uint64_t>(goal_t::getHash()), 0x2c764d9bfd405b4bu);
+  EXPECT_NE(goal_v2_t::getHash(), goal_t::getHash());
 }
 
 TEST(Fingerprint, JointCommandMatchesItsLayout) {

@@ -21,7 +21,9 @@ using kinograph::obstacle_t;
 using kinograph::plan_t;
 using kinograph::planner_status_t;
 using kinograph::robot_state_t;
+using kinograph::goal_v2_t;
 using kinograph::lcmtypes::DecodeStatus;
+using kinograph::lcmtypes::has_fingerprint;
 using kinograph::lcmtypes::safe_decode;
 using namespace kinograph::lcmtypes::testing;
 
@@ -54,6 +56,7 @@ TEST(SafeDecode, AcceptsWellFormedMessagesOfEveryType) {
   joint_goal.joint_position = {0.1, 0.2, 0.3};
   joint_goal.num_joints = 3;
   expect_accepts(joint_goal);
+  expect_accepts(make_goal_v2());
   expect_accepts(make_obstacle("o", obstacle_t::CYLINDER));
   expect_accepts(make_obstacle_list());
   expect_accepts(make_plan(6));
@@ -81,6 +84,7 @@ void expect_prefixes_rejected(const Msg& m) {
 TEST(SafeDecode, RejectsEveryTruncation) {
   expect_prefixes_rejected(make_robot_state());
   expect_prefixes_rejected(make_goal());
+  expect_prefixes_rejected(make_goal_v2());
   expect_prefixes_rejected(make_obstacle_list());
   expect_prefixes_rejected(make_plan(3));
   expect_prefixes_rejected(make_plan_v1(3));
@@ -88,6 +92,19 @@ TEST(SafeDecode, RejectsEveryTruncation) {
   expect_prefixes_rejected(make_joint_command());
   expect_prefixes_rejected(make_iiwa_status());
   expect_prefixes_rejected(make_robot_plan(3));
+}
+
+// Both goal versions come on one channel: the fingerprint tells them apart before decoding.
+TEST(SafeDecode, TellsTheGoalVersionsApart) {
+  const std::vector<uint8_t> v1 = encode(make_goal()), v2 = encode(make_goal_v2());
+  const int n1 = static_cast<int>(v1.size()), n2 = static_cast<int>(v2.size());
+  EXPECT_TRUE(has_fingerprint<goal_t>(v1.data(), n1));
+  EXPECT_FALSE(has_fingerprint<goal_v2_t>(v1.data(), n1));
+  EXPECT_TRUE(has_fingerprint<goal_v2_t>(v2.data(), n2));
+  EXPECT_FALSE(has_fingerprint<goal_t>(v2.data(), n2));
+  EXPECT_FALSE(has_fingerprint<goal_t>(v1.data(), 7));  // shorter than a fingerprint
+  goal_t as_v1;
+  EXPECT_FALSE(decode_bytes(v2, as_v1).ok);
 }
 
 // The two versions of plan_t have their own fingerprints: neither decodes as the other.
@@ -217,6 +234,7 @@ TEST(SafeDecode, SurvivesRandomCorruption) {
   std::mt19937 engine(4242);
   fuzz(make_robot_state(), engine, 2000);
   fuzz(make_goal(), engine, 2000);
+  fuzz(make_goal_v2(), engine, 2000);
   fuzz(make_obstacle_list(), engine, 2000);
   fuzz(make_plan(3), engine, 2000);
   fuzz(make_planner_status(), engine, 2000);

@@ -8,6 +8,7 @@
 #include "drake/lcmt_iiwa_status.hpp"
 #include "drake/lcmt_robot_plan.hpp"
 #include "kinograph/goal_t.hpp"
+#include "kinograph/goal_v2_t.hpp"
 #include "kinograph/joint_command_t.hpp"
 #include "kinograph/obstacle_list_t.hpp"
 #include "kinograph/obstacle_t.hpp"
@@ -19,6 +20,8 @@
 namespace kinograph::lcmtypes::testing {
 
 using kinograph::goal_t;
+using kinograph::goal_v2_t;
+using kinograph::task_constraint_t;
 using kinograph::joint_command_t;
 using kinograph::obstacle_list_t;
 using kinograph::obstacle_t;
@@ -69,6 +72,41 @@ inline goal_t make_goal() {
   const double q[4] = {0.5, 0.5, -0.5, 0.5};
   for (int i = 0; i < 4; ++i) m.ee_quaternion[i] = q[i];
   m.duration_s = 2.5;
+  return m;
+}
+
+/// A goal_v2_t joint goal moving the joints `names` to `q`, with no task constraint.
+inline goal_v2_t joint_goal_by_name(int64_t id, std::vector<std::string> names,
+                                    std::vector<double> q) {
+  goal_v2_t g{};
+  g.goal_id = id;
+  g.kind = goal_v2_t::KIND_JOINT_CONFIGURATION;
+  g.num_joints = static_cast<int32_t>(names.size());
+  g.joint_name = std::move(names);
+  g.joint_position = std::move(q);
+  g.ee_quaternion[0] = 1;
+  return g;
+}
+
+// A joint goal by name with two task constraints (all of goal_v2_t's arrays filled).
+inline goal_v2_t make_goal_v2() {
+  goal_v2_t m = joint_goal_by_name(9'000'000'002, {"iiwa_joint_2", "iiwa_joint_7"},
+                                   {random_double(), random_double()});
+  m.utime = 43;
+  m.robot = "iiwa14";
+  const double q[4] = {1, 0, 0, 0};
+  m.position_only = true;
+  m.duration_s = 1.5;
+  for (const char* frame : {"iiwa_link_ee_kuka", "iiwa_link_7"}) {
+    task_constraint_t t;
+    t.frame = frame;
+    t.orientation_only = frame[5] == 'l';
+    for (double& x : t.position) x = random_double();
+    for (int i = 0; i < 4; ++i) t.quaternion[i] = q[i];
+    t.tolerance = 0.05;
+    m.task_constraint.push_back(t);
+  }
+  m.num_task_constraints = 2;
   return m;
 }
 

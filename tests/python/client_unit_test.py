@@ -11,8 +11,8 @@ import time
 import unittest
 
 import kinograph
-from kinograph import goal_t, plan_t
-from kinograph_client import Lcm, LcmError, PlannerClient, joint_goal
+from kinograph import goal_t, goal_v2_t, plan_t
+from kinograph_client import Lcm, LcmError, PlannerClient, joint_goal, pose_goal
 
 LCMTYPES_DIR = sys.argv.pop(1)
 
@@ -48,6 +48,38 @@ class GeneratedTypes(unittest.TestCase):
         self.assertEqual(back.duration_s, 2.5)
         self.assertEqual(back.robot, "rr")
         self.assertEqual(list(back.ee_quaternion), [1.0, 0.0, 0.0, 0.0])
+
+    def test_named_joint_goal_is_a_goal_v2(self):
+        goal = joint_goal({"joint2": 0.5, "joint1": -1.25}, goal_id=43)
+        back = goal_v2_t.decode(goal.encode())
+        self.assertEqual(back.goal_id, 43)
+        self.assertEqual(back.kind, goal_v2_t.KIND_JOINT_CONFIGURATION)
+        self.assertEqual(list(back.joint_name), ["joint2", "joint1"])
+        self.assertEqual(list(back.joint_position), [0.5, -1.25])
+        self.assertEqual(back.num_task_constraints, 0)
+        with self.assertRaises(ValueError):  # the fingerprints differ
+            goal_t.decode(goal.encode())
+
+    def test_pose_goal(self):
+        goal = pose_goal("ee", (0.1, 0.2, 1.5), (0, 1, 0, 0), goal_id=44, duration_s=2)
+        back = goal_v2_t.decode(goal.encode())
+        self.assertEqual(back.kind, goal_v2_t.KIND_END_EFFECTOR_POSE)
+        self.assertEqual(back.ee_frame, "ee")
+        self.assertEqual(list(back.ee_position), [0.1, 0.2, 1.5])
+        self.assertEqual(list(back.ee_quaternion), [0.0, 1.0, 0.0, 0.0])
+        self.assertFalse(back.position_only)
+        self.assertEqual(back.duration_s, 2.0)
+        free = goal_v2_t.decode(pose_goal("ee", [0, 0, 1], position_only=True).encode())
+        self.assertTrue(free.position_only)
+        self.assertEqual(list(free.ee_quaternion), [1.0, 0.0, 0.0, 0.0])
+        with self.assertRaisesRegex(ValueError, "give quaternion"):
+            pose_goal("ee", [0, 0, 1])
+        with self.assertRaisesRegex(ValueError, "leave out quaternion"):
+            pose_goal("ee", [0, 0, 1], (1, 0, 0, 0), position_only=True)
+        with self.assertRaisesRegex(ValueError, "position has 2 values"):
+            pose_goal("ee", [0, 0], (1, 0, 0, 0))
+        with self.assertRaisesRegex(ValueError, "quaternion has 3 values"):
+            pose_goal("ee", [0, 0, 1], (1, 0, 0))
 
 
 class Binding(unittest.TestCase):

@@ -1,7 +1,9 @@
 """The Python client against a running kinographd (started by daemon_client_test.sh on
 robots/scenes/rr_reach.yaml): a joint goal sent from Python is answered by a valid plan that
-ends at the goal, decoded with the generated types; a goal with the wrong number of joints is
-answered INVALID_GOAL with its reason.
+ends at the goal, decoded with the generated types; goals by joint name (goal_v2_t) and a
+position-only pose goal are planned; an unknown joint name and a goal with the wrong number of
+joints are answered INVALID_GOAL with their reason. The daemon takes goal ids 1, 2, 3, ... as a
+sequence (gaps are losses), so the ids follow the tests' (alphabetical) order.
 Usage: daemon_client_test.py URL PREFIX URDF, with share/kinograph/python on PYTHONPATH."""
 
 import math
@@ -10,7 +12,7 @@ import unittest
 import xml.etree.ElementTree as ET
 
 from kinograph import plan_t
-from kinograph_client import STATUS_NAMES, PlannerClient, joint_goal
+from kinograph_client import STATUS_NAMES, PlannerClient, joint_goal, pose_goal
 
 URL, PREFIX, URDF = sys.argv[1:4]
 del sys.argv[1:4]
@@ -37,11 +39,11 @@ class PythonClientAgainstDaemon(unittest.TestCase):
         cls.client.close()
 
     def test_joint_goal_is_planned(self):
-        plan = self.client.plan(joint_goal(GOAL, goal_id=1), timeout_s=TIMEOUT_S)
+        plan = self.client.plan(joint_goal(GOAL, goal_id=2), timeout_s=TIMEOUT_S)
         self.assertEqual(plan.status, plan_t.SUCCESS,
                          f"{STATUS_NAMES.get(plan.status)}: {plan.status_message}")
         self.assertTrue(plan.valid)
-        self.assertEqual(plan.goal_id, 1)
+        self.assertEqual(plan.goal_id, 2)
         names = urdf_joint_names(URDF)
         self.assertEqual(plan.num_joints, len(names))
         self.assertEqual(list(plan.joint_name), names)
@@ -58,8 +60,31 @@ class PythonClientAgainstDaemon(unittest.TestCase):
         self.assertTrue(all(math.isfinite(x) for row in plan.tau for x in row))
         self.assertLess(plan.goal_error, 1e-3)
 
+    def test_goal_by_joint_name_holds_the_joints_not_named(self):
+        plan = self.client.plan(joint_goal({"joint2": GOAL[1]}, goal_id=1), timeout_s=TIMEOUT_S)
+        self.assertEqual(plan.status, plan_t.SUCCESS,
+                         f"{STATUS_NAMES.get(plan.status)}: {plan.status_message}")
+        self.assertAlmostEqual(plan.q[-1][0], START[0], delta=1e-3, msg="joint1 held")
+        self.assertAlmostEqual(plan.q[-1][1], GOAL[1], delta=1e-3, msg="joint2 moved")
+
+    def test_unknown_joint_name_is_refused_naming_it(self):
+        plan = self.client.plan(joint_goal({"joint1": 0.1, "shoulder": 0.2}, goal_id=4),
+                                timeout_s=TIMEOUT_S)
+        self.assertEqual(plan.status, plan_t.INVALID_GOAL, STATUS_NAMES.get(plan.status))
+        self.assertIn('"shoulder" is not a joint of rr', plan.status_message)
+
+    def test_position_only_pose_goal_is_planned(self):
+        # The tip of rr's 1 m and 0.8 m links (joint axes y, links along z) at GOAL.
+        x = math.sin(GOAL[0]) + 0.8 * math.sin(GOAL[0] + GOAL[1])
+        z = math.cos(GOAL[0]) + 0.8 * math.cos(GOAL[0] + GOAL[1])
+        plan = self.client.plan(pose_goal("ee", (x, 0.0, z), position_only=True,
+                                          goal_id=3), timeout_s=TIMEOUT_S)
+        self.assertEqual(plan.status, plan_t.SUCCESS,
+                         f"{STATUS_NAMES.get(plan.status)}: {plan.status_message}")
+        self.assertLess(plan.goal_error, 1e-2)
+
     def test_wrong_joint_count_is_refused(self):
-        plan = self.client.plan(joint_goal([0.1, 0.2, 0.3], goal_id=2), timeout_s=TIMEOUT_S)
+        plan = self.client.plan(joint_goal([0.1, 0.2, 0.3], goal_id=5), timeout_s=TIMEOUT_S)
         self.assertEqual(plan.status, plan_t.INVALID_GOAL, STATUS_NAMES.get(plan.status))
         self.assertEqual(plan.num_steps, 0)
         self.assertIn("3", plan.status_message)

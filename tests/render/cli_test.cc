@@ -6,9 +6,13 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <memory>
+#include <regex>
+#include <string>
 
 #include "render/image.h"
+#include "render/start_scene.h"
 #include "tests/render/test_scenes.h"
 
 namespace kinograph::render {
@@ -128,6 +132,58 @@ TEST_F(Cli, FailedPlanIsDrawnMarkedFailed) {
           " --frames 3 --width 400 --height 300 --out " + compare_out);
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_EQ(red_edge(read_png(compare_out)), 400 + 300);
+}
+
+// Without a plan: a scene's start pose among its obstacles, or a robot at rest. A different
+// start gives a different picture, so the start is what is drawn.
+TEST_F(Cli, RenderDrawsASceneOrARobotWithoutAPlan) {
+  const std::string scene = std::string(KINOGRAPH_SOURCE_DIR) + "/robots/scenes/rr_reach.yaml";
+  const std::string out = (dir_ / "scene.png").string();
+  CliRun r = run("render " + scene + " --width 320 --height 240 --out " + out);
+  ASSERT_EQ(r.status, 0) << r.output;
+  const Image start = read_png(out);
+  EXPECT_EQ(start.width, 320);
+  EXPECT_EQ(start.height, 240);
+
+  std::ifstream in(scene);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t at = text.find("q: [-1.2, 0]");
+  ASSERT_NE(at, std::string::npos) << "rr_reach.yaml's start changed";
+  text.replace(at, 12, "q: [0.6, 0.9]");
+  const fs::path moved = dir_ / "moved.yaml";
+  std::ofstream(moved) << "# copy of rr_reach.yaml with another start\n"
+                       << std::regex_replace(text, std::regex("\\.\\./rr/rr\\.urdf"),
+                                             std::string(KINOGRAPH_SOURCE_DIR) +
+                                                 "/robots/rr/rr.urdf");
+  r = run("render " + moved.string() + " --width 320 --height 240 --out " +
+          (dir_ / "moved.png").string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(read_png((dir_ / "moved.png").string()).rgba, start.rgba);
+
+  r = run("render " + std::string(KINOGRAPH_SOURCE_DIR) + "/robots/rr/rr.urdf --width 200 "
+          "--height 200 --out " + (dir_ / "robot.png").string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(read_png((dir_ / "robot.png").string()).width, 200);
+
+  r = run("render " + scene + " --compare " + plan_ + " --out " + (dir_ / "x.png").string());
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.output.find("--compare needs two plan files"), std::string::npos) << r.output;
+  r = run("render " + (dir_ / "notes.txt").string() + " --out " + (dir_ / "x.png").string());
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.output.find("not a plan (.json), scene (.yaml) or robot (.urdf)"),
+            std::string::npos)
+      << r.output;
+  EXPECT_FALSE(fs::exists(dir_ / "x.png"));
+}
+
+// A joint whose range excludes 0 rests at its nearer limit, so the picture is a legal pose.
+TEST(RestPose, ZeroOrTheNearerLimit) {
+  dynamics::Model model =
+      dynamics::Model::from_urdf_file(std::string(KINOGRAPH_SOURCE_DIR) + "/robots/rr/rr.urdf");
+  EXPECT_EQ(rest_pose(model), Eigen::Vector2d::Zero());
+  model.bodies[0].limits.lower = 0.5;
+  model.bodies[1].limits.upper = -0.3;
+  EXPECT_EQ(rest_pose(model), Eigen::Vector2d(0.5, -0.3));
 }
 
 TEST_F(Cli, BadInputFailsWithAMessage) {

@@ -56,7 +56,7 @@ TEST(NiceTicks, RoundStepsCoveringTheRange) {
 TEST(TorquePlot, SizeCurvesLimitsAndOverlay) {
   TorquePlotOptions options;
   options.width = 1000;
-  options.limits = {40, 40, 40, 40};
+  options.limits = {25, 25, 25, 25};  // within the curves' ±30: drawn
   const Image one = plot_torques({sine_series("batch", 30, 4)}, options);
   EXPECT_EQ(one.width, 1000);
   EXPECT_EQ(one.height, 44 + 2 * 210);  // 4 joints: 2 columns, 2 rows
@@ -71,6 +71,42 @@ TEST(TorquePlot, SizeCurvesLimitsAndOverlay) {
   const Image no_limits = plot_torques({sine_series("batch", 30, 4)}, options);
   EXPECT_EQ(no_limits.height, 300);
   EXPECT_LT(count_colour(no_limits, Eigen::Vector3d(0.8, 0.1, 0.1), 30), 20);
+}
+
+// Rows of the picture where the i-th series is drawn.
+int rows_with(const Image& image, int i) {
+  const Eigen::Vector3d rgb = series_color(i) * 255;
+  int rows = 0;
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      const std::uint8_t* p = image.at(x, y);
+      if (std::abs(p[0] - rgb.x()) <= 30 && std::abs(p[1] - rgb.y()) <= 30 &&
+          std::abs(p[2] - rgb.z()) <= 30) {
+        ++rows;
+        break;
+      }
+    }
+  }
+  return rows;
+}
+
+// The axes span the data: a limit far beyond the torques neither squashes the curves nor is
+// drawn as a line, but is named at the edge (red text only).
+TEST(TorquePlot, AxesSpanTheDataNotALimitFarBeyond) {
+  TorquePlotOptions options;
+  options.width = 600;
+  const PlotSeries series = sine_series("batch", 30, 1);
+  const Image plain = plot_torques({series}, options);
+  options.limits = {400};
+  const Image far = plot_torques({series}, options);
+  EXPECT_EQ(rows_with(far, 0), rows_with(plain, 0));
+  EXPECT_GT(rows_with(plain, 0), 120);  // most of the 210-pixel row minus the margins
+  const int red = count_colour(far, Eigen::Vector3d(0.8, 0.1, 0.1), 30);
+  EXPECT_GT(red, 0);
+  EXPECT_LT(red, 300);  // the two labels (and the legend's dash), no lines across the axes
+  options.limits = {25};
+  EXPECT_GT(count_colour(plot_torques({series}, options), Eigen::Vector3d(0.8, 0.1, 0.1), 30),
+            red + 300);  // within the data: both dashed lines
 }
 
 TEST(TorquePlot, BadInputIsAClearError) {

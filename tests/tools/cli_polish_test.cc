@@ -112,6 +112,12 @@ TEST_F(CliContract, SendGoalRefusesWhatItCannotFinishBeforeSending) {
       {"--q 0,0 --frame tip --position 1,0,0 --quaternion 1,0,0,0", "not both"},
       {"--frame tip --position 1,0,0", "a pose goal needs --frame, --position and --quaternion"},
       {"--q 0,x", "--q: 'x' is not a finite number"},
+      {"--q 0,0 --joint joint1=0", "not both"},
+      {"--joint joint1", "--joint: 'joint1' is not NAME=VALUE"},
+      {"--joint joint1=pie", "--joint joint1: 'pie' is not a finite number"},
+      {"--q 0,0 --position-only", "--position-only is for pose goals"},
+      {"--frame tip --position 1,0,0 --quaternion 1,0,0,0 --position-only",
+       "--position-only ignores the orientation"},
   };
   for (const Case& c : cases) {
     const CliRun r = run_cli(send + c.args);
@@ -124,6 +130,12 @@ TEST_F(CliContract, SendGoalRefusesWhatItCannotFinishBeforeSending) {
   const CliRun ok = run_cli(send + "--frame tip --position 1,0,0 --quaternion 1,0,0,0");
   EXPECT_EQ(ok.status, 0) << ok.output;
   EXPECT_TRUE(contains(ok.output, "sent goal")) << ok.output;
+  for (const std::string args : {"--frame tip --position 1,0,0 --position-only",
+                                 "--joint joint2=pi/2 --joint joint1=-0.5"}) {
+    const CliRun v2 = run_cli(send + args);
+    EXPECT_EQ(v2.status, 0) << args << "\n" << v2.output;
+    EXPECT_TRUE(contains(v2.output, "(goal_v2_t)")) << args << "\n" << v2.output;
+  }
 }
 
 TEST_F(CliContract, LogPlansRefusesAnotherRobotsSceneAndWritesNothing) {
