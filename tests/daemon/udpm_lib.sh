@@ -22,11 +22,26 @@ wait_for_line() {
   return 1
 }
 
-# Starts kinographd on scene $1, URL $2, logging to $3, and waits until it is subscribed.
-# Sets DAEMON to its pid.
+# Starts kinographd on scene $1, URL $2, logging to $3 (further arguments are the daemon's),
+# and waits until it is subscribed. Sets DAEMON to its pid.
 start_daemon() {
-  "$KGD" "$1" --prefix RR --lcm-url "$2" --status-period 0.2 >"$3" 2>&1 &
+  "$KGD" "$1" --prefix RR --lcm-url "$2" --status-period 0.2 "${@:4}" >"$3" 2>&1 &
   DAEMON=$!
   PIDS+=($DAEMON)
   wait_for_line "$3" "on channels RR_" || fail "daemon did not start"
+}
+
+# Waits (bounded, 60 s) for process $1, a child of this shell, to exit; sets EXIT_CODE. A
+# process still running then is killed and the test fails.
+wait_exit() {
+  sleep 60 &
+  local watchdog=$! ended=""
+  EXIT_CODE=0
+  wait -n -p ended "$1" "$watchdog" || EXIT_CODE=$?
+  if [ "$ended" = "$watchdog" ]; then
+    kill -KILL "$1" 2>/dev/null || true
+    fail "process $1 did not exit within 60 s"
+  fi
+  kill "$watchdog" 2>/dev/null || true
+  wait "$watchdog" 2>/dev/null || true
 }
