@@ -32,16 +32,20 @@ start_daemon() {
 }
 
 # Waits (bounded, 60 s) for process $1, a child of this shell, to exit; sets EXIT_CODE. A
-# process still running then is killed and the test fails.
+# process still running then is killed and the test fails. It polls /proc (every 10 ms) for
+# the child to end or turn zombie rather than using `wait -n`, which in bash 5.2 can lose the
+# status of another child ("wait_for: No record of process").
 wait_exit() {
-  sleep 60 &
-  local watchdog=$! ended=""
-  EXIT_CODE=0
-  wait -n -p ended "$1" "$watchdog" || EXIT_CODE=$?
-  if [ "$ended" = "$watchdog" ]; then
+  local i state
+  for i in $(seq 6000); do
+    state=$(awk '{print $3}' "/proc/$1/stat" 2>/dev/null || true)
+    [ -n "$state" ] && [ "$state" != Z ] || break
+    sleep 0.01
+  done
+  if [ -n "$state" ] && [ "$state" != Z ]; then
     kill -KILL "$1" 2>/dev/null || true
     fail "process $1 did not exit within 60 s"
   fi
-  kill "$watchdog" 2>/dev/null || true
-  wait "$watchdog" 2>/dev/null || true
+  EXIT_CODE=0
+  wait "$1" || EXIT_CODE=$?
 }
