@@ -6,8 +6,8 @@
 namespace kinograph::daemon {
 
 bool Intake::empty() const {
-  return !goal && superseded.empty() && lost.empty() && obstacles.empty() && !replace_all &&
-         states == 0 && state_refused.empty();
+  return !goal && superseded.empty() && lost.empty() && obstacles.empty() &&
+         replaced_sources.empty() && states == 0 && state_refused.empty();
 }
 
 void Intake::absorb(Intake&& newer) {
@@ -17,9 +17,9 @@ void Intake::absorb(Intake&& newer) {
   }
   superseded.insert(superseded.end(), newer.superseded.begin(), newer.superseded.end());
   lost.insert(lost.end(), newer.lost.begin(), newer.lost.end());
-  if (newer.replace_all) {
-    obstacles.clear();
-    replace_all = true;
+  for (const std::string& source : newer.replaced_sources) {
+    std::erase_if(obstacles, [&](const messages::ObstacleUpdate& u) { return u.source == source; });
+    replaced_sources.insert(source);
   }
   obstacles.insert(obstacles.end(), std::make_move_iterator(newer.obstacles.begin()),
                    std::make_move_iterator(newer.obstacles.end()));

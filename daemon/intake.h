@@ -5,6 +5,7 @@
 // plans only the newest one.
 #include <cstdint>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -30,7 +31,8 @@ struct Intake {
   std::vector<int64_t> superseded;
   std::vector<LostGoals> lost;
   std::vector<messages::ObstacleUpdate> obstacles;
-  bool replace_all = false;  ///< the obstacle list starts from an empty world
+  /// Sources whose obstacles the changes start from nothing (a replace_all of theirs).
+  std::set<std::string> replaced_sources;
   std::optional<messages::MeasuredState> state;
   std::uint64_t states = 0;  ///< measured states received
   /// Why the newest measured state was refused as a start (beyond the limits), or empty when
@@ -40,7 +42,7 @@ struct Intake {
   /// Nothing arrived.
   bool empty() const;
   /// Adds what arrived after this intake: a newer goal supersedes the one held here, a
-  /// replace_all discards the obstacle changes held here, a newer state, usable or refused,
+  /// replace_all discards the changes of its source held here, a newer state, usable or refused,
   /// replaces the old one.
   void absorb(Intake&& newer);
 };

@@ -3,6 +3,7 @@
 //              [--batch-only] [--max-goal-change RAD] [--formulation condensed|dfg]
 //              [--ignore-goal-id-gaps] [--max-state-age 0.5]
 //              [--iiwa-status-channel IIWA_STATUS] [--drake-plan-channel COMMITTED_ROBOT_PLAN]
+//              [--state-file FILE]
 // The scene gives the robot, default horizon and steps, start, fixed obstacles, objective
 // weights and the batch formulation; goals, obstacle updates and measured states arrive over
 // LCM.
@@ -11,6 +12,8 @@
 #include <CLI/CLI.hpp>
 #include <atomic>
 #include <csignal>
+#include <cstdint>
+#include <ctime>
 #include <iostream>
 
 #include "daemon/planner_node.h"
@@ -19,7 +22,14 @@
 namespace {
 std::atomic<bool> g_stop{false};
 std::atomic<int> g_signal{0};
+std::atomic<int64_t> g_signal_ns{0};  // CLOCK_MONOTONIC when the signal came, for the summary
+int64_t monotonic_ns() {
+  timespec t{};
+  clock_gettime(CLOCK_MONOTONIC, &t);  // async-signal-safe, unlike std::chrono's clocks
+  return static_cast<int64_t>(t.tv_sec) * 1'000'000'000 + t.tv_nsec;
+}
 void on_signal(int signal) {
+  g_signal_ns = monotonic_ns();
   g_signal = signal;
   g_stop = true;
 }
@@ -61,6 +71,9 @@ int main(int argc, char** argv) {
   app.add_option("--drake-plan-channel", options.drake_plan_channel,
                  "also publish every valid plan as Drake's lcmt_robot_plan on this channel, "
                  "e.g. COMMITTED_ROBOT_PLAN; default: none");
+  app.add_option("--state-file", options.state_file,
+                 "remember plan ids and the obstacles received over LCM in this file across "
+                 "restarts (written atomically); default: none, plan ids start at 1");
   CLI11_PARSE(app, argc, argv);
   options.answer_goal_id_gaps = !ignore_gaps;
   options.replanning.use_incremental = !batch_only;
@@ -79,13 +92,16 @@ int main(int argc, char** argv) {
     kinograph::daemon::PlannerNode node(std::move(scene), options);
     node.run(g_stop);
     const auto c = node.counters();
-    if (g_signal != 0) spdlog::info("kinographd: signal {} received", g_signal.load());
+    if (g_signal != 0) {
+      spdlog::info("kinographd: signal {} received; every goal answered {:.1f} ms after it",
+                   g_signal.load(), static_cast<double>(monotonic_ns() - g_signal_ns) * 1e-6);
+    }
     spdlog::info(
-        "kinographd: stopped after {} goals ({} answered, {} superseded, {} dropped in "
-        "transport), {} plans ({} failed, {} incremental replans, {} fallbacks), {} rejected "
-        "messages",
-        c.goals_received, c.goals_answered, c.goals_superseded, c.goals_dropped, c.plans_published,
-        c.failures, c.incremental, c.fallbacks, c.messages_rejected);
+        "kinographd: stopped after {} goals ({} answered, {} superseded, {} cancelled, {} "
+        "dropped in transport), {} plans ({} failed, {} incremental replans, {} fallbacks), {} "
+        "rejected messages",
+        c.goals_received, c.goals_answered, c.goals_superseded, c.goals_cancelled, c.goals_dropped,
+        c.plans_published, c.failures, c.incremental, c.fallbacks, c.messages_rejected);
   } catch (const std::exception& e) {
     std::cerr << "kinographd: error: " << e.what() << "\n";
     return 1;

@@ -5,20 +5,36 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstring>
+#include <fstream>
 #include <lcm/lcm-cpp.hpp>
 #include <stdexcept>
 #include <string_view>
 #include <thread>
 
+#include "daemon/state_file.h"
 #include "daemon/state_limits.h"
 #include "daemon/wire_strings.h"
+#include "kinograph/graph/cancellation.h"
 #include "kinograph/lcm/drake_convert.h"
 #include "kinograph/lcm/lcm_connection.h"
 #include "kinograph/planner_status_t.hpp"
 #include "lcmtypes/safe_decode.h"
 
 namespace kinograph::daemon {
+
+namespace {
+// Why a goal got CANCELLED: a solve cut short, or a goal never started.
+constexpr char kShutdownReason[] = "the planner daemon is shutting down";
+
+// An obstacle as messages name it: "id", or "id" of source "s" (bounded, wire_strings.h).
+std::string obstacle_name(const ObstacleKey& key) {
+  std::string name = "\"" + truncated(key.second) + "\"";
+  if (!key.first.empty()) name += " of source \"" + truncated(key.first) + "\"";
+  return name;
+}
+}  // namespace
 
 PlannerNode::PlannerNode(planning::Scene scene, PlannerNodeOptions options, lcm::LCM* shared)
     : scene_(std::move(scene)), options_(std::move(options)), replanner_(options_.replanning) {
@@ -37,6 +53,8 @@ PlannerNode::PlannerNode(planning::Scene scene, PlannerNodeOptions options, lcm:
   for (const auto& o : scene_.problem.obstacles) {
     next_obstacle_id_ = std::max(next_obstacle_id_, o.id + 1);
   }
+  // Before subscribing: a state file refused leaves nothing subscribed on a shared LCM.
+  restore_state();
   subscriptions_ = {lcm_->subscribe(channel("GOAL"), &PlannerNode::on_goal, this),
                     lcm_->subscribe(channel("OBSTACLES"), &PlannerNode::on_obstacles, this),
                     lcm_->subscribe(channel("STATE"), &PlannerNode::on_state, this)};
@@ -51,6 +69,70 @@ PlannerNode::PlannerNode(planning::Scene scene, PlannerNodeOptions options, lcm:
   }
   for (std::size_t i = 0; i < subscriptions_.size(); ++i) {
     subscriptions_[i]->setQueueCapacity(capacities[i]);
+  }
+}
+
+void PlannerNode::restore_state() {
+  if (options_.state_file.empty()) {
+    spdlog::info(
+        "kinographd: no --state-file: plan ids start at 1, and obstacles received over LCM are "
+        "forgotten when the daemon stops");
+    return;
+  }
+  if (!std::ifstream(options_.state_file)) {
+    spdlog::info(
+        "kinographd: state file {} does not exist yet: plan ids start at 1, no "
+        "obstacles from LCM",
+        options_.state_file);
+  } else {
+    DaemonState state =
+        read_state_file(options_.state_file, identity_.model_name, identity_.channel_prefix);
+    const std::size_t world = scene_.problem.obstacles.size() + state.obstacles.size();
+    if (world > static_cast<std::size_t>(collision::kMaxObstacles)) {
+      throw StateFileError("state file '" + options_.state_file + "': its " +
+                           std::to_string(state.obstacles.size()) + " obstacles and the scene's " +
+                           std::to_string(scene_.problem.obstacles.size()) + " are more than the " +
+                           std::to_string(collision::kMaxObstacles) + " a world may hold");
+    }
+    next_plan_id_ = state.plan_ids_below;
+    for (const auto& [key, u] : state.obstacles) {
+      collision::Obstacle o;
+      o.id = next_obstacle_id_++;
+      o.shape = u.shape;
+      o.pose = u.pose;
+      live_obstacles_[key] = std::move(o);
+    }
+    stored_obstacles_ = std::move(state.obstacles);
+    spdlog::info(
+        "kinographd: state file {}: plan ids from {}, {} obstacles received over LCM "
+        "before the restart",
+        options_.state_file, next_plan_id_, stored_obstacles_.size());
+  }
+  // The file is ours from now on: a reservation is written before the first id is used.
+  plan_ids_reserved_ = next_plan_id_;
+}
+
+int64_t PlannerNode::take_plan_id_locked() {
+  if (!options_.state_file.empty() && next_plan_id_ >= plan_ids_reserved_) {
+    plan_ids_reserved_ = next_plan_id_ + kPlanIdReservation;
+    save_state_locked();
+  }
+  return next_plan_id_++;
+}
+
+void PlannerNode::save_state_locked() {
+  if (options_.state_file.empty()) return;
+  DaemonState state;
+  state.robot = identity_.model_name;
+  state.prefix = identity_.channel_prefix;
+  state.plan_ids_below = std::max(plan_ids_reserved_, next_plan_id_);
+  state.obstacles = stored_obstacles_;
+  try {
+    write_state_file(options_.state_file, state);
+    stored_obstacles_dirty_ = false;
+    state_written_at_ = std::chrono::steady_clock::now();
+  } catch (const StateFileError& e) {
+    spdlog::error("{}: plan ids and obstacles will not survive a restart", e.what());
   }
 }
 
@@ -149,11 +231,12 @@ void PlannerNode::answer_with_failure(int8_t status, const std::string& reason, 
   messages::PlanTime time;
   {
     std::lock_guard lock(mutex_);
-    plan_id = next_plan_id_++;
+    plan_id = take_plan_id_locked();
     ++counters_.plans_published;
     ++counters_.failures;
     if (first_answer) ++counters_.goals_answered;
     if (status == plan_t::SUPERSEDED) ++counters_.goals_superseded;
+    if (status == plan_t::CANCELLED && first_answer) ++counters_.goals_cancelled;
     time = clock_now_locked();
     if (latest_state_) time.state_utime = latest_state_->utime;
   }
@@ -240,9 +323,15 @@ void PlannerNode::on_goal(const lcm::ReceiveBuffer* rbuf, const std::string& cha
 
 void PlannerNode::on_obstacles(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
   obstacle_list_t msg;
-  if (auto s = lcmtypes::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), msg); !s.ok) {
-    reject(channel, channel + ": malformed obstacle_list_t: " + s.reason);
-    return;
+  const int size = static_cast<int>(rbuf->data_size);
+  if (auto s = lcmtypes::safe_decode(rbuf->data, size, msg); !s.ok) {
+    // A version-1 sender (no source) is the unnamed source "".
+    obstacle_list_v1_t v1;
+    if (!lcmtypes::safe_decode(rbuf->data, size, v1).ok) {
+      reject(channel, channel + ": malformed obstacle_list_t: " + s.reason);
+      return;
+    }
+    msg = messages::obstacle_list_from_v1(v1);
   }
   if (std::string overlong = overlong_name(msg); !overlong.empty()) {
     reject(channel, channel + ": " + overlong);
@@ -253,7 +342,7 @@ void PlannerNode::on_obstacles(const lcm::ReceiveBuffer* rbuf, const std::string
     reject(channel, channel + ": " + c.reason);
     return;
   }
-  arrived.replace_all = msg.replace_all;
+  if (msg.replace_all) arrived.replaced_sources.insert(msg.source);
   intake_.absorb(std::move(arrived));
 }
 
@@ -286,6 +375,12 @@ void PlannerNode::on_iiwa_status(const lcm::ReceiveBuffer* rbuf, const std::stri
   drake::lcmt_iiwa_status msg;
   if (auto s = lcmtypes::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), msg); !s.ok) {
     reject(channel, channel + ": malformed lcmt_iiwa_status: " + s.reason);
+    return;
+  }
+  // Drake's status names no robot: a NaN or Inf in it is a malformed message, dropped as if
+  // lost, and the state age bound (--max-state-age) answers goals when no usable one follows.
+  if (std::string bad = messages::non_finite_iiwa_field(msg, *scene_.problem.model); !bad.empty()) {
+    reject(channel, channel + ": malformed " + bad);
     return;
   }
   MeasuredState state;
@@ -366,31 +461,58 @@ void PlannerNode::hand_over() {
   wake_.notify_one();
 }
 
-bool PlannerNode::apply_obstacles(const std::vector<ObstacleUpdate>& updates, bool replace_all) {
+void PlannerNode::store_obstacles() {
+  if (options_.state_file.empty()) return;
+  std::map<ObstacleKey, ObstacleUpdate> copy;
+  for (const auto& [key, o] : live_obstacles_) {
+    ObstacleUpdate& u = copy[key];
+    u.source = key.first;
+    u.id = key.second;
+    u.shape = o.shape;
+    u.pose = o.pose;
+  }
+  std::lock_guard lock(mutex_);
+  stored_obstacles_ = std::move(copy);
+  stored_obstacles_dirty_ = true;
+}
+
+void PlannerNode::save_state_if_due() {
+  std::lock_guard lock(mutex_);
+  if (!stored_obstacles_dirty_) return;
+  if (std::chrono::steady_clock::now() - state_written_at_ <
+      std::chrono::duration<double>(kStateWritePeriod)) {
+    return;
+  }
+  save_state_locked();
+}
+
+bool PlannerNode::apply_obstacles(const std::vector<ObstacleUpdate>& updates,
+                                  const std::set<std::string>& replaced_sources) {
   bool changed = false;
-  if (replace_all) {
-    // The list is the whole world: obstacles it does not name go; the ones it names keep their
-    // ids, so that the planner sees a move rather than a removal and an addition.
-    for (auto it = live_obstacles_.begin(); it != live_obstacles_.end();) {
-      const bool named = std::any_of(updates.begin(), updates.end(), [&](const ObstacleUpdate& u) {
-        return !u.remove && u.id == it->first;
-      });
-      if (named) {
-        ++it;
-      } else {
-        it = live_obstacles_.erase(it);
-        changed = true;
-      }
+  // A replace_all is one source's whole world: its obstacles the changes do not name go; the
+  // ones named keep their ids, so that the planner sees a move rather than a removal and an
+  // addition. Other sources' obstacles stay.
+  for (auto it = live_obstacles_.begin(); it != live_obstacles_.end();) {
+    const auto& [source, id] = it->first;
+    const bool named = std::any_of(updates.begin(), updates.end(), [&](const ObstacleUpdate& u) {
+      return !u.remove && u.source == source && u.id == id;
+    });
+    if (replaced_sources.count(source) != 0 && !named) {
+      it = live_obstacles_.erase(it);
+      changed = true;
+    } else {
+      ++it;
     }
   }
   // The world's bound (scene obstacles included) is checked before anything is added.
   const std::size_t fixed = scene_.problem.obstacles.size();
   std::vector<std::string> refused;
   for (const auto& u : updates) {
-    auto it = live_obstacles_.find(u.id);
+    const ObstacleKey key{u.source, u.id};
+    auto it = live_obstacles_.find(key);
     if (!u.remove && it == live_obstacles_.end() &&
         fixed + live_obstacles_.size() >= static_cast<std::size_t>(collision::kMaxObstacles)) {
-      refused.push_back(u.id);
+      refused.push_back(obstacle_name(key));
       continue;
     }
     if (u.remove) {
@@ -398,7 +520,7 @@ bool PlannerNode::apply_obstacles(const std::vector<ObstacleUpdate>& updates, bo
         live_obstacles_.erase(it);
         changed = true;
       } else {
-        spdlog::info("obstacle \"{}\" to remove is not known; ignored", truncated(u.id));
+        spdlog::info("obstacle {} to remove is not known; ignored", obstacle_name(key));
       }
       continue;
     }
@@ -406,12 +528,12 @@ bool PlannerNode::apply_obstacles(const std::vector<ObstacleUpdate>& updates, bo
     o.id = it != live_obstacles_.end() ? it->second.id : next_obstacle_id_++;
     o.shape = u.shape;
     o.pose = u.pose;
-    live_obstacles_[u.id] = std::move(o);
+    live_obstacles_[key] = std::move(o);
     changed = true;
   }
   if (!refused.empty()) {
     reject(channel("OBSTACLES"),
-           "obstacle \"" + truncated(refused.front()) + "\"" +
+           "obstacle " + refused.front() +
                (refused.size() > 1 ? " and " + std::to_string(refused.size() - 1) + " more" : "") +
                " not added: the world holds the most obstacles it may, " +
                std::to_string(collision::kMaxObstacles) + " (scene and LCM together)");
@@ -453,6 +575,7 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan) {
     publish_status();
     return;
   }
+  spdlog::debug("goal {}: planning{}", goal.goal_id, replan ? " (replan)" : "");
   for (const auto& [name, obstacle] : live_obstacles_) problem.obstacles.push_back(obstacle);
   // Joints a goal does not name stay where this plan starts.
   problem.goal = messages::goal_for_start(goal, problem.start_q);
@@ -465,6 +588,16 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan) {
   std::string error;
   try {
     plan = replanner_.plan(problem, /*new_goal=*/!replan);
+  } catch (const graph::Cancelled&) {
+    spdlog::info("goal {}: planning cancelled: {}", goal.goal_id, kShutdownReason);
+    answer_with_failure(plan_t::CANCELLED, std::string("planning cancelled: ") + kShutdownReason,
+                        goal.goal_id, /*first_answer=*/!replan);
+    {
+      std::lock_guard lock(mutex_);
+      state_ = planner_status_t::IDLE;
+      last_message_ = kShutdownReason;
+    }
+    return;
   } catch (const std::exception& e) {
     threw = true;
     error = e.what();
@@ -481,7 +614,7 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan) {
   {
     std::lock_guard lock(mutex_);
     time = clock_now_locked();
-    plan_id = next_plan_id_++;
+    plan_id = take_plan_id_locked();
     last_plan_id_ = plan_id;
     ++counters_.plans_published;
     if (!replan) ++counters_.goals_answered;
@@ -518,19 +651,40 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan) {
   publish_status();
 }
 
+void PlannerNode::answer_at_shutdown(const Intake& taken) {
+  answer_superseded(taken);
+  // Obstacle changes are kept (for the state file), not planned.
+  if ((!taken.obstacles.empty() || !taken.replaced_sources.empty()) &&
+      apply_obstacles(taken.obstacles, taken.replaced_sources)) {
+    store_obstacles();
+  }
+  if (!taken.goal) return;
+  spdlog::info("goal {}: not planned: {}", taken.goal->goal_id, kShutdownReason);
+  answer_with_failure(plan_t::CANCELLED, std::string("not planned: ") + kShutdownReason,
+                      taken.goal->goal_id);
+}
+
 void PlannerNode::worker_loop(const std::atomic<bool>& stop) {
+  graph::CancellationScope cancellation(cancel_);
   while (true) {
     Intake taken;
+    bool stopping;
     {
       std::unique_lock lock(mutex_);
       wake_.wait_for(lock, std::chrono::milliseconds(50),
                      [&] { return stop.load() || !pending_.empty(); });
-      if (stop.load()) return;
+      stopping = stop.load();
       std::swap(taken, pending_);
     }
+    if (stopping) {
+      answer_at_shutdown(taken);
+      return;
+    }
+    save_state_if_due();
     answer_superseded(taken);
-    const bool obstacles_changed = (!taken.obstacles.empty() || taken.replace_all) &&
-                                   apply_obstacles(taken.obstacles, taken.replace_all);
+    const bool obstacles_changed = (!taken.obstacles.empty() || !taken.replaced_sources.empty()) &&
+                                   apply_obstacles(taken.obstacles, taken.replaced_sources);
+    if (obstacles_changed) store_obstacles();
     if (taken.goal) {
       current_goal_ = taken.goal;
       plan_and_publish(*taken.goal, /*replan=*/false);
@@ -590,8 +744,15 @@ void PlannerNode::run(const std::atomic<bool>& stop) {
                  options_.drake_plan_channel);
   }
   // The worker stops on `done`, not on `stop`, so that an LCM failure also ends it.
+  cancel_ = false;
   std::atomic<bool> done{false};
+  // Process signals (SIGTERM) reach the thread that runs run(), never the worker (LCM blocks
+  // them in its own thread): a stop is then seen before more of what LCM holds is planned.
+  sigset_t all_signals, previous_mask;
+  sigfillset(&all_signals);
+  pthread_sigmask(SIG_BLOCK, &all_signals, &previous_mask);
   std::thread worker([&] { worker_loop(done); });
+  pthread_sigmask(SIG_SETMASK, &previous_mask, nullptr);
   auto next_status = std::chrono::steady_clock::now();
   int handle_failures = 0;
   while (!stop.load()) {
@@ -622,11 +783,34 @@ void PlannerNode::run(const std::atomic<bool>& stop) {
              lcm_->handleTimeout(1) > 0) {
       }
     }
+    // Once stopping, nothing more is handed to the worker to plan: it is answered below.
+    if (stop.load()) break;
     hand_over();
   }
+  // A solve under way ends at its next iteration; the worker answers what it holds and ends.
+  cancel_ = true;
   done = true;
   wake_.notify_all();
   worker.join();
+  // What LCM already holds is still taken and answered here (bounded: a storm cannot hold the
+  // exit up), so that no goal that arrived goes unanswered.
+  for (int i = 0; i < kGoalQueueCapacity && lcm_->handleTimeout(0) > 0; ++i) {
+  }
+  hand_over();
+  Intake left;
+  {
+    std::lock_guard lock(mutex_);
+    std::swap(left, pending_);
+  }
+  answer_at_shutdown(left);
+  {
+    std::lock_guard lock(mutex_);
+    // The ids used are all below next_plan_id_: the next daemon starts there, not at the
+    // reservation's end.
+    plan_ids_reserved_ = next_plan_id_;
+    save_state_locked();
+  }
+  publish_status();
 }
 
 }  // namespace kinograph::daemon

@@ -8,6 +8,7 @@
 // planning::Replanner's policy; plan_t.method names the path that answered ("batch",
 // "incremental", "batch after incremental", "warm-start", "batch after warm-start").
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <limits>
@@ -15,6 +16,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -37,6 +39,7 @@ namespace kinograph::daemon {
 using messages::Check;
 using messages::GoalRequest;
 using messages::MeasuredState;
+using messages::ObstacleKey;
 using messages::ObstacleUpdate;
 using messages::RobotIdentity;
 
@@ -66,6 +69,10 @@ struct PlannerNodeOptions {
   /// Channel on which every valid plan is also published as Drake's lcmt_robot_plan (e.g.
   /// "COMMITTED_ROBOT_PLAN"); empty = none.
   std::string drake_plan_channel;
+  /// File the daemon remembers its plan ids and the obstacles received over LCM in, across
+  /// restarts (daemon/state_file.h); empty = none: plan ids start at 1 and those obstacles are
+  /// forgotten when it stops.
+  std::string state_file;
 };
 
 /// What a node has done since it started (for its status and for tests).
@@ -83,6 +90,7 @@ struct NodeCounters {
   int64_t publish_failures = 0;    ///< messages LCM failed to send (lcm_publish returned non-zero)
   int64_t states_refused = 0;      ///< states beyond the limits or not finite (never a start)
   int64_t foreign_heartbeats = 0;  ///< heartbeats on this daemon's channel published by another
+  int64_t goals_cancelled = 0;     ///< goals answered CANCELLED: planning or pending at shutdown
 };
 
 /// The planner daemon's node: scene (robot, defaults, fixed obstacles) + LCM + worker thread.
@@ -104,8 +112,14 @@ class PlannerNode {
   static constexpr int kRejectLogLinesPerSecond = 10;
   /// A jump in goal ids larger than this is a new numbering, not a loss.
   static constexpr int64_t kMaxGoalIdGap = kGoalQueueCapacity;
+  /// Plan ids reserved in the state file at a time: it is written once per so many plans, and
+  /// a restart after a crash skips at most so many ids.
+  static constexpr int64_t kPlanIdReservation = 1000;
+  /// Least time between two writes of the state file for obstacle changes (s).
+  static constexpr double kStateWritePeriod = 1.0;
 
-  /// Throws std::runtime_error naming the URL when LCM cannot start (e.g. no multicast route).
+  /// Throws std::runtime_error naming the URL when LCM cannot start (e.g. no multicast route),
+  /// StateFileError when options.state_file exists but cannot be taken (corrupt, foreign).
   /// With `shared`, the node uses that LCM instance instead of opening options.lcm_url (how
   /// in-process tests share one memq:// queue with it); it must outlive the node.
   PlannerNode(planning::Scene scene, PlannerNodeOptions options, lcm::LCM* shared = nullptr);
@@ -114,7 +128,8 @@ class PlannerNode {
   PlannerNode& operator=(const PlannerNode&) = delete;
 
   /// Handles LCM traffic and plans until `stop` becomes true (checked every 50 ms); the
-  /// planning thread is started and joined inside.
+  /// planning thread is started and joined inside. On `stop` a solve under way is cancelled at
+  /// its next iteration, and it and every goal still pending are answered CANCELLED.
   void run(const std::atomic<bool>& stop);
 
   /// Full channel name for a suffix, e.g. channel("GOAL") = "IIWA_GOAL".
@@ -155,9 +170,29 @@ class PlannerNode {
   /// Hands what the handlers took off LCM to the worker, in one go (LCM thread).
   void hand_over();
   void worker_loop(const std::atomic<bool>& stop);
-  bool apply_obstacles(const std::vector<ObstacleUpdate>& updates, bool replace_all);
+  /// Answers the goals `taken` holds at shutdown: replaced ones SUPERSEDED, the newest
+  /// CANCELLED; its obstacle changes are applied, not planned (worker thread, or run() once
+  /// the worker has ended).
+  void answer_at_shutdown(const Intake& taken);
+  /// Applies obstacle changes in order after emptying each replaced source; true when the
+  /// world changed (worker thread).
+  bool apply_obstacles(const std::vector<ObstacleUpdate>& updates,
+                       const std::set<std::string>& replaced_sources);
+  /// Copies the LCM obstacles for the state file (worker thread, after a change).
+  void store_obstacles();
+  /// Writes the state file when obstacles changed and the last write is kStateWritePeriod
+  /// old (worker thread).
+  void save_state_if_due();
   void plan_and_publish(const GoalRequest& goal, bool replan);
   void publish_status();
+  /// Takes the next plan id; first writes a new reservation to the state file when the
+  /// reserved ids run out. Caller holds mutex_.
+  int64_t take_plan_id_locked();
+  /// Loads options.state_file, if it exists, into the plan ids and the LCM obstacles.
+  void restore_state();
+  /// Writes the state file (no-op without one); a failure is logged as an error. Caller holds
+  /// mutex_.
+  void save_state_locked();
   /// The wall clock (epoch, µs): the heartbeat's, and the plans' while no state has arrived.
   static int64_t wall_utime();
   /// The plans' clock: the latest measured state's utime, or the wall clock before any state
@@ -194,9 +229,16 @@ class PlannerNode {
   std::string foreign_daemon_;        // what the last foreign heartbeat said about its daemon
   int64_t foreign_logged_utime_ = 0;  // wall clock of the last log line about it
   int64_t next_plan_id_ = 1;
+  int64_t plan_ids_reserved_ = 1;  // ids below this are in the state file's reservation
+  // Copy of the LCM obstacles for the state file, taken by the worker after each change.
+  std::map<ObstacleKey, ObstacleUpdate> stored_obstacles_;
+  bool stored_obstacles_dirty_ = false;
+  std::chrono::steady_clock::time_point state_written_at_{};
+  // Set when run() ends: the worker's solver loops poll it (graph/cancellation.h).
+  std::atomic<bool> cancel_{false};
 
   // Owned by the worker thread.
-  std::map<std::string, collision::Obstacle> live_obstacles_;
+  std::map<ObstacleKey, collision::Obstacle> live_obstacles_;  // by (source, id)
   int next_obstacle_id_ = 0;
   std::optional<GoalRequest> current_goal_;
   planning::Replanner replanner_;

@@ -49,6 +49,7 @@ std::string overlong_name(const robot_state_t& msg) {
 }
 
 std::string overlong_name(const obstacle_list_t& msg) {
+  if (std::string r = check("obstacle_list_t.source", msg.source); !r.empty()) return r;
   for (std::size_t i = 0; i < msg.obstacles.size(); ++i) {
     std::string r =
         check("obstacle_list_t.obstacles[" + std::to_string(i) + "].id", msg.obstacles[i].id);

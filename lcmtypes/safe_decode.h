@@ -21,6 +21,7 @@
 #include "kinograph/goal_v2_t.hpp"
 #include "kinograph/joint_command_t.hpp"
 #include "kinograph/obstacle_list_t.hpp"
+#include "kinograph/obstacle_list_v1_t.hpp"
 #include "kinograph/obstacle_t.hpp"
 #include "kinograph/plan_t.hpp"
 #include "kinograph/plan_v1_t.hpp"
@@ -196,15 +197,22 @@ inline bool check_fields(WireReader& r, const obstacle_t*) {
 }
 constexpr int64_t kMinObstacleBytes = kMinStringBytes + 2 + 10 * 8;
 
-inline bool check_fields(WireReader& r, const obstacle_list_t*) {
+// obstacle_list_t (version 2) and obstacle_list_v1_t differ only by the source after utime.
+inline bool check_obstacle_list_fields(WireReader& r, bool has_source) {
   int64_t i64 = 0;
   int32_t n = 0;
-  if (!(r.read_i64(i64, "obstacle_list_t.utime") &&
-        r.count(n, kMinObstacleBytes, "obstacle_list_t.num_obstacles")))
-    return false;
+  if (!r.read_i64(i64, "obstacle_list_t.utime")) return false;
+  if (has_source && !r.string("obstacle_list_t.source")) return false;
+  if (!r.count(n, kMinObstacleBytes, "obstacle_list_t.num_obstacles")) return false;
   for (int32_t i = 0; i < n; ++i)
     if (!check_fields(r, static_cast<const obstacle_t*>(nullptr))) return false;
   return r.boolean("obstacle_list_t.replace_all");
+}
+inline bool check_fields(WireReader& r, const obstacle_list_t*) {
+  return check_obstacle_list_fields(r, /*has_source=*/true);
+}
+inline bool check_fields(WireReader& r, const obstacle_list_v1_t*) {
+  return check_obstacle_list_fields(r, /*has_source=*/false);
 }
 
 // plan_t (version 2) and plan_v1_t differ only by the four clock fields after `method`.

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <limits>
 
+#include "kinograph/graph/cancellation.h"
 #include "kinograph/graph/normal_equations.h"
 
 namespace kinograph::graph {
@@ -43,6 +44,7 @@ OptimizationResult GaussNewton::optimize(const FactorGraph& graph, Values& value
   std::string reason;
   Eigen::VectorXd step(eq.dim()), rhs(eq.dim()), x_backup;
   for (int it = 0; it < o.max_iterations; ++it) {
+    throw_if_cancelled();
     IterationStats stats;
     stats.iteration = it;
     auto t = Clock::now();

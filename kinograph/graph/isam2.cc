@@ -9,6 +9,7 @@
 #include <unordered_set>
 #include <utility>
 
+#include "kinograph/graph/cancellation.h"
 #include "kinograph/graph/ordering.h"
 
 namespace kinograph::graph {
@@ -57,10 +58,10 @@ bool dogleg_point(const Eigen::VectorXd& gn, double gn_norm, const Eigen::Vector
 
 /// What one update() works on, passed from step to step.
 struct ISAM2::UpdateWork {
-  bool gauss_newton = true;  // options_.step is Gauss–Newton
-  bool evaluate = false;     // the nonlinear error is evaluated (safeguard or Dogleg)
-  std::vector<int> marked;   // free variables whose cliques must be re-eliminated
-  std::vector<int> touched;  // of those, the ones on removed or added factors
+  bool gauss_newton = true;       // options_.step is Gauss–Newton
+  bool evaluate = false;          // the nonlinear error is evaluated (safeguard or Dogleg)
+  std::vector<int> marked;        // free variables whose cliques must be re-eliminated
+  std::vector<int> touched;       // of those, the ones on removed or added factors
   std::vector<int> to_linearize;  // factors to linearize at θ
   bool full = false;              // rebuild the whole tree
   std::vector<int> vars;          // variables of the affected top
@@ -214,8 +215,7 @@ bool ISAM2::linearize_fresh(const Factor& factor, LinearizedFactor& lf, double* 
 
 // lf.H = JᵀJ and lf.g = Jᵀr over the first `active` rows (those not all zero) and the free
 // columns; r is the residual in r_.
-void ISAM2::form_normal_equations(Eigen::Ref<Eigen::MatrixXd> J, int active,
-                                  LinearizedFactor& lf) {
+void ISAM2::form_normal_equations(Eigen::Ref<Eigen::MatrixXd> J, int active, LinearizedFactor& lf) {
   auto r = r_.head(J.rows());
   const int off = static_cast<int>(free_cols_.size());
   const auto Ja = J.topRows(active);
@@ -300,6 +300,7 @@ double ISAM2::total_error() const {
 ISAM2Result ISAM2::update(const std::vector<FactorPtr>& new_factors,
                           const std::vector<size_t>& removed_factor_indices,
                           const Values& new_values, const ISAM2UpdateOptions& update_options) {
+  throw_if_cancelled();  // before anything of this update is applied
   const auto t_start = Clock::now();
   ISAM2Result res;
   const int kept_before = jacobians_kept_;
@@ -581,8 +582,7 @@ void ISAM2::fail(ISAM2Result& res, ISAM2Status status, std::string reason) {
 
 // Factors eliminated into the new cliques (those with a free variable): every one after a full
 // re-elimination, else those the detached cliques held and the new ones.
-std::vector<int> ISAM2::factors_to_eliminate(const UpdateWork& work,
-                                             const ISAM2Result& res) const {
+std::vector<int> ISAM2::factors_to_eliminate(const UpdateWork& work, const ISAM2Result& res) const {
   std::vector<int> factors;
   if (work.full) {
     for (size_t f = 0; f < graph_.size(); ++f) {

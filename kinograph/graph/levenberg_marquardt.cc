@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 
+#include "kinograph/graph/cancellation.h"
 #include "kinograph/graph/normal_equations.h"
 
 namespace kinograph::graph {
@@ -52,9 +53,13 @@ void LevenbergMarquardt::set_options(const LevenbergMarquardtOptions& options) {
 
 OptimizationResult LevenbergMarquardt::optimize(const FactorGraph& graph, Values& values) {
   Solve s;
+  throw_if_cancelled();
   prepare(graph, values, s);
   bool ended = start(graph, values, s);
-  while (!ended) ended = run_trial(graph, values, s);
+  while (!ended) {
+    throw_if_cancelled();  // between trials `values` is the last accepted point
+    ended = run_trial(graph, values, s);
+  }
   return std::move(s.result);
 }
 

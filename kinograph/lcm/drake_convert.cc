@@ -1,12 +1,35 @@
 #include "kinograph/lcm/drake_convert.h"
 
-#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace kinograph::messages {
+
+std::string non_finite_iiwa_field(const drake::lcmt_iiwa_status& msg,
+                                  const dynamics::Model& model) {
+  // Every array, read or not: a driver sending NaN anywhere is not to be trusted for the rest.
+  const std::pair<const char*, const std::vector<double>*> fields[] = {
+      {"joint_position_measured", &msg.joint_position_measured},
+      {"joint_velocity_estimated", &msg.joint_velocity_estimated},
+      {"joint_position_commanded", &msg.joint_position_commanded},
+      {"joint_position_ipo", &msg.joint_position_ipo},
+      {"joint_torque_measured", &msg.joint_torque_measured},
+      {"joint_torque_commanded", &msg.joint_torque_commanded},
+      {"joint_torque_external", &msg.joint_torque_external}};
+  for (const auto& [field, values] : fields) {
+    for (std::size_t i = 0; i < values->size(); ++i) {
+      if (std::isfinite((*values)[i])) continue;
+      std::string joint =
+          i < model.bodies.size() ? " (joint " + model.bodies[i].joint_name + ")" : "";
+      return "lcmt_iiwa_status." + std::string(field) + "[" + std::to_string(i) + "]" + joint +
+             " is " + std::to_string((*values)[i]);
+    }
+  }
+  return {};
+}
 
 Check state_from_iiwa_status(const drake::lcmt_iiwa_status& msg, const dynamics::Model& model,
                              MeasuredState& out) {
@@ -15,13 +38,7 @@ Check state_from_iiwa_status(const drake::lcmt_iiwa_status& msg, const dynamics:
     return Check::fail("lcmt_iiwa_status.num_joints is " + std::to_string(msg.num_joints) +
                        ", robot " + model.name + " has " + std::to_string(n) + " joints");
   }
-  auto finite = [](const std::vector<double>& v) {
-    return std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); });
-  };
-  if (!finite(msg.joint_position_measured) || !finite(msg.joint_velocity_estimated)) {
-    return Check::fail(
-        "lcmt_iiwa_status.joint_position_measured or joint_velocity_estimated is not finite");
-  }
+  if (std::string bad = non_finite_iiwa_field(msg, model); !bad.empty()) return Check::fail(bad);
   MeasuredState state;
   state.utime = msg.utime;
   state.q = Eigen::Map<const Eigen::VectorXd>(msg.joint_position_measured.data(), n);

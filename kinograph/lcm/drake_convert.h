@@ -9,8 +9,14 @@
 
 namespace kinograph::messages {
 
-/// Checks a Drake iiwa status and reads it as the measured state: joint_position_measured and
-/// joint_velocity_estimated, in the model's joint order (the status names no joints).
+/// The first NaN or Inf in any of a Drake iiwa status's arrays, named with its index and the
+/// model's joint there ("lcmt_iiwa_status.joint_velocity_estimated[3] (joint iiwa_joint_4) is
+/// nan"), or empty when all are finite.
+std::string non_finite_iiwa_field(const drake::lcmt_iiwa_status& msg, const dynamics::Model& model);
+
+/// Checks a Drake iiwa status (joint count, non_finite_iiwa_field) and reads it as the measured
+/// state: joint_position_measured and joint_velocity_estimated, in the model's joint order (the
+/// status names no joints).
 Check state_from_iiwa_status(const drake::lcmt_iiwa_status& msg, const dynamics::Model& model,
                              MeasuredState& out);
 

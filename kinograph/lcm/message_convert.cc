@@ -195,6 +195,15 @@ planning::Goal goal_for_start(const GoalRequest& request, const Eigen::VectorXd&
   return goal;
 }
 
+obstacle_list_t obstacle_list_from_v1(const obstacle_list_v1_t& msg) {
+  obstacle_list_t out;
+  out.utime = msg.utime;
+  out.num_obstacles = msg.num_obstacles;
+  out.obstacles = msg.obstacles;
+  out.replace_all = msg.replace_all;
+  return out;
+}
+
 Check obstacles_from_message(const obstacle_list_t& msg, std::vector<ObstacleUpdate>& out) {
   if (msg.obstacles.size() > static_cast<size_t>(kMaxObstaclesPerMessage)) {
     return Check::fail("obstacle_list_t.num_obstacles is " + std::to_string(msg.obstacles.size()) +
@@ -208,6 +217,7 @@ Check obstacles_from_message(const obstacle_list_t& msg, std::vector<ObstacleUpd
     const std::string field = "obstacle_list_t.obstacles[" + std::to_string(i) + "]";
     if (o.id.empty()) return Check::fail(field + ".id is empty");
     ObstacleUpdate u;
+    u.source = msg.source;
     u.id = o.id;
     if (o.action == obstacle_t::REMOVE) {
       u.remove = true;

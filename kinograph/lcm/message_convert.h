@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "kinograph/collision/shape.h"
@@ -14,6 +15,7 @@
 #include "kinograph/goal_v2_t.hpp"
 #include "kinograph/joint_command_t.hpp"
 #include "kinograph/obstacle_list_t.hpp"
+#include "kinograph/obstacle_list_v1_t.hpp"
 #include "kinograph/plan_t.hpp"
 #include "kinograph/plan_v1_t.hpp"
 #include "kinograph/planning/plan.h"
@@ -52,6 +54,7 @@ struct GoalRequest {
 
 /// One obstacle change from an obstacle_list_t.
 struct ObstacleUpdate {
+  std::string source;  ///< the list's source ("" from version-1 senders); ids are per source
   std::string id;
   bool remove = false;
   collision::Shape shape;
@@ -92,9 +95,16 @@ planning::Goal goal_for_start(const GoalRequest& request, const Eigen::VectorXd&
 /// Most obstacle changes one obstacle_list_t may carry.
 inline constexpr int kMaxObstaclesPerMessage = 256;
 
-/// Checks an obstacle_list_t and converts it; on failure nothing is converted. Refuses more
-/// than kMaxObstaclesPerMessage entries (before converting any) and any shape or position
-/// outside the collision engine's faithful range (collision/shape.h), naming the obstacle.
+/// An obstacle (or its removal) is named by its source and its id within the source.
+using ObstacleKey = std::pair<std::string, std::string>;
+
+/// A version-1 obstacle list as version 2: the same updates from the unnamed source "".
+obstacle_list_t obstacle_list_from_v1(const obstacle_list_v1_t& msg);
+
+/// Checks an obstacle_list_t and converts it, each update carrying the list's source; on failure
+/// nothing is converted. Refuses more than kMaxObstaclesPerMessage entries (before converting any)
+/// and any shape or position outside the collision engine's faithful range (collision/shape.h),
+/// naming the obstacle.
 Check obstacles_from_message(const obstacle_list_t& msg, std::vector<ObstacleUpdate>& out);
 
 /// Checks a robot_state_t and converts it to model order. Its joints may come in any order,

@@ -3,10 +3,12 @@
 // daemon's heartbeat accounts for every goal. Used by the storm and burst tests in
 // tests/daemon/*.sh.
 //   goal_storm --url URL --prefix RR --goals N [--rate HZ] [--obstacle-rate HZ] [--q 0.8,-0.4]
-//              [--first-id 1] [--answer-timeout S] [--json FILE]
+//              [--first-id 1] [--answer-timeout S] [--json FILE] [--newest plan|cancelled]
+//              [--state-rate HZ --state-q q,... --state-joints name,...]
 // --rate 0 sends the goals back to back. After the last goal it prints "sent N goals" (the
 // burst test's cue to resume a stopped daemon) and waits for the answers. Exit 0 when all is
-// well, 1 with the reasons on stderr otherwise.
+// well, 1 with the reasons on stderr otherwise. --newest cancelled: the newest goal must be
+// answered CANCELLED (the daemon is stopped while it is pending), not by a valid plan.
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <atomic>
@@ -28,6 +30,7 @@
 #include "kinograph/obstacle_list_t.hpp"
 #include "kinograph/plan_t.hpp"
 #include "kinograph/planner_status_t.hpp"
+#include "kinograph/robot_state_t.hpp"
 #include "lcmtypes/safe_decode.h"
 
 namespace {
@@ -141,16 +144,25 @@ int main(int argc, char** argv) {
   CLI::App app{"goal_storm: floods a kinographd with goals and checks every one is answered"};
   std::string url, prefix = "RR", q_text = "0.8,-0.4", json_path, heartbeat_text;
   int64_t goals = 40, first_id = 1;
-  double rate = 0, obstacle_rate = 0, answer_timeout = 60;
+  double rate = 0, obstacle_rate = 0, state_rate = 0, answer_timeout = 60;
+  std::string state_q_text;
   app.add_option("--url", url, "LCM URL")->required();
   app.add_option("--prefix", prefix, "daemon channel prefix");
   app.add_option("--goals", goals, "number of goals")->check(CLI::PositiveNumber);
   app.add_option("--rate", rate, "goals per second (0: back to back)");
   app.add_option("--obstacle-rate", obstacle_rate, "obstacle moves per second (0: none)");
+  app.add_option("--state-rate", state_rate,
+                 "measured states per second, at --state-q on the wall clock (0: none)");
+  app.add_option("--state-q", state_q_text, "joint positions of the measured states");
+  std::string state_names_text;
+  app.add_option("--state-joints", state_names_text, "joint names of the measured states");
   app.add_option("--q", q_text, "base joint goal; goal i adds 0.05 (i mod 5) to joint 1");
   app.add_option("--first-id", first_id, "id of the first goal (then consecutive)");
   app.add_option("--answer-timeout", answer_timeout, "s to wait for answers after the last goal");
   app.add_option("--json", json_path, "write the figures as JSON here");
+  std::string newest = "plan";
+  app.add_option("--newest", newest, "how the newest goal must be answered")
+      ->check(CLI::IsMember({"plan", "cancelled"}));
   app.add_option("--heartbeat-text", heartbeat_text,
                  "also wait (30 s at most) for a heartbeat whose message contains this");
   CLI11_PARSE(app, argc, argv);
@@ -180,10 +192,36 @@ int main(int argc, char** argv) {
                                    : std::chrono::duration<double>(1e9);
   auto next_obstacle = start;
   int64_t obstacle_moves = 0;
+  const auto state_period = state_rate > 0 ? std::chrono::duration<double>(1.0 / state_rate)
+                                           : std::chrono::duration<double>(1e9);
+  auto next_state = start;
+  int64_t states_sent = 0;
+  kinograph::robot_state_t state{};
+  if (state_rate > 0) {
+    state.position = parse_list(state_q_text);
+    std::stringstream names(state_names_text);
+    for (std::string name; std::getline(names, name, ',');) state.joint_name.push_back(name);
+    state.num_joints = static_cast<int32_t>(state.joint_name.size());
+    state.velocity.assign(state.joint_name.size(), 0.0);
+  }
   for (int64_t i = 0; i < goals; ++i) {
     const auto due = start + std::chrono::duration_cast<Clock::duration>(goal_period * i);
-    while (obstacle_rate > 0 && next_obstacle <= due) {
-      std::this_thread::sleep_until(next_obstacle);
+    // States and obstacle moves stream between the goals, each when it is due.
+    while (true) {
+      const bool state_first =
+          state_rate > 0 && (obstacle_rate <= 0 || next_state <= next_obstacle);
+      const auto next = state_first ? next_state : next_obstacle;
+      if ((state_rate <= 0 && obstacle_rate <= 0) || next > due) break;
+      std::this_thread::sleep_until(next);
+      if (state_first) {
+        state.utime = std::chrono::duration_cast<std::chrono::microseconds>(
+                          std::chrono::system_clock::now().time_since_epoch())
+                          .count();
+        lcm.publish(prefix + "_STATE", &state);
+        ++states_sent;
+        next_state += std::chrono::duration_cast<Clock::duration>(state_period);
+        continue;
+      }
       kinograph::obstacle_list_t list{};
       kinograph::obstacle_t o{};
       o.id = "storm_ball";
@@ -241,7 +279,12 @@ int main(int argc, char** argv) {
   const auto last = answers.last_answer_.find(last_id);
   const bool last_valid = last != answers.last_answer_.end() &&
                           last->second.status == kinograph::plan_t::SUCCESS && last->second.valid;
-  if (!last_valid) problems.push_back("the newest goal has no valid plan");
+  const bool last_cancelled =
+      last != answers.last_answer_.end() && last->second.status == kinograph::plan_t::CANCELLED;
+  if (newest == "plan" && !last_valid) problems.push_back("the newest goal has no valid plan");
+  if (newest == "cancelled" && !last_cancelled) {
+    problems.push_back("the newest goal was not answered CANCELLED");
+  }
   if (answers.answered_after_refusal_ > 0) {
     problems.push_back(std::to_string(answers.answered_after_refusal_) +
                        " goals planned after they were answered superseded or refused");
@@ -257,11 +300,13 @@ int main(int argc, char** argv) {
   std::ostringstream json;
   json << "{\"goals\": " << goals << ", \"goal_rate_hz\": " << rate
        << ", \"obstacle_rate_hz\": " << obstacle_rate << ", \"obstacle_moves\": " << obstacle_moves
-       << ", \"send_s\": " << send_s << ", \"answered\": " << answered
+       << ", \"states_sent\": " << states_sent << ", \"send_s\": " << send_s
+       << ", \"answered\": " << answered
        << ", \"planned\": " << by_status[kinograph::plan_t::SUCCESS]
-       << ", \"superseded\": " << by_status[kinograph::plan_t::SUPERSEDED] << ", \"other_status\": "
+       << ", \"superseded\": " << by_status[kinograph::plan_t::SUPERSEDED]
+       << ", \"cancelled\": " << by_status[kinograph::plan_t::CANCELLED] << ", \"other_status\": "
        << answered - by_status[kinograph::plan_t::SUCCESS] -
-              by_status[kinograph::plan_t::SUPERSEDED]
+              by_status[kinograph::plan_t::SUPERSEDED] - by_status[kinograph::plan_t::CANCELLED]
        << ", \"last_goal_valid\": " << (last_valid ? "true" : "false")
        << ", \"answer_latency_ms_p50\": " << percentile(answers.latencies_ms_, 0.5)
        << ", \"answer_latency_ms_p99\": " << percentile(answers.latencies_ms_, 0.99)

@@ -1,8 +1,12 @@
 // The daemon's intake: coalescing keeps the newest goal and lists every one it replaced, a
-// replace_all discards older obstacle changes, and goal-id gaps are found (and only real ones).
+// replace_all discards older obstacle changes of its source, and goal-id gaps are found (and only
+// real ones).
 #include "daemon/intake.h"
 
 #include <gtest/gtest.h>
+
+#include <set>
+#include <string>
 
 namespace kinograph::daemon {
 namespace {
@@ -14,11 +18,12 @@ Intake goal(int64_t id) {
   return in;
 }
 
-Intake obstacle(const std::string& id, bool replace_all = false) {
+Intake obstacle(const std::string& id, bool replace_all = false, const std::string& source = "") {
   Intake in;
   in.obstacles.emplace_back();
+  in.obstacles.back().source = source;
   in.obstacles.back().id = id;
-  in.replace_all = replace_all;
+  if (replace_all) in.replaced_sources.insert(source);
   return in;
 }
 
@@ -40,13 +45,29 @@ TEST(Intake, ObstacleChangesKeepTheirOrderAndReplaceAllStartsOver) {
   held.absorb(obstacle("b"));
   ASSERT_EQ(held.obstacles.size(), 2u);
   EXPECT_EQ(held.obstacles[1].id, "b");
-  EXPECT_FALSE(held.replace_all);
+  EXPECT_TRUE(held.replaced_sources.empty());
   held.absorb(obstacle("c", /*replace_all=*/true));
   held.absorb(obstacle("d"));
   ASSERT_EQ(held.obstacles.size(), 2u);
   EXPECT_EQ(held.obstacles[0].id, "c");
   EXPECT_EQ(held.obstacles[1].id, "d");
-  EXPECT_TRUE(held.replace_all);
+  EXPECT_EQ(held.replaced_sources, (std::set<std::string>{""}));
+}
+
+// A replace_all starts over only its own source's changes.
+TEST(Intake, AReplaceAllDiscardsOnlyItsSourcesChanges) {
+  Intake held = obstacle("a", false, "perception");
+  held.absorb(obstacle("b", false, "operator"));
+  held.absorb(obstacle("c", /*replace_all=*/true, "operator"));
+  ASSERT_EQ(held.obstacles.size(), 2u);
+  EXPECT_EQ(held.obstacles[0].id, "a");
+  EXPECT_EQ(held.obstacles[0].source, "perception");
+  EXPECT_EQ(held.obstacles[1].id, "c");
+  EXPECT_EQ(held.replaced_sources, (std::set<std::string>{"operator"}));
+  EXPECT_FALSE(held.empty());
+  Intake only_replace;
+  only_replace.replaced_sources.insert("perception");
+  EXPECT_FALSE(only_replace.empty());
 }
 
 TEST(Intake, TheNewestStateIsKeptAndAllAreCounted) {

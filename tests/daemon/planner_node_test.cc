@@ -4,18 +4,23 @@
 #include "daemon/planner_node.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
+#include <cstdio>
+#include <fstream>
 #include <lcm/lcm-cpp.hpp>
 #include <mutex>
 #include <optional>
 #include <set>
 #include <thread>
 
+#include "daemon/state_file.h"
+#include "drake/lcmt_iiwa_status.hpp"
 #include "kinograph/dynamics/data.h"
 #include "kinograph/dynamics/kinematics.h"
 #include "kinograph/planner_status_t.hpp"
@@ -148,8 +153,10 @@ class NodeFixture : public ::testing::Test {
   }
 
   void send_obstacle(const std::string& id, int8_t action, double radius,
-                     const Eigen::Vector3d& position, bool replace_all = false) {
+                     const Eigen::Vector3d& position, bool replace_all = false,
+                     const std::string& source = "") {
     obstacle_list_t list{};
+    list.source = source;
     obstacle_t o{};
     o.id = id;
     o.action = action;
@@ -456,6 +463,129 @@ TEST_F(StateAgeFixture, TheStateAgeBoundIsTheOptionsOne) {
   ASSERT_EQ(plans.size(), 1u);
   EXPECT_EQ(plans[0].status, plan_t::SUCCESS) << plans[0].status_message;
   EXPECT_EQ(plans[0].start_utime, 5'000'000);
+}
+
+// Drake's iiwa status names no robot: one with NaN is refused as malformed, naming the field
+// and joint, and dropped as if lost; the usable status before it is still the start.
+TEST_F(StateAgeFixture, ANonFiniteIiwaStatusIsRefusedAsMalformed) {
+  PlannerNodeOptions options;
+  options.iiwa_status_channel = "RR_IIWA_STATUS";
+  start(default_scene(), options);
+  const auto status = [&](int64_t utime, double q1) {
+    drake::lcmt_iiwa_status m;
+    m.utime = utime;
+    m.num_joints = 2;
+    for (auto* v : {&m.joint_position_measured, &m.joint_velocity_estimated,
+                    &m.joint_position_commanded, &m.joint_position_ipo, &m.joint_torque_measured,
+                    &m.joint_torque_commanded, &m.joint_torque_external}) {
+      v->assign(2, 0.0);
+    }
+    m.joint_position_measured = {-0.8, q1};
+    lcm_.publish("RR_IIWA_STATUS", &m);
+  };
+  status(5'000'000, 0.4);
+  status(5'050'000, std::nan(""));
+  ASSERT_TRUE(listener_->wait_status_containing(
+      "RR_IIWA_STATUS: malformed lcmt_iiwa_status.joint_position_measured[1] (joint joint2) is "
+      "nan"));
+  send_goal(26, {0.9, -0.5}, 5'100'000);
+  const auto plans = listener_->wait_plans(1);
+  ASSERT_EQ(plans.size(), 1u);
+  EXPECT_EQ(plans[0].status, plan_t::SUCCESS) << plans[0].status_message;
+  EXPECT_EQ(plans[0].start_utime, 5'000'000);
+  EXPECT_EQ(node_->counters().messages_rejected, 1);
+  EXPECT_EQ(node_->counters().states_refused, 0);
+}
+
+// A restarted node with the same --state-file continues the plan ids and still knows the
+// obstacle received over LCM before the restart; without one it says the world was forgotten.
+TEST_F(StateAgeFixture, AStateFileKeepsPlanIdsAndObstaclesAcrossARestart) {
+  const std::string path =
+      ::testing::TempDir() + "kinograph_restart_" + std::to_string(::getpid()) + ".state";
+  std::remove(path.c_str());
+  PlannerNodeOptions options;
+  options.state_file = path;
+  start(default_scene(), options);
+  send_goal(1, {0.8, -0.4});
+  auto plans = listener_->wait_plans(1);
+  ASSERT_EQ(plans.size(), 1u);
+  EXPECT_EQ(plans[0].plan_id, 1);
+  EXPECT_GT(plans[0].min_clearance, 0.5);                                  // nothing near the arm
+  send_obstacle("ball", obstacle_t::ADD_OR_MOVE, 0.05, {0.0, 0.0, 1.85});  // in its way
+  plans = listener_->wait_plans(2);
+  ASSERT_EQ(plans.size(), 2u);
+  EXPECT_EQ(plans[1].plan_id, 2);
+
+  // Restart: a new node on the same file (the listener stays subscribed).
+  stop_ = true;
+  thread_.join();
+  node_.reset();
+  stop_ = false;
+  options.channel_prefix = "RR";
+  options.status_period_s = 0.2;
+  node_ = std::make_unique<PlannerNode>(default_scene(), options, &lcm_);
+  run();
+  send_goal(1, {0.8, -0.4});  // a restarted sender numbers from 1 again
+  plans = listener_->wait_plans(3);
+  ASSERT_EQ(plans.size(), 3u);
+  EXPECT_EQ(plans[2].plan_id, 3);
+  EXPECT_EQ(plans[2].status, plan_t::SUCCESS) << plans[2].status_message;
+  EXPECT_LT(plans[2].min_clearance, 0.5) << "the ball was forgotten";
+  EXPECT_GE(plans[2].min_clearance, 0.0);
+  std::remove(path.c_str());
+}
+
+// A corrupt state file stops the node from starting, naming the file.
+TEST_F(StateAgeFixture, ACorruptStateFileIsRefused) {
+  const std::string path =
+      ::testing::TempDir() + "kinograph_corrupt_" + std::to_string(::getpid()) + ".state";
+  std::ofstream(path) << "{\"format\": \"kinographd state\", \"version\": 1,";
+  PlannerNodeOptions options;
+  options.state_file = path;
+  try {
+    PlannerNode node(default_scene(), options, &lcm_);
+    FAIL() << "a corrupt state file was taken";
+  } catch (const StateFileError& e) {
+    EXPECT_NE(std::string(e.what()).find("state file '" + path + "': is not valid JSON"),
+              std::string::npos)
+        << e.what();
+  }
+  std::remove(path.c_str());
+}
+
+// Obstacles are per source: another source's replace_all (here a version-1 sender's, the
+// unnamed source) leaves perception's ball in the world; perception's own removes it.
+TEST_F(NodeFixture, AReplaceAllReplacesOnlyItsSourcesObstacles) {
+  send_goal(1, {0.8, -0.4});
+  auto plans = listener_->wait_plans(1);
+  ASSERT_EQ(plans.size(), 1u);
+  EXPECT_GT(plans[0].min_clearance, 0.5);
+  send_obstacle("ball", obstacle_t::ADD_OR_MOVE, 0.05, {0.0, 0.0, 1.85}, false, "perception");
+  plans = listener_->wait_plans(2);  // the replan around the ball
+  ASSERT_EQ(plans.size(), 2u);
+  EXPECT_LT(plans[1].min_clearance, 0.5);
+
+  kinograph::obstacle_list_v1_t wipe{};  // an old sender's empty replace_all
+  wipe.replace_all = true;
+  lcm_.publish("RR_OBSTACLES", &wipe);
+  // The same id from the operator is another obstacle, far away.
+  send_obstacle("ball", obstacle_t::ADD_OR_MOVE, 0.05, {0.0, 3.0, 0.0}, true, "operator");
+  plans = listener_->wait_plans(3);  // the operator's ball is a change: one replan
+  ASSERT_EQ(plans.size(), 3u);
+  EXPECT_LT(plans[2].min_clearance, 0.5) << "perception's ball was wiped by another source";
+  send_goal(2, {0.8, -0.4});
+  plans = listener_->wait_plans(4);
+  ASSERT_EQ(plans.size(), 4u);
+  EXPECT_LT(plans[3].min_clearance, 0.5);
+
+  obstacle_list_t own{};
+  own.source = "perception";
+  own.replace_all = true;
+  lcm_.publish("RR_OBSTACLES", &own);
+  plans = listener_->wait_plans(5);
+  ASSERT_EQ(plans.size(), 5u);
+  EXPECT_GT(plans[4].min_clearance, 0.5) << "perception's own replace_all kept its ball";
+  EXPECT_EQ(node_->counters().messages_rejected, 0);
 }
 
 TEST_F(NodeFixture, MalformedBytesGetAStatusAndTheNodeKeepsServing) {

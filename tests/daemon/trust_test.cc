@@ -94,6 +94,10 @@ TEST(WireStrings, OverlongNamesAreRefusedWithTheirFieldAndLength) {
   list.obstacles[1].id = std::string(257, 'o');
   EXPECT_NE(overlong_name(list).find("obstacle_list_t.obstacles[1].id is 257 bytes long"),
             std::string::npos);
+  list.obstacles[1].id = "ball";
+  list.source = std::string(300, 's');
+  EXPECT_NE(overlong_name(list).find("obstacle_list_t.source is 300 bytes long"),
+            std::string::npos);
 }
 
 TEST(LogLimiter, AtMostNLinesPerWindowThenOneSummary) {

@@ -22,11 +22,30 @@ wait_for_line() {
   return 1
 }
 
-# Starts kinographd on scene $1, URL $2, logging to $3, and waits until it is subscribed.
-# Sets DAEMON to its pid.
+# Starts kinographd on scene $1, URL $2, logging to $3 (further arguments are the daemon's),
+# and waits until it is subscribed. Sets DAEMON to its pid.
 start_daemon() {
-  "$KGD" "$1" --prefix RR --lcm-url "$2" --status-period 0.2 >"$3" 2>&1 &
+  "$KGD" "$1" --prefix RR --lcm-url "$2" --status-period 0.2 "${@:4}" >"$3" 2>&1 &
   DAEMON=$!
   PIDS+=($DAEMON)
   wait_for_line "$3" "on channels RR_" || fail "daemon did not start"
+}
+
+# Waits (bounded, 60 s) for process $1, a child of this shell, to exit; sets EXIT_CODE. A
+# process still running then is killed and the test fails. It polls /proc (every 10 ms) for
+# the child to end or turn zombie rather than using `wait -n`, which in bash 5.2 can lose the
+# status of another child ("wait_for: No record of process").
+wait_exit() {
+  local i state
+  for i in $(seq 6000); do
+    state=$(awk '{print $3}' "/proc/$1/stat" 2>/dev/null || true)
+    [ -n "$state" ] && [ "$state" != Z ] || break
+    sleep 0.01
+  done
+  if [ -n "$state" ] && [ "$state" != Z ]; then
+    kill -KILL "$1" 2>/dev/null || true
+    fail "process $1 did not exit within 60 s"
+  fi
+  EXIT_CODE=0
+  wait "$1" || EXIT_CODE=$?
 }

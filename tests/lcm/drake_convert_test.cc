@@ -61,7 +61,19 @@ TEST(IiwaStatus, ANonFiniteMeasurementIsRefused) {
   MeasuredState state;
   const Check c = state_from_iiwa_status(m, iiwa(), state);
   EXPECT_FALSE(c.ok);
-  EXPECT_NE(c.reason.find("not finite"), std::string::npos) << c.reason;
+  EXPECT_NE(
+      c.reason.find("lcmt_iiwa_status.joint_velocity_estimated[3] (joint iiwa_joint_4) is nan"),
+      std::string::npos)
+      << c.reason;
+}
+
+// Arrays the daemon does not read are checked too, and Inf as NaN.
+TEST(IiwaStatus, ANonFiniteTorqueIsNamed) {
+  drake::lcmt_iiwa_status m = status(7);
+  m.joint_torque_external[6] = -std::numeric_limits<double>::infinity();
+  EXPECT_EQ(non_finite_iiwa_field(m, iiwa()),
+            "lcmt_iiwa_status.joint_torque_external[6] (joint iiwa_joint_7) is -inf");
+  EXPECT_EQ(non_finite_iiwa_field(status(7), iiwa()), "");
 }
 
 plan_t three_knot_plan() {

@@ -103,6 +103,33 @@ obstacle_t box(const std::string& id) {
   return o;
 }
 
+// Every update carries its list's source; a version-1 list is the unnamed source's.
+TEST(ObstaclesFromMessage, UpdatesCarryTheSourceAndVersionOneIsUnnamed) {
+  obstacle_list_t msg{};
+  msg.source = "perception";
+  msg.obstacles = {box("a"), box("b")};
+  msg.num_obstacles = 2;
+  std::vector<ObstacleUpdate> out;
+  ASSERT_TRUE(obstacles_from_message(msg, out).ok);
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_EQ(out[0].source, "perception");
+  EXPECT_EQ(out[1].source, "perception");
+
+  kinograph::obstacle_list_v1_t v1{};
+  v1.utime = 9;
+  v1.obstacles = {box("c")};
+  v1.num_obstacles = 1;
+  v1.replace_all = true;
+  const obstacle_list_t up = obstacle_list_from_v1(v1);
+  EXPECT_EQ(up.utime, 9);
+  EXPECT_EQ(up.source, "");
+  EXPECT_TRUE(up.replace_all);
+  ASSERT_EQ(up.obstacles.size(), 1u);
+  EXPECT_EQ(up.obstacles[0].id, "c");
+  ASSERT_TRUE(obstacles_from_message(up, out).ok);
+  EXPECT_EQ(out[0].source, "");
+}
+
 TEST(ObstaclesFromMessage, ConvertsAndRejectsBadShapes) {
   obstacle_list_t msg{};
   msg.obstacles = {box("a"), box("b")};

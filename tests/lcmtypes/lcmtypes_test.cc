@@ -149,11 +149,15 @@ TEST(LcmTypes, TruncatedBuffersAreRejected) {
 
 // The fingerprint at the head of each message keeps one type from being read as another.
 TEST(LcmTypes, FingerprintsDifferAndMismatchIsRejected) {
-  const std::vector<int64_t> hashes = {
-      robot_state_t::getHash(),    goal_t::getHash(),
-      obstacle_t::getHash(),       obstacle_list_t::getHash(),
-      plan_t::getHash(),           kinograph::plan_v1_t::getHash(),
-      planner_status_t::getHash(), kinograph::joint_command_t::getHash()};
+  const std::vector<int64_t> hashes = {robot_state_t::getHash(),
+                                       goal_t::getHash(),
+                                       obstacle_t::getHash(),
+                                       obstacle_list_t::getHash(),
+                                       plan_t::getHash(),
+                                       kinograph::plan_v1_t::getHash(),
+                                       planner_status_t::getHash(),
+                                       kinograph::joint_command_t::getHash(),
+                                       kinograph::obstacle_list_v1_t::getHash()};
   for (size_t i = 0; i < hashes.size(); ++i)
     for (size_t j = i + 1; j < hashes.size(); ++j) EXPECT_NE(hashes[i], hashes[j]);
 

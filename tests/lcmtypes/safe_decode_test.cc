@@ -59,6 +59,7 @@ TEST(SafeDecode, AcceptsWellFormedMessagesOfEveryType) {
   expect_accepts(make_goal_v2());
   expect_accepts(make_obstacle("o", obstacle_t::CYLINDER));
   expect_accepts(make_obstacle_list());
+  expect_accepts(make_obstacle_list_v1());
   expect_accepts(make_plan(6));
   expect_accepts(make_plan(0));
   expect_accepts(make_plan_v1(6));
@@ -86,6 +87,7 @@ TEST(SafeDecode, RejectsEveryTruncation) {
   expect_prefixes_rejected(make_goal());
   expect_prefixes_rejected(make_goal_v2());
   expect_prefixes_rejected(make_obstacle_list());
+  expect_prefixes_rejected(make_obstacle_list_v1());
   expect_prefixes_rejected(make_plan(3));
   expect_prefixes_rejected(make_plan_v1(3));
   expect_prefixes_rejected(make_planner_status());
@@ -116,6 +118,17 @@ TEST(SafeDecode, TellsThePlanVersionsApart) {
   EXPECT_NE(as_v2.reason.find("fingerprint"), std::string::npos) << as_v2.reason;
   EXPECT_FALSE(decode_bytes(encode(make_plan(2)), v1).ok);
   EXPECT_TRUE(decode_bytes(encode(make_plan_v1(2)), v1).ok);
+}
+
+// So have the two versions of obstacle_list_t.
+TEST(SafeDecode, TellsTheObstacleListVersionsApart) {
+  obstacle_list_t v2;
+  kinograph::obstacle_list_v1_t v1;
+  const DecodeStatus as_v2 = decode_bytes(encode(make_obstacle_list_v1()), v2);
+  EXPECT_FALSE(as_v2.ok);
+  EXPECT_NE(as_v2.reason.find("fingerprint"), std::string::npos) << as_v2.reason;
+  EXPECT_FALSE(decode_bytes(encode(make_obstacle_list()), v1).ok);
+  EXPECT_TRUE(decode_bytes(encode(make_obstacle_list_v1()), v1).ok);
 }
 
 // Drake's lcmt_robot_state counts joints in an int16: a negative count is refused by name.

@@ -11,6 +11,7 @@
 #include "kinograph/goal_v2_t.hpp"
 #include "kinograph/joint_command_t.hpp"
 #include "kinograph/obstacle_list_t.hpp"
+#include "kinograph/obstacle_list_v1_t.hpp"
 #include "kinograph/obstacle_t.hpp"
 #include "kinograph/plan_t.hpp"
 #include "kinograph/plan_v1_t.hpp"
@@ -125,12 +126,24 @@ inline obstacle_t make_obstacle(const std::string& id, int8_t shape) {
 inline obstacle_list_t make_obstacle_list() {
   obstacle_list_t m;
   m.utime = 7;
+  m.source = "perception";
   m.obstacles = {make_obstacle("table", obstacle_t::BOX), make_obstacle("ball", obstacle_t::SPHERE),
                  make_obstacle("pole", obstacle_t::CYLINDER),
                  make_obstacle("arm", obstacle_t::CAPSULE)};
   m.obstacles[1].action = obstacle_t::REMOVE;
   m.num_obstacles = static_cast<int32_t>(m.obstacles.size());
   m.replace_all = true;
+  return m;
+}
+
+// The same updates as version 1 (no source).
+inline kinograph::obstacle_list_v1_t make_obstacle_list_v1() {
+  const obstacle_list_t v2 = make_obstacle_list();
+  kinograph::obstacle_list_v1_t m;
+  m.utime = v2.utime;
+  m.num_obstacles = v2.num_obstacles;
+  m.obstacles = v2.obstacles;
+  m.replace_all = v2.replace_all;
   return m;
 }
 
