@@ -46,6 +46,11 @@ struct Objectives {
   /// Number of interpolated states checked for collision between consecutive steps by the
   /// planner's collision factors (0 = only at the steps).
   int collision_substeps = 1;
+  /// Number of interior points per interval (evenly spaced) where the planner enforces the
+  /// effort, q and q̇ limits on the interpolant, raised to one per RK4 node of the interpolant
+  /// (limit_points in interpolant.h); 0 = only at the knots. The default matches the
+  /// validator's 10 samples per interval.
+  int limit_substeps = 9;
 };
 
 /// A kinodynamic planning problem: move from (start_q, start_qd) to the goal in `horizon`

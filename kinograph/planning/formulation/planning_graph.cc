@@ -1,5 +1,6 @@
 #include "kinograph/planning/formulation/planning_graph.h"
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <stdexcept>
@@ -7,6 +8,7 @@
 
 #include "kinograph/dynamics/inverse_dynamics.h"
 #include "kinograph/planning/factors/dynamics_factors.h"
+#include "kinograph/planning/factors/interval_factors.h"
 #include "kinograph/planning/factors/pose_factors.h"
 #include "kinograph/planning/factors/state_target_factor.h"
 #include "kinograph/planning/factors/trajectory_factors.h"
@@ -131,14 +133,33 @@ FactorEntry make_soft_entry(graph::FactorPtr soft_factor, FactorKey key) {
 
 std::vector<FactorEntry> timing_entries(const Problem& problem, const GraphOptions& options) {
   std::vector<FactorEntry> out;
-  const int n = problem.model->nq();
+  const dynamics::Model& model = *problem.model;
+  const int n = model.nq();
   const double dt = problem.dt();
+  std::vector<int> actuated;
+  for (int j = 0; j < n; ++j) {
+    if (model.bodies[j].actuated) actuated.push_back(j);
+  }
+  IntervalDynamicsOptions between;
+  between.checks = limit_points(problem.objectives.limit_substeps, dt);
+  between.limit_epsilon = problem.objectives.limit_epsilon;
+  between.defect_scale = options.collocation_scale;
+  between.torque_scale = options.torque_scale;
+  between.limit_scale = options.limit_scale;
+  const bool has_between = !IntervalDynamicsFactor::layout(model, between).empty();
   for (int k = 0; k < problem.steps; ++k) {
     out.push_back(make_soft_entry(std::make_shared<GpPriorFactor>(k, n, dt, problem.objectives.qc),
-                             {FactorRole::kGpPrior, k}));
-    out.push_back(make_entry(
-        std::make_shared<CollocationFactor>(k, n, dt, options.collocation_scale),
-        {FactorRole::kCollocation, k}));
+                                  {FactorRole::kGpPrior, k}));
+    if (!actuated.empty()) {
+      out.push_back(make_entry(
+          std::make_shared<CollocationFactor>(k, n, dt, options.collocation_scale, actuated),
+          {FactorRole::kCollocation, k}));
+    }
+    if (has_between) {
+      out.push_back(make_entry(
+          std::make_shared<IntervalDynamicsFactor>(k, dt, problem.model, between),
+          {FactorRole::kInterval, k}));
+    }
   }
   return out;
 }

@@ -36,7 +36,8 @@ enum class FactorRole {
   kStart,        ///< prior on (q_0, q̇_0) (incremental form; the batch form fixes them)
   kGoal,         ///< joint goal on q_N (incremental form) or pose goal (both forms)
   kGpPrior,      ///< GP prior of interval k (depends on Δt)
-  kCollocation,  ///< collocation of interval k (depends on Δt)
+  kCollocation,  ///< collocation of interval k's actuated joints (depends on Δt)
+  kInterval,     ///< interval k's dynamics between the knots: shooting defect, interior limits
   kLimits,       ///< q, q̇, q̈ limits of state k
   kDynamics,     ///< equations of motion and torque rows of state k
   kCollision,    ///< hinges of state k (sub-step s) against one obstacle or all of them
@@ -60,7 +61,7 @@ struct FactorKey {
   /// Whether the factor depends on the time step Δt (replaced when the horizon changes).
   bool depends_on_dt() const {
     return role == FactorRole::kGpPrior || role == FactorRole::kCollocation ||
-           role == FactorRole::kCollision;
+           role == FactorRole::kInterval || role == FactorRole::kCollision;
   }
 };
 
@@ -116,7 +117,8 @@ PlanningGraph build_graph(const Problem& problem, const Trajectory& init,
 FactorEntry make_entry(std::shared_ptr<ConstrainedFactor> factor, FactorKey key);
 FactorEntry make_soft_entry(graph::FactorPtr soft_factor, FactorKey key);
 
-/// The GP prior and collocation of every interval for the problem's Δt, interval by interval.
+/// The GP prior, collocation and between-knot dynamics of every interval for the problem's Δt,
+/// interval by interval.
 std::vector<FactorEntry> timing_entries(const Problem& problem, const GraphOptions& options);
 /// The collision hinges of every free state and sub-step against the obstacles of `context`,
 /// keyed by `obstacle` (an id, or −1 for a context of all obstacles).

@@ -1,0 +1,199 @@
+#include "kinograph/planning/interpolant.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "kinograph/dynamics/inverse_dynamics.h"
+
+namespace kinograph::planning {
+
+int integration_steps(double dt) {
+  // The small allowance keeps Δt = 0.1 s at 10 steps despite rounding in Δt = horizon/steps.
+  return std::max(1, static_cast<int>(std::ceil(dt / kMaxIntegrationStep - 1e-9)));
+}
+
+int limit_points(int requested, double dt) {
+  if (requested <= 0) return 0;
+  return std::max(requested, integration_steps(dt) - 1);
+}
+
+IntervalInterpolant::IntervalInterpolant(const dynamics::Model& model)
+    : model_(model), data_(model) {
+  for (int j = 0; j < model.nq(); ++j) {
+    (model.bodies[j].actuated ? actuated_ : unactuated_).push_back(j);
+  }
+  const int n = model.nq(), m = static_cast<int>(unactuated_.size());
+  tau0_.resize(n);
+  tau0u_.resize(m);
+  fu_.resize(m);
+  muu_.resize(m, m);
+  rhs_.resize(m, 4 * n);
+}
+
+void IntervalInterpolant::point(double s, const Eigen::VectorXd& y, const Eigen::MatrixXd& S,
+                                bool derivatives, bool with_tau, InterpolantPoint& p) {
+  const int n = model_.nq(), m = static_cast<int>(unactuated_.size());
+  const double h = dt_;
+  // Cubic with linear q̈: coefficients of (q_k, q̇_k, q̈_k, q̈_{k+1}) in q, q̇ and q̈ at s.
+  const double s2 = s * s, s3 = s2 * s;
+  const double cq[4] = {1, s, s2 / 2 - s3 / (6 * h), s3 / (6 * h)};
+  const double cv[4] = {0, 1, s - s2 / (2 * h), s2 / (2 * h)};
+  const double ca[4] = {0, 0, 1 - s / h, s / h};
+  p.s = s;
+  p.q = cq[0] * q0_ + cq[1] * qd0_ + cq[2] * qdd0_ + cq[3] * qdd1_;
+  p.qd = cv[1] * qd0_ + cv[2] * qdd0_ + cv[3] * qdd1_;
+  p.qdd = ca[2] * qdd0_ + ca[3] * qdd1_;
+  if (derivatives) {
+    p.dq.setZero(n, 4 * n);
+    p.dqd.setZero(n, 4 * n);
+    p.dqdd.setZero(n, 4 * n);
+    for (int j : actuated_) {
+      for (int b = 0; b < 4; ++b) {
+        p.dq(j, b * n + j) = cq[b];
+        p.dqd(j, b * n + j) = cv[b];
+        p.dqdd(j, b * n + j) = ca[b];
+      }
+    }
+  }
+  for (int i = 0; i < m; ++i) {
+    const int j = unactuated_[i];
+    p.q[j] = y[i];
+    p.qd[j] = y[m + i];
+    p.qdd[j] = 0;
+    if (derivatives) {
+      p.dq.row(j) = S.row(i);
+      p.dqd.row(j) = S.row(m + i);
+    }
+  }
+  if (m == 0) {
+    if (derivatives) {
+      dynamics::rnea_derivatives(model_, data_, p.q, p.qd, p.qdd);
+      if (with_tau) {
+        p.dtau.noalias() = data_.dtau_dq * p.dq;
+        p.dtau.noalias() += data_.dtau_dqd * p.dqd;
+        p.dtau.noalias() += data_.M * p.dqdd;
+      }
+    } else {
+      dynamics::rnea(model_, data_, p.q, p.qd, p.qdd);
+    }
+    p.tau = data_.tau;
+    return;
+  }
+  // τ_u(q̈_u) = τ0_u + M_uu q̈_u = 0 with τ0 the torques at q̈_u = 0.
+  dynamics::rnea(model_, data_, p.q, p.qd, p.qdd);
+  tau0_ = data_.tau;
+  dynamics::mass_matrix(model_, data_, p.q);
+  for (int a = 0; a < m; ++a) {
+    tau0u_[a] = tau0_[unactuated_[a]];
+    for (int b = 0; b < m; ++b) muu_(a, b) = data_.M(unactuated_[a], unactuated_[b]);
+  }
+  llt_.compute(muu_);
+  fu_ = -llt_.solve(tau0u_);
+  for (int i = 0; i < m; ++i) p.qdd[unactuated_[i]] = fu_[i];
+  if (!derivatives) {
+    if (with_tau) {
+      p.tau = tau0_;
+      for (int i = 0; i < m; ++i) p.tau += data_.M.col(unactuated_[i]) * fu_[i];
+    }
+    return;
+  }
+  dynamics::rnea_derivatives(model_, data_, p.q, p.qd, p.qdd);
+  p.tau = data_.tau;
+  // Implicit function τ_u(q, q̇, q̈_a, q̈_u) = 0: dq̈_u = −M_uu⁻¹(∂τ_u/∂q dq + ∂τ_u/∂q̇ dq̇ +
+  // M_ua dq̈_a), where dq̈ holds only the actuated rows so far.
+  for (int i = 0; i < m; ++i) {
+    const int u = unactuated_[i];
+    rhs_.row(i).noalias() = data_.dtau_dq.row(u) * p.dq;
+    rhs_.row(i).noalias() += data_.dtau_dqd.row(u) * p.dqd;
+    rhs_.row(i).noalias() += data_.M.row(u) * p.dqdd;
+  }
+  llt_.solveInPlace(rhs_);
+  for (int i = 0; i < m; ++i) p.dqdd.row(unactuated_[i]) = -rhs_.row(i);
+  if (with_tau) {
+    p.dtau.noalias() = data_.dtau_dq * p.dq;
+    p.dtau.noalias() += data_.dtau_dqd * p.dqd;
+    p.dtau.noalias() += data_.M * p.dqdd;
+  }
+}
+
+void IntervalInterpolant::rk4_step(double s, double len, const Eigen::VectorXd& y,
+                                   const Eigen::MatrixXd& S, bool derivatives, Eigen::VectorXd& y1,
+                                   Eigen::MatrixXd& S1) {
+  const int m = static_cast<int>(unactuated_.size());
+  // Forward-mode RK4: each stage's slope ẏ = [q̇_u; q̈_u] and its total derivative dẏ/dz.
+  const double c[4] = {0, 0.5, 0.5, 1};
+  for (int i = 0; i < 4; ++i) {
+    if (i == 0) {
+      ys_ = y;
+      if (derivatives) Ss_ = S;
+    } else {
+      ys_ = y + c[i] * len * k_[i - 1];
+      if (derivatives) Ss_ = S + c[i] * len * dk_[i - 1];
+    }
+    point(s + c[i] * len, ys_, Ss_, derivatives, false, stage_);
+    k_[i].resize(2 * m);
+    k_[i] << stage_.qd(unactuated_), stage_.qdd(unactuated_);
+    if (derivatives) {
+      dk_[i].resize(2 * m, stage_.dq.cols());
+      dk_[i] << stage_.dqd(unactuated_, Eigen::all),
+          stage_.dqdd(unactuated_, Eigen::all);
+    }
+  }
+  y1 = y + len / 6 * (k_[0] + 2 * k_[1] + 2 * k_[2] + k_[3]);
+  if (derivatives) S1 = S + len / 6 * (dk_[0] + 2 * dk_[1] + 2 * dk_[2] + dk_[3]);
+}
+
+void IntervalInterpolant::evaluate(const Eigen::Ref<const Eigen::VectorXd>& q0,
+                                   const Eigen::Ref<const Eigen::VectorXd>& qd0,
+                                   const Eigen::Ref<const Eigen::VectorXd>& qdd0,
+                                   const Eigen::Ref<const Eigen::VectorXd>& qdd1, double dt,
+                                   const std::vector<double>& s, bool derivatives,
+                                   std::vector<InterpolantPoint>& out) {
+  const int n = model_.nq(), m = static_cast<int>(unactuated_.size());
+  if (q0.size() != n || qd0.size() != n || qdd0.size() != n || qdd1.size() != n) {
+    throw std::invalid_argument("interpolant: knot vectors must have one entry per joint");
+  }
+  if (!(dt > 0)) throw std::invalid_argument("interpolant: the interval must have dt > 0");
+  q0_ = q0;
+  qd0_ = qd0;
+  qdd0_ = qdd0;
+  qdd1_ = qdd1;
+  dt_ = dt;
+  out.resize(s.size());
+  Eigen::VectorXd y(2 * m), y_next;
+  Eigen::MatrixXd S, S_next;
+  y << q0(unactuated_), qd0(unactuated_);
+  if (derivatives) {
+    S.setZero(2 * m, 4 * n);
+    for (int i = 0; i < m; ++i) {
+      S(i, unactuated_[i]) = 1;
+      S(m + i, n + unactuated_[i]) = 1;
+    }
+  }
+  const int steps = integration_steps(dt);
+  const double h = dt / steps, tiny = 1e-12 * dt;
+  int node = 0;  // y, S hold the state at node·h
+  for (size_t i = 0; i < s.size(); ++i) {
+    if (!(s[i] >= -tiny && s[i] <= dt + tiny) || (i > 0 && s[i] < s[i - 1])) {
+      throw std::invalid_argument("interpolant: sample times must ascend within [0, dt]");
+    }
+    if (m > 0) {
+      while (node < steps && s[i] >= (node + 1) * h - tiny) {
+        rk4_step(node * h, h, y, S, derivatives, y_next, S_next);
+        y.swap(y_next);
+        S.swap(S_next);
+        ++node;
+      }
+      const double rest = s[i] - node * h;
+      if (rest > tiny) {  // a partial step from the last node; the nodes stay on the grid
+        rk4_step(node * h, rest, y, S, derivatives, y_next, S_next);
+        point(s[i], y_next, S_next, derivatives, true, out[i]);
+        continue;
+      }
+    }
+    point(m > 0 ? node * h : s[i], y, S, derivatives, true, out[i]);
+  }
+}
+
+}  // namespace kinograph::planning
