@@ -10,6 +10,7 @@ find_package(yaml-cpp REQUIRED)
 find_package(CLI11 REQUIRED)
 find_package(spdlog REQUIRED)
 find_package(Threads REQUIRED)
+find_package(EXPAT REQUIRED)                                       # SRDF reading (libexpat1-dev)
 pkg_check_modules(LCM REQUIRED IMPORTED_TARGET lcm)                 # needs libglib2.0-dev
 pkg_check_modules(OSMESA REQUIRED IMPORTED_TARGET osmesa)           # never link libGL too
 pkg_check_modules(BULLET64 REQUIRED IMPORTED_TARGET bullet-float64) # carries -DBT_USE_DOUBLE_PRECISION

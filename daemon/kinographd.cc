@@ -1,6 +1,7 @@
 // kinographd: the kinograph planner daemon for one robot on an LCM network.
 //   kinographd SCENE.yaml [--prefix IIWA] [--lcm-url URL] [--status-period 1.0]
 //              [--batch-only] [--max-goal-change RAD] [--formulation condensed|dfg]
+//              [--ignore-goal-id-gaps]
 // The scene gives the robot, default horizon and steps, start, fixed obstacles, objective
 // weights and the batch formulation; goals, obstacle updates and measured states arrive over
 // LCM.
@@ -45,7 +46,12 @@ int main(int argc, char** argv) {
                  "batch formulation: condensed (tau = RNEA per step) or dfg (the paper's full "
                  "dynamic factor graph); default: the scene's planner.formulation")
       ->check(CLI::IsMember({"condensed", "dfg"}));
+  bool ignore_gaps = false;
+  app.add_flag("--ignore-goal-id-gaps", ignore_gaps,
+               "goal ids are not numbered 1, 2, 3, ... by one sender: do not answer skipped ids "
+               "as lost (default: answer them SUPERSEDED and count them as dropped)");
   CLI11_PARSE(app, argc, argv);
+  options.answer_goal_id_gaps = !ignore_gaps;
   options.replanning.use_incremental = !batch_only;
   spdlog::set_level(spdlog::level::from_str(level));
 
@@ -55,7 +61,8 @@ int main(int argc, char** argv) {
     kinograph::planning::Scene scene = kinograph::planning::load_scene(scene_path);
     // Every batch solve of the node (first plans, fallbacks) is in this formulation.
     const std::string name = formulation.empty() ? scene.planner.formulation : formulation;
-    options.replanning.incremental.batch.formulation = kinograph::planning::formulation_from_name(name).value();
+    options.replanning.incremental.batch.formulation =
+        kinograph::planning::formulation_from_name(name).value();
     spdlog::info("kinographd: batch formulation {}",
                  kinograph::planning::to_string(options.replanning.incremental.batch.formulation));
     kinograph::daemon::PlannerNode node(std::move(scene), options);
@@ -63,10 +70,11 @@ int main(int argc, char** argv) {
     const auto c = node.counters();
     if (g_signal != 0) spdlog::info("kinographd: signal {} received", g_signal.load());
     spdlog::info(
-        "kinographd: stopped after {} goals, {} plans ({} failed, {} incremental replans, {} "
-        "fallbacks), {} rejected messages",
-        c.goals_received, c.plans_published, c.failures, c.incremental, c.fallbacks,
-        c.messages_rejected);
+        "kinographd: stopped after {} goals ({} answered, {} superseded, {} dropped in "
+        "transport), {} plans ({} failed, {} incremental replans, {} fallbacks), {} rejected "
+        "messages",
+        c.goals_received, c.goals_answered, c.goals_superseded, c.goals_dropped, c.plans_published,
+        c.failures, c.incremental, c.fallbacks, c.messages_rejected);
   } catch (const std::exception& e) {
     std::cerr << "kinographd: error: " << e.what() << "\n";
     return 1;

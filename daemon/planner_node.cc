@@ -26,9 +26,7 @@ std::string upper(std::string s) {
 }  // namespace
 
 PlannerNode::PlannerNode(planning::Scene scene, PlannerNodeOptions options, lcm::LCM* shared)
-    : scene_(std::move(scene)),
-      options_(std::move(options)),
-      replanner_(options_.replanning) {
+    : scene_(std::move(scene)), options_(std::move(options)), replanner_(options_.replanning) {
   if (!scene_.problem.model) throw std::invalid_argument("PlannerNode: the scene has no robot");
   identity_.model_name = scene_.problem.model->name;
   identity_.channel_prefix =
@@ -52,6 +50,10 @@ PlannerNode::PlannerNode(planning::Scene scene, PlannerNodeOptions options, lcm:
   subscriptions_ = {lcm_->subscribe(channel("GOAL"), &PlannerNode::on_goal, this),
                     lcm_->subscribe(channel("OBSTACLES"), &PlannerNode::on_obstacles, this),
                     lcm_->subscribe(channel("STATE"), &PlannerNode::on_state, this)};
+  const int capacities[] = {kGoalQueueCapacity, kObstacleQueueCapacity, kStateQueueCapacity};
+  for (std::size_t i = 0; i < subscriptions_.size(); ++i) {
+    subscriptions_[i]->setQueueCapacity(capacities[i]);
+  }
 }
 
 // A shared LCM instance outlives the node: its handlers must not call into a destroyed node.
@@ -92,10 +94,32 @@ void PlannerNode::answer_with_failure(int8_t status, const std::string& reason, 
     plan_id = next_plan_id_++;
     ++counters_.plans_published;
     ++counters_.failures;
+    ++counters_.goals_answered;
+    if (status == plan_t::SUPERSEDED) ++counters_.goals_superseded;
   }
   plan_t answer = messages::failure_message(status, reason, identity_.model_name, plan_id, goal_id,
                                             now_utime());
   lcm_->publish(channel("PLAN"), &answer);
+}
+
+void PlannerNode::answer_superseded(const Intake& taken) {
+  // Superseded goals were always replaced by a newer valid goal, which `taken` holds.
+  const std::string newest = taken.goal ? std::to_string(taken.goal->goal_id) : "?";
+  for (const int64_t id : taken.superseded) {
+    answer_with_failure(plan_t::SUPERSEDED,
+                        "superseded by goal " + newest + " before planning began", id);
+  }
+  for (const LostGoals& gap : taken.lost) {
+    spdlog::warn("goals {}..{} never arrived (lost in transport); answered SUPERSEDED", gap.first,
+                 gap.last);
+    for (int64_t id = gap.first; id <= gap.last; ++id) {
+      answer_with_failure(plan_t::SUPERSEDED,
+                          "goal " + std::to_string(id) +
+                              " did not reach the planner (lost in transport); goal " +
+                              std::to_string(gap.revealed_by) + " is newer",
+                          id);
+    }
+  }
 }
 
 void PlannerNode::on_goal(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
@@ -103,6 +127,17 @@ void PlannerNode::on_goal(const lcm::ReceiveBuffer* rbuf, const std::string& cha
   if (auto s = lcmtypes::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), msg); !s.ok) {
     reject(channel + ": malformed goal_t: " + s.reason);
     return;
+  }
+  if (msg.goal_id >= 0) {
+    std::optional<LostGoals> lost;
+    if (options_.answer_goal_id_gaps) lost = goal_ids_.next(msg.goal_id);
+    std::lock_guard lock(mutex_);
+    ++counters_.goals_received;
+    last_goal_id_ = msg.goal_id;
+    if (lost) {
+      counters_.goals_dropped += lost->count();
+      intake_.lost.push_back(*lost);
+    }
   }
   GoalRequest request;
   if (Check c = messages::goal_from_message(msg, *scene_.problem.model, identity_, request);
@@ -112,22 +147,9 @@ void PlannerNode::on_goal(const lcm::ReceiveBuffer* rbuf, const std::string& cha
     if (msg.goal_id >= 0) answer_with_failure(plan_t::INVALID_GOAL, c.reason, msg.goal_id);
     return;
   }
-  std::optional<GoalRequest> superseded;
-  {
-    std::lock_guard lock(mutex_);
-    ++counters_.goals_received;
-    last_goal_id_ = request.goal_id;
-    if (pending_goal_) {
-      superseded = std::move(pending_goal_);
-      ++counters_.goals_cancelled;
-    }
-    pending_goal_ = std::move(request);
-  }
-  wake_.notify_one();
-  if (superseded) {
-    answer_with_failure(plan_t::CANCELLED, "superseded by a newer goal before planning began",
-                        superseded->goal_id);
-  }
+  Intake arrived;
+  arrived.goal = std::move(request);
+  intake_.absorb(std::move(arrived));
 }
 
 void PlannerNode::on_obstacles(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
@@ -136,20 +158,13 @@ void PlannerNode::on_obstacles(const lcm::ReceiveBuffer* rbuf, const std::string
     reject(channel + ": malformed obstacle_list_t: " + s.reason);
     return;
   }
-  std::vector<ObstacleUpdate> updates;
-  if (Check c = messages::obstacles_from_message(msg, updates); !c.ok) {
+  Intake arrived;
+  if (Check c = messages::obstacles_from_message(msg, arrived.obstacles); !c.ok) {
     reject(channel + ": " + c.reason);
     return;
   }
-  {
-    std::lock_guard lock(mutex_);
-    if (msg.replace_all) {
-      pending_obstacles_.clear();
-      pending_replace_all_ = true;
-    }
-    pending_obstacles_.insert(pending_obstacles_.end(), updates.begin(), updates.end());
-  }
-  wake_.notify_one();
+  arrived.replace_all = msg.replace_all;
+  intake_.absorb(std::move(arrived));
 }
 
 void PlannerNode::on_state(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
@@ -158,14 +173,29 @@ void PlannerNode::on_state(const lcm::ReceiveBuffer* rbuf, const std::string& ch
     reject(channel + ": malformed robot_state_t: " + s.reason);
     return;
   }
-  MeasuredState state;
-  if (Check c = messages::state_from_message(msg, *scene_.problem.model, identity_, state); !c.ok) {
+  Intake arrived;
+  arrived.state.emplace();
+  if (Check c = messages::state_from_message(msg, *scene_.problem.model, identity_, *arrived.state);
+      !c.ok) {
     reject(channel + ": " + c.reason);
     return;
   }
-  std::lock_guard lock(mutex_);
-  latest_state_ = std::move(state);
-  ++state_count_;
+  arrived.states = 1;
+  intake_.absorb(std::move(arrived));
+}
+
+void PlannerNode::hand_over() {
+  if (intake_.empty()) return;
+  {
+    std::lock_guard lock(mutex_);
+    if (intake_.state) latest_state_ = std::move(intake_.state);
+    state_count_ += intake_.states;
+    intake_.state.reset();
+    intake_.states = 0;
+    pending_.absorb(std::move(intake_));
+  }
+  intake_ = Intake{};
+  wake_.notify_one();
 }
 
 bool PlannerNode::apply_obstacles(const std::vector<ObstacleUpdate>& updates, bool replace_all) {
@@ -185,8 +215,16 @@ bool PlannerNode::apply_obstacles(const std::vector<ObstacleUpdate>& updates, bo
       }
     }
   }
+  // The world's bound (scene obstacles included) is checked before anything is added.
+  const std::size_t fixed = scene_.problem.obstacles.size();
+  std::vector<std::string> refused;
   for (const auto& u : updates) {
     auto it = live_obstacles_.find(u.id);
+    if (!u.remove && it == live_obstacles_.end() &&
+        fixed + live_obstacles_.size() >= static_cast<std::size_t>(collision::kMaxObstacles)) {
+      refused.push_back(u.id);
+      continue;
+    }
     if (u.remove) {
       if (it != live_obstacles_.end()) {
         live_obstacles_.erase(it);
@@ -202,6 +240,12 @@ bool PlannerNode::apply_obstacles(const std::vector<ObstacleUpdate>& updates, bo
     o.pose = u.pose;
     live_obstacles_[u.id] = std::move(o);
     changed = true;
+  }
+  if (!refused.empty()) {
+    reject("obstacle \"" + refused.front() + "\"" +
+           (refused.size() > 1 ? " and " + std::to_string(refused.size() - 1) + " more" : "") +
+           " not added: the world holds the most obstacles it may, " +
+           std::to_string(collision::kMaxObstacles) + " (scene and LCM together)");
   }
   return changed;
 }
@@ -246,6 +290,7 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan) {
     plan_id = next_plan_id_++;
     last_plan_id_ = plan_id;
     ++counters_.plans_published;
+    if (!replan) ++counters_.goals_answered;
     if (replan) ++counters_.replans;
     if (!threw && report.incremental) ++counters_.incremental;
     if (!threw && report.fell_back) ++counters_.fallbacks;
@@ -272,26 +317,20 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan) {
 
 void PlannerNode::worker_loop(const std::atomic<bool>& stop) {
   while (true) {
-    std::optional<GoalRequest> goal;
-    std::vector<ObstacleUpdate> updates;
-    bool replace_all = false;
+    Intake taken;
     {
       std::unique_lock lock(mutex_);
-      wake_.wait_for(lock, std::chrono::milliseconds(50), [&] {
-        return stop.load() || pending_goal_ || !pending_obstacles_.empty() || pending_replace_all_;
-      });
+      wake_.wait_for(lock, std::chrono::milliseconds(50),
+                     [&] { return stop.load() || !pending_.empty(); });
       if (stop.load()) return;
-      goal = std::move(pending_goal_);
-      pending_goal_.reset();
-      updates.swap(pending_obstacles_);
-      replace_all = pending_replace_all_;
-      pending_replace_all_ = false;
+      std::swap(taken, pending_);
     }
-    const bool obstacles_changed =
-        (!updates.empty() || replace_all) && apply_obstacles(updates, replace_all);
-    if (goal) {
-      current_goal_ = goal;
-      plan_and_publish(*goal, /*replan=*/false);
+    answer_superseded(taken);
+    const bool obstacles_changed = (!taken.obstacles.empty() || taken.replace_all) &&
+                                   apply_obstacles(taken.obstacles, taken.replace_all);
+    if (taken.goal) {
+      current_goal_ = taken.goal;
+      plan_and_publish(*taken.goal, /*replan=*/false);
     } else if (obstacles_changed && current_goal_) {
       plan_and_publish(*current_goal_, /*replan=*/true);
     }
@@ -310,6 +349,10 @@ void PlannerNode::publish_status() {
     msg.message = last_message_;
     msg.num_plans = counters_.plans_published;
     msg.num_failures = counters_.failures;
+    msg.num_goals_received = counters_.goals_received;
+    msg.num_goals_answered = counters_.goals_answered;
+    msg.num_goals_superseded = counters_.goals_superseded;
+    msg.num_goals_dropped = counters_.goals_dropped;
   }
   lcm_->publish(channel("PLANNER_STATUS"), &msg);
 }
@@ -331,7 +374,8 @@ void PlannerNode::run(const std::atomic<bool>& stop) {
     // LCM 1.3's udpm handle() occasionally reports a failure for a single datagram (seen when
     // a packet of our own arrives while no handler wants it); only a persistent failure means
     // the transport is gone.
-    if (lcm_->handleTimeout(50) < 0) {
+    const int handled = lcm_->handleTimeout(50);
+    if (handled < 0) {
       if (++handle_failures > 100) {
         spdlog::error("LCM handle failed 100 times in a row; stopping");
         break;
@@ -340,7 +384,15 @@ void PlannerNode::run(const std::atomic<bool>& stop) {
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
     } else {
       handle_failures = 0;
+      // A burst (messages less than 1 ms apart, as after a stall) is taken whole before the
+      // worker sees any of it, so that only its newest goal is planned; at most 5 ms, so that a
+      // steady storm still reaches the worker.
+      const auto drain_end = std::chrono::steady_clock::now() + std::chrono::milliseconds(5);
+      while (handled > 0 && std::chrono::steady_clock::now() < drain_end &&
+             lcm_->handleTimeout(1) > 0) {
+      }
     }
+    hand_over();
   }
   done = true;
   wake_.notify_all();

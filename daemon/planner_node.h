@@ -1,7 +1,8 @@
 #pragma once
 // kinographd's core: one planner for one robot on an LCM network. It listens for goals,
 // obstacle updates and measured states, plans off the LCM thread (the newest goal wins), and
-// answers every goal with a plan_t — a trajectory or a failure status with its reason.
+// answers every goal with a plan_t — a trajectory, SUPERSEDED when a newer goal was planned
+// instead, or a failure status with its reason (docs/reliability.md).
 //
 // Which plans are incremental replans and what answers a plan that does not validate is the
 // planning::Replanner's policy; plan_t.method names the path that answered ("batch",
@@ -17,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "daemon/intake.h"
 #include "kinograph/lcm/message_convert.h"
 #include "kinograph/planning/io/scene.h"
 #include "kinograph/planning/replanner.h"
@@ -49,23 +51,38 @@ struct PlannerNodeOptions {
   double status_period_s = 1.0;
   /// The planners and the replanning policy (incremental or batch only, fallbacks).
   planning::ReplannerOptions replanning;
+  /// Senders number their goals 1, 2, 3, ...: goal ids skipped between two goals were lost on
+  /// the way and are answered SUPERSEDED and counted as dropped. Off when several senders
+  /// share the channel or ids are not consecutive (then no id means a loss).
+  bool answer_goal_id_gaps = true;
 };
 
 /// What a node has done since it started (for its status and for tests).
 struct NodeCounters {
-  int goals_received = 0;     ///< goal_t messages that passed their checks
-  int messages_rejected = 0;  ///< messages of any type that failed to decode or check
-  int goals_cancelled = 0;    ///< goals superseded by a newer one before planning began
-  int plans_published = 0;    ///< plan_t messages sent (successes and failures)
-  int failures = 0;           ///< of which not SUCCESS
-  int replans = 0;            ///< plans triggered by an obstacle change for the current goal
-  int incremental = 0;        ///< plans answered by an incremental replan (validated or not)
-  int fallbacks = 0;          ///< incremental replans redone by a batch solve
+  int64_t goals_received = 0;    ///< goal_t messages decoded with a goal_id (valid or not)
+  int64_t goals_answered = 0;    ///< goals answered once: planned, refused or superseded
+  int64_t goals_superseded = 0;  ///< of which SUPERSEDED: a newer goal was planned instead
+  int64_t goals_dropped = 0;     ///< goal ids skipped in the sender's sequence (lost), answered
+  int messages_rejected = 0;     ///< messages of any type that failed to decode or check
+  int plans_published = 0;       ///< plan_t messages sent (successes and failures)
+  int failures = 0;              ///< of which not SUCCESS
+  int replans = 0;               ///< plans triggered by an obstacle change for the current goal
+  int incremental = 0;           ///< plans answered by an incremental replan (validated or not)
+  int fallbacks = 0;             ///< incremental replans redone by a batch solve
 };
 
 /// The planner daemon's node: scene (robot, defaults, fixed obstacles) + LCM + worker thread.
 class PlannerNode {
  public:
+  /// LCM's per-subscription queues (liblcm drops, unreported, what arrives beyond them):
+  /// sized to absorb a 10 s stall of the node under a 1 kHz goal storm with 200 Hz obstacle
+  /// and state streams, bounding what a stall can hold in memory.
+  static constexpr int kGoalQueueCapacity = 10000;
+  static constexpr int kObstacleQueueCapacity = 2000;
+  static constexpr int kStateQueueCapacity = 2000;
+  /// A jump in goal ids larger than this is a new numbering, not a loss.
+  static constexpr int64_t kMaxGoalIdGap = kGoalQueueCapacity;
+
   /// Throws std::runtime_error naming the URL when LCM cannot start (e.g. no multicast route).
   /// With `shared`, the node uses that LCM instance instead of opening options.lcm_url (how
   /// in-process tests share one memq:// queue with it); it must outlive the node.
@@ -90,6 +107,10 @@ class PlannerNode {
   void reject(const std::string& reason);
   /// Publishes a plan_t without trajectory that answers `goal_id` with a failure status.
   void answer_with_failure(int8_t status, const std::string& reason, int64_t goal_id);
+  /// Answers the goals a newer one replaced and the ids that never arrived (worker thread).
+  void answer_superseded(const Intake& taken);
+  /// Hands what the handlers took off LCM to the worker, in one go (LCM thread).
+  void hand_over();
   void worker_loop(const std::atomic<bool>& stop);
   bool apply_obstacles(const std::vector<ObstacleUpdate>& updates, bool replace_all);
   void plan_and_publish(const GoalRequest& goal, bool replan);
@@ -103,12 +124,15 @@ class PlannerNode {
   lcm::LCM* lcm_ = nullptr;
   std::vector<lcm::Subscription*> subscriptions_;
 
+  // Owned by the LCM thread: what its handlers took off LCM since the last hand-over, so that
+  // a burst is handed to the worker whole (the newest goal of it planned, not the first).
+  Intake intake_;
+  GoalIdSequence goal_ids_{kMaxGoalIdGap};
+
   // Shared between the LCM thread and the worker, under mutex_.
   mutable std::mutex mutex_;
   std::condition_variable wake_;
-  std::optional<GoalRequest> pending_goal_;
-  std::vector<ObstacleUpdate> pending_obstacles_;
-  bool pending_replace_all_ = false;
+  Intake pending_;
   std::optional<MeasuredState> latest_state_;
   std::uint64_t state_count_ = 0;  // measured states received; compared with used_state_count_
   NodeCounters counters_;

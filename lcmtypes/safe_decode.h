@@ -180,7 +180,8 @@ inline bool check_fields(WireReader& r, const planner_status_t*) {
          r.skip(1, 1, "planner_status_t.state") &&
          r.skip(2, 8, "planner_status_t.last_goal_id/last_plan_id") &&
          r.string("planner_status_t.message") &&
-         r.skip(2, 4, "planner_status_t.num_plans/num_failures");
+         r.skip(2, 4, "planner_status_t.num_plans/num_failures") &&
+         r.skip(4, 8, "planner_status_t.num_goals_*");
 }
 
 }  // namespace detail

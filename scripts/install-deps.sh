@@ -13,7 +13,7 @@ PACKAGES=(
   # rendering and plots
   libosmesa6-dev libpng-dev libfreetype-dev fonts-dejavu-core libcairo2-dev
   # tools, config, logging
-  nlohmann-json3-dev libyaml-cpp-dev libcli11-dev libspdlog-dev
+  nlohmann-json3-dev libyaml-cpp-dev libexpat1-dev libcli11-dev libspdlog-dev
   # tests and benchmarks (KDL and Ceres are test/bench-only oracles; OMPL for the SST baseline)
   libgtest-dev libgmock-dev libbenchmark-dev liborocos-kdl-dev libceres-dev libompl-dev
   # third-party URDFs with real meshes for renderer tests

@@ -5,7 +5,6 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -17,6 +16,7 @@
 
 #include "bench/common/bench_stats.h"
 #include "bench/common/iiwa_goals.h"
+#include "bench/common/timed_plan.h"
 #include "kinograph/planning/batch/batch_planner.h"
 #include "kinograph/planning/goal_sampler.h"
 #include "kinograph/planning/io/plan_json.h"
@@ -33,19 +33,6 @@ const std::string kScenes = std::string(KINOGRAPH_SOURCE_DIR) + "/robots/scenes/
 
 // The paper's "total torque" of a run (N·m): Σ_k Σ_j |τ_kj| over every state and joint.
 double total_torque(const Plan& plan) { return plan.tau.cwiseAbs().sum(); }
-
-struct Run {
-  Plan plan;
-  double wall_s = 0;  // the whole plan() call: build, solve and validate
-};
-
-Run plan_once(const planning::BatchPlanner& planner, const Problem& problem) {
-  const auto start = std::chrono::steady_clock::now();
-  Run run;
-  run.plan = planner.plan(problem);
-  run.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return run;
-}
 
 // Success rate and times of a set of runs (times over successful runs, as the paper).
 json summary(const std::vector<Run>& runs) {

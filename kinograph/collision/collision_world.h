@@ -68,6 +68,8 @@ class CollisionWorld {
   const CollisionWorldOptions& options() const { return options_; }
   // The robot whose geometry this world holds.
   const dynamics::Model& model() const { return model_; }
+  // The self-collision pairs checked (robot geometry indices a < b); empty unless enabled.
+  const std::vector<std::pair<int, int>>& self_pairs() const { return self_pairs_; }
 
   // Every pair within options().query_distance at the robot configuration of the last
   // forward_kinematics on `data` and obstacle poses at time t. The span stays valid until the

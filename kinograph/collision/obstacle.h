@@ -7,6 +7,10 @@
 
 namespace kinograph::collision {
 
+// Most obstacles one world (a scene's fixed ones plus those sent over LCM) may hold: the
+// planner's collision factors, memory and time per plan grow with the count.
+inline constexpr int kMaxObstacles = 1024;
+
 // A solid in the robot's workspace: a fixed body (desk, wall) or, with a trajectory, a moving
 // one (a neighbouring robot's link along its published plan). The id is the caller's handle.
 struct Obstacle {

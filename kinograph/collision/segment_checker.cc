@@ -97,8 +97,10 @@ PathCheckResult SegmentChecker::check_path(CollisionWorld& world, dynamics::Data
     if (times.empty()) return 0.0;
     return i + 1 < m ? times[i] + u * (times[i + 1] - times[i]) : times[i];
   };
+  // Any point moves at most the sweep; two points of the robot approach by at most twice it.
+  const double relative = world.self_pairs().empty() ? 1.0 : 2.0;
   auto sweep_of = [&](int i) {
-    return (path.row(i + 1) - path.row(i)).cwiseAbs().dot(lever_.transpose());
+    return relative * (path.row(i + 1) - path.row(i)).cwiseAbs().dot(lever_.transpose());
   };
   auto sample = [&](int i, double u) {
     if (i + 1 < m) {
@@ -108,13 +110,14 @@ PathCheckResult SegmentChecker::check_path(CollisionWorld& world, dynamics::Data
     }
     dynamics::forward_kinematics(model_, data, q_);
     ++result.samples;
-    const double d = world.closest(data, time_at(i, u)).distance;
-    if (d < result.min_distance) {
-      result.min_distance = d;
+    const Proximity p = world.closest(data, time_at(i, u));
+    if (p.distance < result.min_distance) {
+      result.min_distance = p.distance;
       result.segment = i;
       result.s = u;
+      result.closest = p;
     }
-    return d;
+    return p.distance;
   };
 
   int i = 0;     // current segment

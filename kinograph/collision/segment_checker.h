@@ -49,6 +49,8 @@ struct PathCheckResult {
   // Where min_distance occurs: polyline segment index and fraction along it.
   int segment = 0;
   double s = 0;
+  // The closest pair there.
+  Proximity closest;
   // Number of configurations checked.
   int samples = 0;
 };
@@ -70,7 +72,9 @@ class SegmentChecker {
   // distance d the next one is d − clearance further along the path's sweep (at least
   // max_sweep_step, and at most max_time_step later when obstacles move), so no stretch where
   // the robot could come closer than `clearance` is skipped, yet clear stretches cost one
-  // query. Allocates nothing after the first call with a given joint count.
+  // query. With self-collision pairs in the world the budget is halved: both geometries of a
+  // pair move, so their distance changes up to twice the sweep. Allocates nothing after the
+  // first call with a given joint count.
   PathCheckResult check_path(CollisionWorld& world, dynamics::Data& data,
                              const Eigen::Ref<const Eigen::MatrixXd>& path,
                              const std::vector<double>& times = {}, double clearance = 0);

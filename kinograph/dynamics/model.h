@@ -49,7 +49,9 @@ struct Body {
   Matrix6 inertia = Matrix6::Zero();
   JointLimits limits;
   double damping = 0.0;  ///< viscous joint damping b: τ gets + b q̇
-  bool actuated = true;  ///< false when the URDF effort limit is 0 (e.g. the Acrobot shoulder)
+  /// false for a passive joint (e.g. the Acrobot shoulder): URDF cannot say so, a scene's
+  /// `unactuated` list does. The loader reads effort="0" as an unknown limit (+inf), with a warning.
+  bool actuated = true;
 };
 
 /// A named frame: every URDF link (including the root and merged links), fixed on a body.
@@ -62,10 +64,14 @@ struct Frame {
 /// The immutable robot description; algorithms take it with a Data workspace.
 class Model {
  public:
-  /// Reads a URDF file. Throws UrdfError naming the file and the offending element.
+  /// Reads a URDF file; every joint actuated (effort="0" is logged as unknown and read as +inf).
+  /// @throws UrdfError naming the file, the link or joint, the element and its line: unreadable
+  ///   file, malformed XML, a xacro file (to be expanded first), an attribute that is not a
+  ///   number, geometry urdfdom could not read, an unsupported joint, a moving link without
+  ///   inertial, a mesh not found.
   static Model from_urdf_file(const std::string& path);
   /// Parses URDF text; relative mesh paths resolve against base_dir (the working directory
-  /// when empty). Throws UrdfError.
+  /// when empty). @throws UrdfError as from_urdf_file.
   static Model from_urdf_string(const std::string& xml, const std::string& base_dir = "");
 
   /// Number of joint coordinates (= number of bodies).

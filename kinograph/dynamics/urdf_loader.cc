@@ -8,10 +8,12 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <mutex>
 #include <sstream>
 
 #include "kinograph/dynamics/model.h"
+#include "kinograph/dynamics/urdf_outline.h"
 
 namespace kinograph::dynamics {
 namespace {
@@ -19,16 +21,19 @@ namespace {
 namespace fs = std::filesystem;
 
 // Captures urdfdom's console_bridge messages so the reason for a parse failure ends up in
-// the UrdfError instead of on stderr.
+// the UrdfError, and its warnings in the log, instead of on stderr.
 class CapturingHandler : public console_bridge::OutputHandler {
  public:
   void log(const std::string& text, console_bridge::LogLevel level, const char*, int) override {
     if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR) {
       if (!errors.empty()) errors += "; ";
       errors += text;
+    } else if (level == console_bridge::CONSOLE_BRIDGE_LOG_WARN) {
+      warnings.push_back(text);
     }
   }
   std::string errors;
+  std::vector<std::string> warnings;
 };
 
 std::mutex& parse_mutex() {
@@ -63,8 +68,10 @@ class Loader {
       : source_(std::move(source)), base_dir_(std::move(base_dir)) {}
 
   Model load(const std::string& xml) {
+    outline_ = outline_urdf(xml, source_);
     urdf::ModelInterfaceSharedPtr urdf;
     std::string errors;
+    std::vector<std::string> warnings;
     {
       std::lock_guard<std::mutex> lock(parse_mutex());
       CapturingHandler handler;
@@ -72,7 +79,9 @@ class Loader {
       urdf = urdf::parseURDF(xml);
       console_bridge::restorePreviousOutputHandler();
       errors = handler.errors;
+      warnings = handler.warnings;
     }
+    for (const std::string& w : warnings) spdlog::warn("{}: urdfdom: {}", source_, w);
     if (!urdf) {
       fail("malformed URDF" + (errors.empty() ? std::string() : " (urdfdom: " + errors + ")"));
     }
@@ -80,6 +89,7 @@ class Loader {
     urdf_ = urdf;
     model_.name = urdf->getName();
     visit(urdf->getRoot(), -1, Eigen::Isometry3d::Identity(), false);
+    check_nothing_dropped();
     spdlog::debug("{}: model '{}' with {} bodies, {} frames", source_, model_.name,
                   model_.bodies.size(), model_.frames.size());
     return std::move(model_);
@@ -96,7 +106,8 @@ class Loader {
     if (link->inertial) {
       const urdf::Inertial& in = *link->inertial;
       if (!(in.mass >= 0) || !std::isfinite(in.mass)) {
-        fail("link '" + link->name + "' <inertial>: mass must be finite and >= 0");
+        fail("link '" + link->name + "'" + outline_.link_line(link->name) +
+             " <inertial>: mass must be finite and >= 0");
       }
       if (body < 0) {
         model_.base_mass += in.mass;
@@ -108,16 +119,20 @@ class Loader {
             spatial_inertia(in.mass, T.translation(), T.linear() * Ic * T.linear().transpose());
       }
     } else if (moving) {
-      fail("link '" + link->name + "' moves (joint '" + model_.bodies[body].joint_name +
-           "') but has no <inertial>");
+      fail("link '" + link->name + "'" + outline_.link_line(link->name) + " moves (joint '" +
+           model_.bodies[body].joint_name + "') but has no <inertial>");
     }
     for (const auto& c : link->collision_array) {
-      if (c && c->geometry)
-        add_geometry(*c->geometry, c->origin, link->name, body, placement, nullptr, "collision",
-                     model_.collision);
+      if (!c || !c->geometry)
+        fail("link '" + link->name + "'" + outline_.link_line(link->name) +
+             ": a <collision> without a usable <geometry>");
+      add_geometry(*c->geometry, c->origin, link->name, body, placement, nullptr, "collision",
+                   model_.collision);
     }
     for (const auto& v : link->visual_array) {
-      if (!v || !v->geometry) continue;
+      if (!v || !v->geometry)
+        fail("link '" + link->name + "'" + outline_.link_line(link->name) +
+             ": a <visual> without a usable <geometry>");
       urdf::MaterialSharedPtr mat = v->material;
       if (!mat && !v->material_name.empty()) mat = urdf_->getMaterial(v->material_name);
       add_geometry(*v->geometry, v->origin, link->name, body, placement, mat.get(), "visual",
@@ -126,7 +141,8 @@ class Loader {
 
     for (const auto& joint : link->child_joints) {
       const urdf::LinkConstSharedPtr child = urdf_->getLink(joint->child_link_name);
-      if (!child) fail("joint '" + joint->name + "': child link not found");
+      const std::string jname = "joint '" + joint->name + "'" + outline_.joint_line(joint->name);
+      if (!child) fail(jname + ": child link not found");
       const Eigen::Isometry3d origin =
           placement * to_isometry(joint->parent_to_joint_origin_transform);
       switch (joint->type) {
@@ -139,11 +155,11 @@ class Loader {
           visit(child, add_body(*joint, body, origin), Eigen::Isometry3d::Identity(), true);
           break;
         case urdf::Joint::FLOATING:
-          fail("joint '" + joint->name + "': unsupported joint type 'floating'");
+          fail(jname + ": unsupported joint type 'floating'");
         case urdf::Joint::PLANAR:
-          fail("joint '" + joint->name + "': unsupported joint type 'planar'");
+          fail(jname + ": unsupported joint type 'planar'");
         default:
-          fail("joint '" + joint->name + "': unsupported joint type");
+          fail(jname + ": unsupported joint type");
       }
     }
   }
@@ -154,9 +170,10 @@ class Loader {
     b.joint_name = joint.name;
     b.parent = parent;
     b.parent_to_joint = parent_to_joint;
+    const std::string jname = "joint '" + joint.name + "'" + outline_.joint_line(joint.name);
     Eigen::Vector3d axis(joint.axis.x, joint.axis.y, joint.axis.z);
     if (!(axis.norm() > 1e-12) || !axis.allFinite()) {
-      fail("joint '" + joint.name + "' <axis>: axis must be a non-zero vector");
+      fail(jname + " <axis>: axis must be a non-zero vector");
     }
     axis.normalize();
     b.screw_axis.setZero();
@@ -172,12 +189,22 @@ class Loader {
         b.limits.lower = joint.limits->lower;
         b.limits.upper = joint.limits->upper;
         if (b.limits.lower > b.limits.upper) {
-          fail("joint '" + joint.name + "' <limit>: lower > upper");
+          fail(jname + " <limit>: lower > upper");
         }
       }
       b.limits.velocity = joint.limits->velocity;
       b.limits.effort = joint.limits->effort;
-      b.actuated = joint.limits->effort > 0;
+      if (!(b.limits.velocity >= 0)) fail(jname + " <limit>: velocity must be >= 0");
+      if (!(b.limits.effort >= 0)) fail(jname + " <limit>: effort must be >= 0");
+      // Many vendor files write effort="0" as a placeholder; URDF cannot say "passive", so a
+      // scene declares unactuated joints itself.
+      if (b.limits.effort == 0) {
+        spdlog::warn(
+            "{}: {}: effort=\"0\" read as unknown: no torque limit (an unactuated "
+            "joint is declared in the scene's 'unactuated' list)",
+            source_, jname);
+        b.limits.effort = std::numeric_limits<double>::infinity();
+      }
     }
     if (joint.dynamics) b.damping = joint.dynamics->damping;
     model_.bodies.push_back(b);
@@ -264,8 +291,27 @@ class Loader {
     fail(where + ": mesh file not found (first looked for " + candidates.front().string() + ")");
   }
 
+  // urdfdom skips some elements it cannot read without an error; every <collision> and <visual>
+  // the text holds must have become a shape.
+  void check_nothing_dropped() const {
+    for (const auto& [name, link] : outline_.links) {
+      const urdf::LinkConstSharedPtr l = urdf_->getLink(name);
+      if (!l) fail("link '" + name + "'" + outline_.link_line(name) + " was not read by urdfdom");
+      const auto check = [&](size_t read, const std::vector<int>& lines, const char* kind) {
+        if (read == lines.size()) return;
+        fail("link '" + name + "': " + std::to_string(lines.size()) + " <" + kind + "> elements" +
+             (lines.empty() ? "" : " (first on line " + std::to_string(lines.front()) + ")") +
+             " but urdfdom read " + std::to_string(read) +
+             "; one of them has geometry it could not parse");
+      };
+      check(l->collision_array.size(), link.collision_lines, "collision");
+      check(l->visual_array.size(), link.visual_lines, "visual");
+    }
+  }
+
   std::string source_;
   fs::path base_dir_;
+  UrdfOutline outline_;
   urdf::ModelInterfaceSharedPtr urdf_;
   Model model_;
 };
@@ -276,6 +322,10 @@ Model Model::from_urdf_file(const std::string& path) {
   std::error_code ec;
   if (!fs::exists(path, ec)) throw UrdfError(path + ": URDF file does not exist");
   if (fs::is_directory(path, ec)) throw UrdfError(path + ": is a directory, not a URDF file");
+  if (fs::path(path).extension() == ".xacro") {
+    throw UrdfError(path + ": this is a xacro file: expand it with xacro first (xacro " + path +
+                    " > robot.urdf)");
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) throw UrdfError(path + ": cannot open URDF file for reading");
   std::ostringstream text;

@@ -3,10 +3,12 @@
 #include <cxxabi.h>
 
 #include <atomic>
+#include <cmath>
 #include <cstdlib>
 #include <memory>
 #include <stdexcept>
 #include <typeinfo>
+#include <vector>
 
 namespace kinograph::graph {
 
@@ -107,17 +109,33 @@ double Factor::error(const Values& values) const {
   return 0.5 * r.squaredNorm();
 }
 
+bool all_finite(const Eigen::Ref<const Eigen::MatrixXd>& M) {
+  return std::isfinite((M.array() * 0.0).sum());
+}
+
 int compact_nonzero_rows(Eigen::Ref<Eigen::MatrixXd> J, Eigen::Ref<Eigen::VectorXd> r) {
-  int kept = 0;
-  for (Eigen::Index i = 0; i < J.rows(); ++i) {
-    if ((J.row(i).array() == 0).all()) continue;
-    if (kept != i) {
-      J.row(kept) = J.row(i);
-      r[kept] = r[i];
-    }
-    ++kept;
+  // J is column-major: rows are found and moved column by column, never by strided row scans.
+  // A row of finite entries is all zero exactly when the sum of its magnitudes is zero.
+  const Eigen::Index m = J.rows();
+  thread_local Eigen::ArrayXd magnitude;
+  thread_local std::vector<Eigen::Index> rows;
+  if (magnitude.size() < m) magnitude.resize(m);
+  auto mag = magnitude.head(m);
+  mag.setZero();
+  for (Eigen::Index c = 0; c < J.cols(); ++c) mag += J.col(c).array().abs();
+  rows.clear();
+  for (Eigen::Index i = 0; i < m; ++i) {
+    if (mag[i] != 0) rows.push_back(i);
   }
-  return kept;
+  const Eigen::Index kept = static_cast<Eigen::Index>(rows.size());
+  if (kept == m) return static_cast<int>(kept);
+  // rows[t] >= t, so moving in increasing t never overwrites a row still to be read.
+  for (Eigen::Index c = 0; c < J.cols(); ++c) {
+    double* col = J.col(c).data();
+    for (Eigen::Index t = 0; t < kept; ++t) col[t] = col[rows[t]];
+  }
+  for (Eigen::Index t = 0; t < kept; ++t) r[t] = r[rows[t]];
+  return static_cast<int>(kept);
 }
 
 void jacobian_gram(const Eigen::Ref<const Eigen::MatrixXd>& J, Eigen::Ref<Eigen::MatrixXd> H,

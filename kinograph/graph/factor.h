@@ -117,6 +117,10 @@ class Factor {
   long jacobian_version_ = 0;
 };
 
+/// True when every entry of `M` is finite. One vectorized sum (M·0 is NaN exactly where M is
+/// not finite) instead of Eigen's entry-by-entry test, which dominated checking big Jacobians.
+bool all_finite(const Eigen::Ref<const Eigen::MatrixXd>& M);
+
 /// Moves the rows of a whitened Jacobian that are not all zero to its top (with their
 /// residuals) and returns how many there are. Inactive inequality rows (a collision hinge far
 /// from its bound) are exactly zero and add nothing to JᵀJ or Jᵀr; a collision factor has a row

@@ -193,7 +193,7 @@ bool ISAM2::linearize_fresh(const Factor& factor, LinearizedFactor& lf, double* 
   auto r = r_.head(rows);
   Eigen::Ref<Eigen::MatrixXd> J = J_.topLeftCorner(rows, factor.jacobian_cols());
   factor.whitened(ptrs_.data(), r, &J);
-  if (!r.allFinite() || !J.allFinite()) return false;
+  if (!r.allFinite() || !all_finite(J)) return false;
   lf.error = 0.5 * r.squaredNorm();
   if (error != nullptr) *error = lf.error;
   const int off = static_cast<int>(free_cols_.size());

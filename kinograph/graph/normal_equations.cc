@@ -267,7 +267,7 @@ bool NormalEquations::run(const FactorGraph& graph, const Values& values, double
       Eigen::Ref<Eigen::MatrixXd> J = J_.topLeftCorner(m, nc);
       f.whitened(x_ptrs_.data(), r, kept ? nullptr : &J);
       const bool r_ok = r.allFinite();
-      if (!r_ok || (!kept && !J.allFinite())) {
+      if (!r_ok || (!kept && !all_finite(J))) {
         if (reason) {
           *reason = "factor " + std::to_string(info.slot) + " (" + f.name() +
                     ") has a non-finite " + (r_ok ? "Jacobian" : "residual");

@@ -92,6 +92,11 @@ Check goal_from_message(const goal_t& msg, const dynamics::Model& model,
 }
 
 Check obstacles_from_message(const obstacle_list_t& msg, std::vector<ObstacleUpdate>& out) {
+  if (msg.obstacles.size() > static_cast<size_t>(kMaxObstaclesPerMessage)) {
+    return Check::fail("obstacle_list_t.num_obstacles is " + std::to_string(msg.obstacles.size()) +
+                       ", more than the " + std::to_string(kMaxObstaclesPerMessage) +
+                       " one message may carry");
+  }
   std::vector<ObstacleUpdate> updates;
   updates.reserve(msg.obstacles.size());
   for (size_t i = 0; i < msg.obstacles.size(); ++i) {
@@ -108,29 +113,33 @@ Check obstacles_from_message(const obstacle_list_t& msg, std::vector<ObstacleUpd
     if (o.action != obstacle_t::ADD_OR_MOVE) {
       return Check::fail(field + ".action " + std::to_string(o.action) + " is unknown");
     }
+    const std::string named = field + " (\"" + o.id + "\")";
     if (!all_finite(o.size, o.size + 3) || !all_finite(o.position, o.position + 3)) {
-      return Check::fail(field + " (\"" + o.id + "\") has a non-finite size or position");
+      return Check::fail(named + " has a non-finite size or position");
     }
     const double a = o.size[0], b = o.size[1], c = o.size[2];
     switch (o.shape) {
       case obstacle_t::BOX:
-        if (a <= 0 || b <= 0 || c <= 0) return Check::fail(field + ".size must be > 0 (box)");
         u.shape = collision::Shape::box(a, b, c);
         break;
       case obstacle_t::SPHERE:
-        if (a <= 0) return Check::fail(field + ".size[0] (radius) must be > 0");
         u.shape = collision::Shape::sphere(a);
         break;
       case obstacle_t::CYLINDER:
+        u.shape = collision::Shape::cylinder(a, b);
+        break;
       case obstacle_t::CAPSULE:
-        if (a <= 0 || b < 0 || (o.shape == obstacle_t::CYLINDER && b == 0)) {
-          return Check::fail(field + ".size must hold radius > 0 and a valid length");
-        }
-        u.shape = o.shape == obstacle_t::CYLINDER ? collision::Shape::cylinder(a, b)
-                                                  : collision::Shape::capsule(a, b);
+        u.shape = collision::Shape::capsule(a, b);
         break;
       default:
         return Check::fail(field + ".shape " + std::to_string(o.shape) + " is unknown");
+    }
+    if (std::string e = collision::range_error(u.shape); !e.empty()) {
+      return Check::fail(named + ".size: " + e);
+    }
+    const Eigen::Vector3d position(o.position[0], o.position[1], o.position[2]);
+    if (std::string e = collision::position_range_error(position); !e.empty()) {
+      return Check::fail(named + ": " + e);
     }
     Eigen::Quaterniond rotation;
     if (Check ch = quaternion_from(o.quaternion, field + ".quaternion", rotation); !ch.ok) {

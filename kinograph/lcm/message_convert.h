@@ -61,7 +61,12 @@ struct MeasuredState {
 Check goal_from_message(const goal_t& msg, const dynamics::Model& model,
                         const RobotIdentity& identity, GoalRequest& out);
 
-/// Checks an obstacle_list_t and converts it; on failure nothing is converted.
+/// Most obstacle changes one obstacle_list_t may carry.
+inline constexpr int kMaxObstaclesPerMessage = 256;
+
+/// Checks an obstacle_list_t and converts it; on failure nothing is converted. Refuses more
+/// than kMaxObstaclesPerMessage entries (before converting any) and any shape or position
+/// outside the collision engine's faithful range (collision/shape.h), naming the obstacle.
 Check obstacles_from_message(const obstacle_list_t& msg, std::vector<ObstacleUpdate>& out);
 
 /// Checks a robot_state_t (joint names may come in any order) and converts it to model order.

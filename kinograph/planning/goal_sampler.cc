@@ -6,6 +6,7 @@
 #include "kinograph/collision/collision_world.h"
 #include "kinograph/dynamics/data.h"
 #include "kinograph/dynamics/kinematics.h"
+#include "kinograph/planning/clearance_world.h"
 
 namespace kinograph::planning {
 
@@ -37,6 +38,8 @@ GoalSampler::GoalSampler(const Problem& problem, GoalSamplerOptions options)
     const collision::Status status = world_->add_obstacle(o);
     if (!status) throw std::invalid_argument("GoalSampler: " + status.reason);
   }
+  if (problem_.self_and_floor.floor)
+    world_->add_obstacle(floor_obstacle(*problem_.self_and_floor.floor));
   if (options_.self_collision) {
     collision::CollisionWorldOptions self;
     self.self_collision = true;

@@ -4,8 +4,8 @@
 // Generation: each candidate draws every joint uniformly from its position limits shrunk by
 // `limit_margin` (joints with infinite limits from [-π, π]); it is kept only if (1) the frame
 // `region_frame` (when set) lies inside `region`, (2) every robot body (payload included) is at
-// least `clearance` from every obstacle (obstacles at time `horizon`, where the goal is
-// reached), and (3) no two non-adjacent robot bodies are closer than `self_clearance`
+// least `clearance` from every obstacle and the problem's floor (obstacles at time `horizon`, where
+// the goal is reached), and (3) no two non-adjacent robot bodies are closer than `self_clearance`
 // (pairs listed in `self_collision_excluded` skipped). Candidates are drawn until one passes.
 #include <Eigen/Core>
 #include <Eigen/Geometry>

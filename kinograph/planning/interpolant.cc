@@ -24,11 +24,23 @@ IntervalInterpolant::IntervalInterpolant(const dynamics::Model& model)
     (model.bodies[j].actuated ? actuated_ : unactuated_).push_back(j);
   }
   const int n = model.nq(), m = static_cast<int>(unactuated_.size());
+  q0_.setZero(n);
+  qd0_.setZero(n);
+  qdd0_.setZero(n);
+  qdd1_.setZero(n);
   tau0_.resize(n);
   tau0u_.resize(m);
   fu_.resize(m);
   muu_.resize(m, m);
   rhs_.resize(m, 4 * n);
+  for (int i = 0; i < 4; ++i) {
+    k_[i].resize(2 * m);
+    dk_[i].resize(2 * m, 4 * n);
+  }
+  ys_.resize(2 * m);
+  y_part_.resize(2 * m);
+  Ss_.resize(2 * m, 4 * n);
+  S_part_.resize(2 * m, 4 * n);
 }
 
 void IntervalInterpolant::point(double s, const Eigen::VectorXd& y, const Eigen::MatrixXd& S,
@@ -70,9 +82,12 @@ void IntervalInterpolant::point(double s, const Eigen::VectorXd& y, const Eigen:
     if (derivatives) {
       dynamics::rnea_derivatives(model_, data_, p.q, p.qd, p.qdd);
       if (with_tau) {
-        p.dtau.noalias() = data_.dtau_dq * p.dq;
-        p.dtau.noalias() += data_.dtau_dqd * p.dqd;
-        p.dtau.noalias() += data_.M * p.dqdd;
+        // Each input block b moves every joint by the same coefficient: dτ_b = Σ c_b ∂τ/∂x.
+        p.dtau.resize(n, 4 * n);
+        for (int b = 0; b < 4; ++b) {
+          p.dtau.middleCols(b * n, n) = cq[b] * data_.dtau_dq + cv[b] * data_.dtau_dqd;
+          p.dtau.middleCols(b * n, n) += ca[b] * data_.M;
+        }
       }
     } else {
       dynamics::rnea(model_, data_, p.q, p.qd, p.qdd);
@@ -132,24 +147,25 @@ void IntervalInterpolant::rk4_step(double s, double len, const Eigen::VectorXd& 
       if (derivatives) Ss_ = S + c[i] * len * dk_[i - 1];
     }
     point(s + c[i] * len, ys_, Ss_, derivatives, false, stage_);
-    k_[i].resize(2 * m);
-    k_[i] << stage_.qd(unactuated_), stage_.qdd(unactuated_);
-    if (derivatives) {
-      dk_[i].resize(2 * m, stage_.dq.cols());
-      dk_[i] << stage_.dqd(unactuated_, Eigen::all),
-          stage_.dqdd(unactuated_, Eigen::all);
+    for (int a = 0; a < m; ++a) {
+      const int u = unactuated_[a];
+      k_[i][a] = stage_.qd[u];
+      k_[i][m + a] = stage_.qdd[u];
+      if (derivatives) {
+        dk_[i].row(a) = stage_.dqd.row(u);
+        dk_[i].row(m + a) = stage_.dqdd.row(u);
+      }
     }
   }
   y1 = y + len / 6 * (k_[0] + 2 * k_[1] + 2 * k_[2] + k_[3]);
   if (derivatives) S1 = S + len / 6 * (dk_[0] + 2 * dk_[1] + 2 * dk_[2] + dk_[3]);
 }
 
-void IntervalInterpolant::evaluate(const Eigen::Ref<const Eigen::VectorXd>& q0,
-                                   const Eigen::Ref<const Eigen::VectorXd>& qd0,
-                                   const Eigen::Ref<const Eigen::VectorXd>& qdd0,
-                                   const Eigen::Ref<const Eigen::VectorXd>& qdd1, double dt,
-                                   const std::vector<double>& s, bool derivatives,
-                                   std::vector<InterpolantPoint>& out) {
+void IntervalInterpolant::start(const Eigen::Ref<const Eigen::VectorXd>& q0,
+                                const Eigen::Ref<const Eigen::VectorXd>& qd0,
+                                const Eigen::Ref<const Eigen::VectorXd>& qdd0,
+                                const Eigen::Ref<const Eigen::VectorXd>& qdd1, double dt,
+                                bool derivatives) {
   const int n = model_.nq(), m = static_cast<int>(unactuated_.size());
   if (q0.size() != n || qd0.size() != n || qdd0.size() != n || qdd1.size() != n) {
     throw std::invalid_argument("interpolant: knot vectors must have one entry per joint");
@@ -160,39 +176,67 @@ void IntervalInterpolant::evaluate(const Eigen::Ref<const Eigen::VectorXd>& q0,
   qdd0_ = qdd0;
   qdd1_ = qdd1;
   dt_ = dt;
-  out.resize(s.size());
-  Eigen::VectorXd y(2 * m), y_next;
-  Eigen::MatrixXd S, S_next;
-  y << q0(unactuated_), qd0(unactuated_);
+  derivatives_ = derivatives;
+  steps_ = integration_steps(dt);
+  h_ = dt / steps_;
+  if (m == 0) return;
+  // Grow-only node storage: intervals of one plan share their step count.
+  if (static_cast<int>(y_.size()) < steps_ + 1) {
+    y_.resize(steps_ + 1, Eigen::VectorXd(2 * m));
+    S_.resize(steps_ + 1, Eigen::MatrixXd(2 * m, 4 * n));
+  }
+  for (int i = 0; i < m; ++i) {
+    y_[0][i] = q0[unactuated_[i]];
+    y_[0][m + i] = qd0[unactuated_[i]];
+  }
   if (derivatives) {
-    S.setZero(2 * m, 4 * n);
+    S_[0].setZero();
     for (int i = 0; i < m; ++i) {
-      S(i, unactuated_[i]) = 1;
-      S(m + i, n + unactuated_[i]) = 1;
+      S_[0](i, unactuated_[i]) = 1;
+      S_[0](m + i, n + unactuated_[i]) = 1;
     }
   }
-  const int steps = integration_steps(dt);
-  const double h = dt / steps, tiny = 1e-12 * dt;
-  int node = 0;  // y, S hold the state at node·h
+  for (int node = 0; node < steps_; ++node) {
+    rk4_step(node * h_, h_, y_[node], S_[node], derivatives, y_[node + 1], S_[node + 1]);
+  }
+}
+
+void IntervalInterpolant::at(double s, bool derivatives, InterpolantPoint& p) {
+  const double tiny = 1e-12 * dt_;
+  if (!(s >= -tiny && s <= dt_ + tiny)) {
+    throw std::invalid_argument("interpolant: sample time outside [0, dt]");
+  }
+  if (derivatives && !derivatives_) {
+    throw std::invalid_argument("interpolant: derivatives asked of an interval started without");
+  }
+  if (unactuated_.empty()) {
+    point(s, y_part_, S_part_, derivatives, true, p);
+    return;
+  }
+  // The node at or before s; a time on a node reads it, others take a partial step from it.
+  const int node = std::min(steps_, static_cast<int>(std::floor((s + tiny) / h_)));
+  const double rest = s - node * h_;
+  if (rest <= tiny) {
+    point(node * h_, y_[node], S_[node], derivatives, true, p);
+    return;
+  }
+  rk4_step(node * h_, rest, y_[node], S_[node], derivatives, y_part_, S_part_);
+  point(s, y_part_, S_part_, derivatives, true, p);
+}
+
+void IntervalInterpolant::evaluate(const Eigen::Ref<const Eigen::VectorXd>& q0,
+                                   const Eigen::Ref<const Eigen::VectorXd>& qd0,
+                                   const Eigen::Ref<const Eigen::VectorXd>& qdd0,
+                                   const Eigen::Ref<const Eigen::VectorXd>& qdd1, double dt,
+                                   const std::vector<double>& s, bool derivatives,
+                                   std::vector<InterpolantPoint>& out) {
+  start(q0, qd0, qdd0, qdd1, dt, derivatives);
+  out.resize(s.size());
   for (size_t i = 0; i < s.size(); ++i) {
-    if (!(s[i] >= -tiny && s[i] <= dt + tiny) || (i > 0 && s[i] < s[i - 1])) {
+    if (i > 0 && s[i] < s[i - 1]) {
       throw std::invalid_argument("interpolant: sample times must ascend within [0, dt]");
     }
-    if (m > 0) {
-      while (node < steps && s[i] >= (node + 1) * h - tiny) {
-        rk4_step(node * h, h, y, S, derivatives, y_next, S_next);
-        y.swap(y_next);
-        S.swap(S_next);
-        ++node;
-      }
-      const double rest = s[i] - node * h;
-      if (rest > tiny) {  // a partial step from the last node; the nodes stay on the grid
-        rk4_step(node * h, rest, y, S, derivatives, y_next, S_next);
-        point(s[i], y_next, S_next, derivatives, true, out[i]);
-        continue;
-      }
-    }
-    point(m > 0 ? node * h : s[i], y, S, derivatives, true, out[i]);
+    at(s[i], derivatives, out[i]);
   }
 }
 

@@ -39,14 +39,26 @@ struct InterpolantPoint {
 };
 
 /// The interpolant of one interval for one robot, with its own workspace (not thread-safe).
+/// Allocates nothing once it has seen an interval of the same number of RK4 steps.
 class IntervalInterpolant {
  public:
   /// Borrows `model`, which must outlive this.
   explicit IntervalInterpolant(const dynamics::Model& model);
 
-  /// The points at times `s` (ascending, in [0, dt]) of the interval that starts at the knot
-  /// (q0, qd0, qdd0) and ends, dt later, with acceleration qdd1; `out` is resized to match.
-  /// With `derivatives`, the d* members are filled too.
+  /// Starts the interval from the knot (q0, qd0, qdd0) that ends, dt later, with acceleration
+  /// qdd1: integrates the unactuated joints to every RK4 node, with their sensitivities when
+  /// `derivatives`. Throws std::invalid_argument if a vector has not one entry per joint or
+  /// dt ≤ 0.
+  void start(const Eigen::Ref<const Eigen::VectorXd>& q0,
+             const Eigen::Ref<const Eigen::VectorXd>& qd0,
+             const Eigen::Ref<const Eigen::VectorXd>& qdd0,
+             const Eigen::Ref<const Eigen::VectorXd>& qdd1, double dt, bool derivatives);
+  /// The point s seconds into the started interval (s in [0, dt]: one shorter RK4 step from the
+  /// node before s). `derivatives` also fills the d* members and needs a start() with them.
+  /// Throws std::invalid_argument for s outside [0, dt] or derivatives without them.
+  void at(double s, bool derivatives, InterpolantPoint& p);
+
+  /// start() and at() for the times `s` (ascending, in [0, dt]); `out` is resized to match.
   void evaluate(const Eigen::Ref<const Eigen::VectorXd>& q0,
                 const Eigen::Ref<const Eigen::VectorXd>& qd0,
                 const Eigen::Ref<const Eigen::VectorXd>& qdd0,
@@ -58,8 +70,8 @@ class IntervalInterpolant {
   const std::vector<int>& actuated() const { return actuated_; }
 
  private:
-  // The point at time s with the unactuated state y = [q_u; q̇_u] and its sensitivity S = dy/dz;
-  // without with_tau (RK4 stages) τ and dτ are left stale.
+  // The state at time s with the unactuated state y = [q_u; q̇_u] and its sensitivity S = dy/dz
+  // (q, q̇, q̈ and with derivatives their d*); with_tau adds τ (and dτ).
   void point(double s, const Eigen::VectorXd& y, const Eigen::MatrixXd& S, bool derivatives,
              bool with_tau, InterpolantPoint& p);
   // One RK4 step of length len from (s, y, S) into (y1, S1).
@@ -69,15 +81,19 @@ class IntervalInterpolant {
   const dynamics::Model& model_;
   dynamics::Data data_;
   std::vector<int> unactuated_, actuated_;
-  // The current interval's inputs.
+  // The current interval: inputs, RK4 step and the state (and sensitivity) at every node.
   Eigen::VectorXd q0_, qd0_, qdd0_, qdd1_;
-  double dt_ = 0;
+  double dt_ = 0, h_ = 0;
+  int steps_ = 0;
+  bool derivatives_ = false;
+  std::vector<Eigen::VectorXd> y_;
+  std::vector<Eigen::MatrixXd> S_;
   // Scratch.
   InterpolantPoint stage_;
   Eigen::VectorXd k_[4];
   Eigen::MatrixXd dk_[4];
-  Eigen::VectorXd ys_;
-  Eigen::MatrixXd Ss_;
+  Eigen::VectorXd ys_, y_part_;
+  Eigen::MatrixXd Ss_, S_part_;
   Eigen::VectorXd tau0_, tau0u_, fu_;
   Eigen::MatrixXd muu_, rhs_;
   Eigen::LLT<Eigen::MatrixXd> llt_;

@@ -4,7 +4,9 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <memory>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "kinograph/collision/obstacle.h"
@@ -46,11 +48,27 @@ struct Objectives {
   /// Number of interpolated states checked for collision between consecutive steps by the
   /// planner's collision factors (0 = only at the steps).
   int collision_substeps = 1;
+  /// Safety distance (m) the planner keeps between two links of the robot and between a link
+  /// and the floor: smaller than ε, since an arm's own links pass close by design (links two
+  /// joints apart are 4.5 cm apart on the iiwa) and it works close to the floor it stands on.
+  double self_collision_epsilon = 0.01;
   /// Number of interior points per interval (evenly spaced) where the planner enforces the
   /// effort, q and q̇ limits on the interpolant, raised to one per RK4 node of the interpolant
   /// (limit_points in interpolant.h); 0 = only at the knots. The default matches the
   /// validator's 10 samples per interval.
   int limit_substeps = 9;
+};
+
+/// What the robot must clear besides the obstacles: its own links and the floor.
+struct SelfAndFloor {
+  /// Check every pair of links that are neither the same nor parent and child.
+  bool self_collision = true;
+  /// Body pairs (Model::bodies indices, −1 = the base) allowed to touch, never checked (an
+  /// SRDF's disable_collisions, the scene's allowed_collisions).
+  std::vector<std::pair<int, int>> allowed_pairs;
+  /// World height (m) of a floor (the half-space below it) that every moving link and the
+  /// payload must clear; no floor when unset. The base is not checked: it stands on it.
+  std::optional<double> floor;
 };
 
 /// A kinodynamic planning problem: move from (start_q, start_qd) to the goal in `horizon`
@@ -66,6 +84,7 @@ struct Problem {
   std::vector<collision::Obstacle> obstacles;
   std::vector<TaskConstraint> task_constraints;
   Objectives objectives;
+  SelfAndFloor self_and_floor;
 
   /// Time between consecutive states (s).
   double dt() const { return horizon / steps; }

@@ -1,10 +1,15 @@
 #include "kinograph/planning/problem_check.h"
 
 #include <cmath>
+#include <memory>
 #include <sstream>
 
 #include "kinograph/collision/collision_world.h"
+#include "kinograph/dynamics/inverse_dynamics.h"
 #include "kinograph/dynamics/kinematics.h"
+#include "kinograph/planning/clearance_world.h"
+#include "kinograph/planning/motion_bounds.h"
+#include "kinograph/planning/user_terms.h"
 
 namespace kinograph::planning {
 namespace {
@@ -15,19 +20,110 @@ std::string joint_list_outside(const dynamics::Model& model, const Eigen::Vector
   for (int j = 0; j < model.nq(); ++j) {
     const auto& l = model.bodies[j].limits;
     if (q[j] < l.lower || q[j] > l.upper) {
-      os << what << " joint '" << model.bodies[j].joint_name << "' = " << q[j] << " is outside ["
-         << l.lower << ", " << l.upper << "]; ";
+      const std::string u = joint_unit(model, j, 0);
+      os << what << " " << joint_label(model, j) << " = " << number(q[j]) << " " << u
+         << " is outside its limits [" << number(l.lower) << ", " << number(l.upper) << "] " << u
+         << "; ";
     }
   }
   return os.str();
 }
 
-double min_clearance(const Problem& problem, const Eigen::VectorXd& q) {
-  collision::CollisionWorld world(*problem.model);
-  for (const auto& o : problem.obstacles) world.add_obstacle(o);
+// The start velocity within the limits, and able to stop before a position limit.
+std::string check_start_velocity(const dynamics::Model& model, const Eigen::VectorXd& q0,
+                                 const Eigen::VectorXd& v0) {
+  for (int j = 0; j < model.nq(); ++j) {
+    const dynamics::JointLimits& l = model.bodies[j].limits;
+    const std::string u = joint_unit(model, j, 0), uv = joint_unit(model, j, 1);
+    if (std::abs(v0[j]) > l.velocity) {
+      return joint_label(model, j) + " starts at " + number(v0[j]) + " " + uv +
+             ", beyond its velocity limit " + number(l.velocity) + " " + uv;
+    }
+    const double stop = stopping_distance(v0[j], l.acceleration);
+    const double room = v0[j] > 0 ? l.upper - q0[j] : q0[j] - l.lower;
+    if (v0[j] != 0 && stop > room) {
+      return joint_label(model, j) + " starts at " + number(v0[j]) + " " + uv + " and needs " +
+             number(stop) + " " + u + " to stop within its acceleration limit " +
+             number(l.acceleration) + " " + joint_unit(model, j, 2) + ", but its " +
+             (v0[j] > 0 ? "upper" : "lower") + " position limit is " + number(room) + " " + u +
+             " away";
+    }
+  }
+  return "";
+}
+
+// The horizon at least the time each joint needs alone under its velocity and acceleration
+// limits (a true lower bound: coupling and torque limits only make a motion slower).
+std::string check_horizon(const Problem& p) {
+  if (p.goal.kind != Goal::Kind::kJoint) return "";
+  const dynamics::Model& model = *p.model;
+  for (int j = 0; j < model.nq(); ++j) {
+    const dynamics::JointLimits& l = model.bodies[j].limits;
+    const double v0 = p.start_qd.size() == model.nq() ? p.start_qd[j] : 0.0;
+    const double d = p.goal.q[j] - p.start_q[j];
+    const double t = min_time_to_rest(d, v0, l.velocity, l.acceleration);
+    // Relative slack for the rounding of the closed form only; a horizon at the bound passes.
+    if (!(t > p.horizon * (1 + 1e-9))) continue;
+    const std::string u = joint_unit(model, j, 0), uv = joint_unit(model, j, 1);
+    std::string why = joint_label(model, j) + " must move " + number(std::abs(d)) + " " + u;
+    if (v0 != 0) why += " from " + number(v0) + " " + uv;
+    if (l.velocity == 0) return why + " but its velocity limit is 0";
+    const auto [needs, horizon] = distinct_numbers(t, p.horizon);
+    why += " and needs " + needs + " s at its velocity limit " + number(l.velocity) + " " + uv;
+    if (std::isfinite(l.acceleration)) {
+      why += " and acceleration limit " + number(l.acceleration) + " " + joint_unit(model, j, 2);
+    }
+    return why + "; the horizon is " + horizon + " s";
+  }
+  return "";
+}
+
+// At the goal the robot rests, so each joint must hold the gravity torque there: an unactuated
+// joint none, an actuated one within its effort. The margin covers how far a plan may end from
+// the goal at rest and still validate (5× the validator's default 0.01 goal and final-velocity
+// tolerances, through the torque's first derivatives, doubled), so only sure cases are refused.
+std::string check_goal_holding(const Problem& p) {
+  if (p.goal.kind != Goal::Kind::kJoint) return "";
+  const dynamics::Model& model = *p.model;
+  const int n = model.nq();
+  dynamics::Data data(model);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
+  dynamics::rnea_derivatives(model, data, p.goal.q, zero, zero);
+  constexpr double kSlack = 0.05;
+  for (int j = 0; j < n; ++j) {
+    const double tau = data.tau[j];
+    const double margin =
+        2 * kSlack *
+            (data.dtau_dq.row(j).cwiseAbs().sum() + data.M.row(j).cwiseAbs().sum() +
+             data.dtau_dqd.row(j).cwiseAbs().sum()) +
+        2e-3;
+    const dynamics::Body& b = model.bodies[j];
+    const std::string u = joint_unit(model, j, 3);
+    if (!b.actuated && std::abs(tau) > margin) {
+      return "at the goal the robot is at rest, and " + joint_label(model, j) +
+             " is unactuated but would have to hold " + number(tau) + " " + u + " against gravity";
+    }
+    if (b.actuated && std::abs(tau) > b.limits.effort + margin) {
+      return "at the goal the robot is at rest, and " + joint_label(model, j) + " needs " +
+             number(tau) + " " + u + " to hold it against gravity, over its " +
+             number(b.limits.effort) + " " + u + " effort limit";
+    }
+  }
+  return "";
+}
+
+// Why configuration q (the start or the goal) is in collision, naming the pair and the depth;
+// empty when it is clear of obstacles, the floor and its own links.
+std::string collision_at(const Problem& problem, const Eigen::VectorXd& q, const char* what) {
+  const std::unique_ptr<collision::CollisionWorld> world = clearance_world(problem);
   dynamics::Data data(*problem.model);
   dynamics::forward_kinematics(*problem.model, data, q);
-  return world.closest(data, 0).distance;
+  const collision::Proximity p = world->closest(data, 0);
+  if (!(p.distance < 0)) return "";
+  std::ostringstream os;
+  os << "the " << what << " configuration is in collision: " << describe_pair(*problem.model, p)
+     << " overlap by " << -p.distance << " m";
+  return os.str();
 }
 
 }  // namespace
@@ -45,10 +141,14 @@ std::string check_problem(const Problem& p) {
   if (!p.start_q.allFinite() || !p.start_qd.allFinite()) return "start state holds NaN or inf";
   if (!(p.objectives.qc > 0) || !std::isfinite(p.objectives.qc)) return "Qc must be positive";
   if (!(p.objectives.min_torque >= 0) || !(p.objectives.collision_epsilon >= 0) ||
-      !(p.objectives.limit_epsilon >= 0))
+      !(p.objectives.self_collision_epsilon >= 0) || !(p.objectives.limit_epsilon >= 0))
     return "objective weights and margins must be non-negative numbers";
   std::string r = joint_list_outside(model, p.start_q, "start");
   if (!r.empty()) return r;
+  if (p.start_qd.size() == n) {
+    r = check_start_velocity(model, p.start_q, p.start_qd);
+    if (!r.empty()) return r;
+  }
   if (p.goal.kind == Goal::Kind::kJoint) {
     if (p.goal.q.size() != n) return "joint goal has the wrong size";
     if (!p.goal.q.allFinite()) return "joint goal holds NaN or inf";
@@ -62,6 +162,10 @@ std::string check_problem(const Problem& p) {
       return "goal frame '" + p.goal.frame + "' is not in the model";
     }
   }
+  r = check_horizon(p);
+  if (!r.empty()) return r;
+  r = check_goal_holding(p);
+  if (!r.empty()) return r;
   for (const auto& t : p.task_constraints) {
     try {
       model.frame_index(t.frame);
@@ -69,11 +173,11 @@ std::string check_problem(const Problem& p) {
       return "task-constraint frame '" + t.frame + "' is not in the model";
     }
   }
-  if (!p.obstacles.empty()) {
+  if (has_clearance_checks(p)) {
     try {
-      if (min_clearance(p, p.start_q) < 0) return "the start configuration is in collision";
-      if (p.goal.kind == Goal::Kind::kJoint && min_clearance(p, p.goal.q) < 0)
-        return "the goal configuration is in collision";
+      r = collision_at(p, p.start_q, "start");
+      if (r.empty() && p.goal.kind == Goal::Kind::kJoint) r = collision_at(p, p.goal.q, "goal");
+      if (!r.empty()) return r;
     } catch (const std::exception& e) {
       return std::string("bad obstacle: ") + e.what();
     }

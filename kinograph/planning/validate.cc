@@ -9,8 +9,10 @@
 #include "kinograph/collision/segment_checker.h"
 #include "kinograph/dynamics/inverse_dynamics.h"
 #include "kinograph/dynamics/kinematics.h"
+#include "kinograph/planning/clearance_world.h"
 #include "kinograph/planning/factors/pose_error.h"
 #include "kinograph/planning/trajectory_sampler.h"
+#include "kinograph/planning/user_terms.h"
 
 namespace kinograph::planning {
 namespace {
@@ -195,32 +197,56 @@ void check_physics(const Problem& problem, const Plan& plan, const ValidationThr
   }
 }
 
-// The start state and the goal (at rest).
+// The start state and the goal (at rest), naming the joint or frame that misses.
 void check_start_and_goal(const Problem& problem, const Plan& plan,
                           const ValidationThresholds& thresholds, dynamics::Data& data,
                           Validation& v) {
   const dynamics::Model& model = *problem.model;
   const int n = model.nq(), N = problem.steps;
-  if (problem.start_q.size() == n) {
-    v.start_error = (plan.q.row(0).transpose() - problem.start_q).cwiseAbs().maxCoeff();
-  }
-  if (problem.start_qd.size() == n) {
-    v.start_error = std::max(v.start_error,
-                             (plan.qd.row(0).transpose() - problem.start_qd).cwiseAbs().maxCoeff());
-  }
+  const double t_end = plan.t.size() == static_cast<size_t>(N + 1) ? plan.t[N] : problem.horizon;
+  std::string start_worst;
+  const auto start_row = [&](const Eigen::MatrixXd& x, const Eigen::VectorXd& target, int d) {
+    for (int j = 0; j < n; ++j) {
+      const double e = std::abs(x(0, j) - target[j]);
+      if (e <= v.start_error) continue;
+      v.start_error = e;
+      start_worst = joint_label(model, j) + (d == 0 ? " position " : " velocity ") +
+                    number(x(0, j)) + " " + joint_unit(model, j, d) + " instead of " +
+                    number(target[j]);
+    }
+  };
+  if (problem.start_q.size() == n) start_row(plan.q, problem.start_q, 0);
+  if (problem.start_qd.size() == n) start_row(plan.qd, problem.start_qd, 1);
   if (v.start_error > thresholds.start)
-    add_failure(v, fmt("start state error", v.start_error, thresholds.start));
-  v.final_velocity =
-      std::max(plan.qd.row(N).cwiseAbs().maxCoeff(), plan.qdd.row(N).cwiseAbs().maxCoeff());
+    add_failure(v, fmt("start state error", v.start_error, thresholds.start) + " (" + start_worst +
+                       " at t = 0)");
+  std::string final_worst;
+  for (int j = 0; j < n; ++j) {
+    for (int d = 1; d <= 2; ++d) {
+      const double x = d == 1 ? plan.qd(N, j) : plan.qdd(N, j);
+      if (std::abs(x) <= v.final_velocity) continue;
+      v.final_velocity = std::abs(x);
+      final_worst = joint_label(model, j) + (d == 1 ? " velocity " : " acceleration ") + number(x) +
+                    " " + joint_unit(model, j, d);
+    }
+  }
   if (v.final_velocity > thresholds.final_velocity)
     add_failure(v, fmt("final velocity/acceleration (goal is at rest)", v.final_velocity,
-                       thresholds.final_velocity));
+                       thresholds.final_velocity) +
+                       " (" + final_worst + " at " + at_time(t_end) + ")");
   const Eigen::VectorXd q_final = plan.q.row(N).transpose();
+  std::string goal_worst;
   if (problem.goal.kind == Goal::Kind::kJoint) {
     if (problem.goal.q.size() != n) {
       add_failure(v, "joint goal has the wrong size");
     } else {
-      v.goal_error = (q_final - problem.goal.q).cwiseAbs().maxCoeff();
+      for (int j = 0; j < n; ++j) {
+        const double e = std::abs(q_final[j] - problem.goal.q[j]);
+        if (e <= v.goal_error) continue;
+        v.goal_error = e;
+        goal_worst = joint_label(model, j) + " ends at " + number(q_final[j]) + " " +
+                     joint_unit(model, j, 0) + ", its goal is " + number(problem.goal.q[j]);
+      }
     }
   } else {
     int frame = -1;
@@ -233,16 +259,23 @@ void check_start_and_goal(const Problem& problem, const Plan& plan,
       dynamics::forward_kinematics(model, data, q_final);
       const PoseError e = pose_error(dynamics::frame_pose(model, data, frame), problem.goal.pose);
       v.goal_error = problem.goal.position_only ? e.position : std::max(e.position, e.rotation);
+      goal_worst = "frame '" + problem.goal.frame + "' ends " + number(e.position) +
+                   " m from its goal position" +
+                   (problem.goal.position_only
+                        ? ""
+                        : " and " + number(e.rotation) + " rad from its goal orientation");
     }
   }
   if (v.goal_error > thresholds.goal)
-    add_failure(v, fmt("goal error", v.goal_error, thresholds.goal));
+    add_failure(v, fmt("goal error", v.goal_error, thresholds.goal) + " (" + goal_worst + " at " +
+                       at_time(t_end) + ")");
 }
 
-// Task constraints at every step.
+// Task constraints at every step, naming the frame and the time of the worst step.
 void check_tasks(const Problem& problem, const Plan& plan, dynamics::Data& data, Validation& v) {
   const dynamics::Model& model = *problem.model;
   const int rows = problem.steps + 1;
+  const bool timed = plan.t.size() == static_cast<size_t>(rows);
   for (const TaskConstraint& task : problem.task_constraints) {
     int frame = -1;
     try {
@@ -252,61 +285,72 @@ void check_tasks(const Problem& problem, const Plan& plan, dynamics::Data& data,
       continue;
     }
     double worst = 0;
+    int worst_step = 0;
     for (int k = 0; k < rows; ++k) {
       dynamics::forward_kinematics(model, data, plan.q.row(k).transpose());
       const PoseError e = pose_error(dynamics::frame_pose(model, data, frame), task.target);
-      worst =
-          std::max(worst, task.orientation_only ? e.rotation : std::max(e.rotation, e.position));
+      const double err = task.orientation_only ? e.rotation : std::max(e.rotation, e.position);
+      if (err > worst) {
+        worst = err;
+        worst_step = k;
+      }
     }
     v.max_task_error = std::max(v.max_task_error, worst);
     if (worst > task.tolerance)
       add_failure(v,
-                  fmt(("task constraint on '" + task.frame + "'").c_str(), worst, task.tolerance));
+                  fmt(("task constraint on '" + task.frame + "'").c_str(), worst, task.tolerance) +
+                      " at " + at_time(timed ? plan.t[worst_step] : worst_step * problem.dt()));
   }
 }
 
-// Collision: every step and dense samples along the validator's Hermite interpolation.
+// Clearance (obstacles, the floor, self pairs): every step and dense samples along the
+// validator's Hermite interpolation; a failure names the closest pair, its time and depth.
 void check_collision(const Problem& problem, const Plan& plan,
                      const ValidationThresholds& thresholds, dynamics::Data& data, Validation& v) {
   const dynamics::Model& model = *problem.model;
   const int n = model.nq(), N = problem.steps, rows = N + 1;
   const double dt = problem.dt();
-  collision::CollisionWorld world(model);
-  bool ok = true;
-  for (const collision::Obstacle& o : problem.obstacles) {
-    const collision::Status s = world.add_obstacle(o);
-    if (!s.ok) {
-      add_failure(v, "obstacle " + std::to_string(o.id) + ": " + s.reason);
-      ok = false;
+  std::unique_ptr<collision::CollisionWorld> world;
+  try {
+    world = clearance_world(problem);
+  } catch (const std::invalid_argument& e) {
+    add_failure(v, e.what());
+    return;
+  }
+  // The validator's Hermite interpolation sampled `sub` times per interval, walked by
+  // conservative advancement: stretches far from everything cost one query, and near
+  // something the samples are as dense as the segment checker's sweep step.
+  collision::SegmentChecker checker(model);
+  const int sub = std::max(1, thresholds.collision_samples);
+  Eigen::MatrixXd path(N * sub + 1, n);
+  std::vector<double> times(N * sub + 1);
+  const bool timed = plan.t.size() == static_cast<size_t>(rows);
+  for (int k = 0; k < N; ++k) {
+    for (int i = 0; i < sub; ++i) {
+      const double s = static_cast<double>(i) / sub;
+      path.row(k * sub + i) =
+          i == 0 ? Eigen::VectorXd(plan.q.row(k).transpose()) : hermite(plan, k, s, dt);
+      times[k * sub + i] = (timed ? plan.t[k] : k * dt) + s * dt;
     }
   }
-  if (ok) {
-    // The validator's Hermite interpolation sampled `sub` times per interval, walked by
-    // conservative advancement: stretches far from every obstacle cost one query, and near
-    // one the samples are as dense as the segment checker's sweep step.
-    collision::SegmentChecker checker(model);
-    const int sub = std::max(1, thresholds.collision_samples);
-    Eigen::MatrixXd path(N * sub + 1, n);
-    std::vector<double> times(N * sub + 1);
-    const bool timed = plan.t.size() == static_cast<size_t>(rows);
-    for (int k = 0; k < N; ++k) {
-      for (int i = 0; i < sub; ++i) {
-        const double s = static_cast<double>(i) / sub;
-        path.row(k * sub + i) =
-            i == 0 ? Eigen::VectorXd(plan.q.row(k).transpose()) : hermite(plan, k, s, dt);
-        times[k * sub + i] = (timed ? plan.t[k] : k * dt) + s * dt;
-      }
+  path.row(N * sub) = plan.q.row(N);
+  times[N * sub] = timed ? plan.t[N] : N * dt;
+  const collision::PathCheckResult r =
+      checker.check_path(*world, data, path, times, thresholds.min_clearance);
+  v.min_clearance = std::min(v.min_clearance, r.min_distance);
+  if (r.min_distance < thresholds.min_clearance) {
+    const size_t at = std::min(static_cast<size_t>(r.segment), times.size() - 1);
+    const double t =
+        at + 1 < times.size() ? times[at] + r.s * (times[at + 1] - times[at]) : times[at];
+    std::ostringstream os;
+    os << "collision: " << describe_pair(model, r.closest);
+    if (r.min_distance < 0) {
+      os << " overlap by " << -r.min_distance << " m";
+    } else {
+      os << " are " << r.min_distance << " m apart";
     }
-    path.row(N * sub) = plan.q.row(N);
-    times[N * sub] = timed ? plan.t[N] : N * dt;
-    const collision::PathCheckResult r =
-        checker.check_path(world, data, path, times, thresholds.min_clearance);
-    v.min_clearance = std::min(v.min_clearance, r.min_distance);
-    if (v.min_clearance < thresholds.min_clearance) {
-      std::ostringstream os;
-      os << "collision: clearance " << v.min_clearance << " m below " << thresholds.min_clearance;
-      add_failure(v, os.str());
-    }
+    os << " at t = " << t << " s (required clearance " << thresholds.min_clearance << " m)";
+    add_failure(v, os.str());
   }
 }
 
@@ -321,7 +365,7 @@ Validation validate(const Problem& problem, const Plan& plan,
   check_start_and_goal(problem, plan, thresholds, data, v);
   check_tasks(problem, plan, data, v);
   // The only costly check; a caller that only needs the verdict skips it once another failed.
-  if (!problem.obstacles.empty() && !(verdict_only && !v.failures.empty())) {
+  if (has_clearance_checks(problem) && !(verdict_only && !v.failures.empty())) {
     check_collision(problem, plan, thresholds, data, v);
   }
   v.valid = v.failures.empty();

@@ -12,6 +12,7 @@
 #include <condition_variable>
 #include <lcm/lcm-cpp.hpp>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <thread>
 
@@ -40,8 +41,9 @@ goal:
 class Listener {
  public:
   explicit Listener(lcm::LCM& lcm) {
-    lcm.subscribe("RR_PLAN", &Listener::on_plan, this);
-    lcm.subscribe("RR_PLANNER_STATUS", &Listener::on_status, this);
+    // A burst of answers must not overflow LCM's default 30-message queue here.
+    lcm.subscribe("RR_PLAN", &Listener::on_plan, this)->setQueueCapacity(100000);
+    lcm.subscribe("RR_PLANNER_STATUS", &Listener::on_status, this)->setQueueCapacity(100000);
   }
   void on_plan(const lcm::ReceiveBuffer* rbuf, const std::string&) {
     plan_t msg;
@@ -63,6 +65,21 @@ class Listener {
     cv_.wait_for(lock, std::chrono::duration<double>(timeout_s),
                  [&] { return plans_.size() >= count; });
     return plans_;
+  }
+  // Waits until a heartbeat accounts for `answered` goals; returns the first that does.
+  std::optional<planner_status_t> wait_status_answered(int64_t answered, double timeout_s = 30) {
+    std::unique_lock lock(mutex_);
+    std::optional<planner_status_t> found;
+    cv_.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] {
+      for (const auto& s : statuses_) {
+        if (s.num_goals_answered >= answered) {
+          found = s;
+          return true;
+        }
+      }
+      return false;
+    });
+    return found;
   }
   // Waits until some status message mentions `text`.
   bool wait_status_containing(const std::string& text, double timeout_s = 10) {
@@ -86,15 +103,26 @@ class Listener {
 class NodeFixture : public ::testing::Test {
  protected:
   void SetUp() override {
-    start(planning::parse_scene(kScene, std::string(KINOGRAPH_SOURCE_DIR) + "/scene.yaml"));
+    if (!defer_start_) start(default_scene());
   }
   void start(planning::Scene scene, PlannerNodeOptions options = {}) {
+    create(std::move(scene), options);
+    run();
+  }
+  // The node subscribes when created; what is published before run() waits in LCM's queues,
+  // as during a stall.
+  void create(planning::Scene scene, PlannerNodeOptions options = {}) {
     ASSERT_TRUE(lcm_.good());
     options.channel_prefix = "RR";
     options.status_period_s = 0.2;
     node_ = std::make_unique<PlannerNode>(std::move(scene), options, &lcm_);
     listener_ = std::make_unique<Listener>(lcm_);
+  }
+  void run() {
     thread_ = std::thread([this] { node_->run(stop_); });
+  }
+  static planning::Scene default_scene() {
+    return planning::parse_scene(kScene, std::string(KINOGRAPH_SOURCE_DIR) + "/scene.yaml");
   }
   void TearDown() override {
     stop_ = true;
@@ -127,6 +155,7 @@ class NodeFixture : public ::testing::Test {
   }
 
   lcm::LCM lcm_{"memq://"};
+  bool defer_start_ = false;  // set by fixtures that create and run the node themselves
   std::atomic<bool> stop_{false};
   std::unique_ptr<PlannerNode> node_;
   std::unique_ptr<Listener> listener_;
@@ -171,6 +200,10 @@ TEST_F(NodeFixture, AnInvalidGoalIsAnsweredWithInvalidGoal) {
   ASSERT_EQ(plans.size(), 2u);
   EXPECT_EQ(plans[1].goal_id, 14);
   EXPECT_EQ(plans[1].status, plan_t::INVALID_GOAL) << plans[1].status_message;
+  // The answer carries the planner's reason in the user's terms.
+  EXPECT_NE(plans[1].status_message.find("goal joint 1 (joint1) = 10 rad is outside its limits"),
+            std::string::npos)
+      << plans[1].status_message;
 }
 
 TEST_F(NodeFixture, AnObstacleInThePathTriggersACollisionFreeReplan) {
@@ -216,13 +249,13 @@ TEST_F(NodeFixture, AnObstacleInThePathTriggersACollisionFreeReplan) {
 
 TEST_F(NodeFixture, NewestGoalWinsAndEveryGoalIsAnswered) {
   for (int i = 0; i < 4; ++i) send_goal(20 + i, {0.2 * i, 0.1});
-  // Each goal gets exactly one answer: planned, or cancelled because a newer one came first.
+  // Each goal gets exactly one answer: planned, or superseded because a newer one came first.
   auto plans = listener_->wait_plans(4);
   ASSERT_EQ(plans.size(), 4u);
   std::set<int64_t> answered;
   for (const auto& p : plans) {
     EXPECT_TRUE(answered.insert(p.goal_id).second) << "goal " << p.goal_id << " answered twice";
-    EXPECT_TRUE(p.status == plan_t::SUCCESS || p.status == plan_t::CANCELLED);
+    EXPECT_TRUE(p.status == plan_t::SUCCESS || p.status == plan_t::SUPERSEDED);
   }
   EXPECT_EQ(answered, (std::set<int64_t>{20, 21, 22, 23}));
   const auto newest =
@@ -230,12 +263,106 @@ TEST_F(NodeFixture, NewestGoalWinsAndEveryGoalIsAnswered) {
   EXPECT_EQ(newest->status, plan_t::SUCCESS);
 }
 
+// Goals that piled up while the node was not handling LCM (a stall) are answered whole: the
+// newest planned, every older one SUPERSEDED, and the heartbeat accounts for each.
+class StalledNodeFixture : public NodeFixture {
+ protected:
+  StalledNodeFixture() { defer_start_ = true; }
+};
+
+TEST_F(StalledNodeFixture, ABurstWaitingInLcmIsAnsweredWholeAndOnlyTheNewestPlanned) {
+  create(default_scene());
+  constexpr int kBurst = 40;  // more than LCM's default queue of 30
+  for (int i = 0; i < kBurst; ++i) send_goal(100 + i, {0.5 + 0.01 * i, -0.2});
+  run();
+  auto plans = listener_->wait_plans(kBurst);
+  ASSERT_EQ(plans.size(), static_cast<size_t>(kBurst));
+  std::set<int64_t> answered;
+  for (const auto& p : plans) {
+    EXPECT_TRUE(answered.insert(p.goal_id).second) << "goal " << p.goal_id << " answered twice";
+    if (p.goal_id == 100 + kBurst - 1) {
+      EXPECT_EQ(p.status, plan_t::SUCCESS) << p.status_message;
+      EXPECT_TRUE(p.valid);
+      EXPECT_NEAR(p.q.back()[0], 0.5 + 0.01 * (kBurst - 1), 1e-3);
+    } else {
+      EXPECT_EQ(p.status, plan_t::SUPERSEDED) << "goal " << p.goal_id;
+      EXPECT_NE(p.status_message.find("superseded by goal 139"), std::string::npos)
+          << p.status_message;
+    }
+  }
+  EXPECT_EQ(answered.size(), static_cast<size_t>(kBurst));
+  const auto status = listener_->wait_status_answered(kBurst);
+  ASSERT_TRUE(status);
+  EXPECT_EQ(status->num_goals_received, kBurst);
+  EXPECT_EQ(status->num_goals_answered, kBurst);
+  EXPECT_EQ(status->num_goals_superseded, kBurst - 1);
+  EXPECT_EQ(status->num_goals_dropped, 0);
+  const NodeCounters c = node_->counters();
+  EXPECT_EQ(c.goals_superseded, kBurst - 1);
+  EXPECT_EQ(c.plans_published, kBurst);
+}
+
+// Goal ids 31 and 32 never arrive: goal 33 reveals the gap, both are answered SUPERSEDED and
+// counted as dropped, and received + dropped = answered.
+TEST_F(NodeFixture, SkippedGoalIdsAreAnsweredAndCountedAsDropped) {
+  send_goal(30, {0.5, 0.1});
+  ASSERT_EQ(listener_->wait_plans(1).size(), 1u);
+  send_goal(33, {0.6, 0.1});
+  auto plans = listener_->wait_plans(4);
+  ASSERT_EQ(plans.size(), 4u);
+  EXPECT_EQ(plans[1].goal_id, 31);
+  EXPECT_EQ(plans[2].goal_id, 32);
+  for (int k : {1, 2}) {
+    EXPECT_EQ(plans[k].status, plan_t::SUPERSEDED);
+    EXPECT_NE(plans[k].status_message.find("lost in transport"), std::string::npos)
+        << plans[k].status_message;
+  }
+  EXPECT_EQ(plans[3].goal_id, 33);
+  EXPECT_EQ(plans[3].status, plan_t::SUCCESS) << plans[3].status_message;
+  const auto status = listener_->wait_status_answered(4);
+  ASSERT_TRUE(status);
+  EXPECT_EQ(status->num_goals_received, 2);
+  EXPECT_EQ(status->num_goals_dropped, 2);
+  EXPECT_EQ(status->num_goals_answered, 4);
+  EXPECT_EQ(status->num_goals_superseded, 2);
+}
+
+// With answer_goal_id_gaps off (ids carry no sequence), a jump in ids answers nothing extra.
+TEST_F(StalledNodeFixture, GoalIdGapsAreIgnoredWhenAsked) {
+  PlannerNodeOptions options;
+  options.answer_goal_id_gaps = false;
+  start(default_scene(), options);
+  send_goal(30, {0.5, 0.1});
+  ASSERT_EQ(listener_->wait_plans(1).size(), 1u);
+  send_goal(33, {0.6, 0.1});
+  // Any answer for 31 or 32 would come before 33's plan (the worker answers first, then plans).
+  auto plans = listener_->wait_plans(2);
+  ASSERT_EQ(plans.size(), 2u);
+  EXPECT_EQ(plans[1].goal_id, 33);
+  EXPECT_EQ(plans[1].status, plan_t::SUCCESS) << plans[1].status_message;
+  const auto status = listener_->wait_status_answered(2);
+  ASSERT_TRUE(status);
+  EXPECT_EQ(status->num_goals_dropped, 0);
+  EXPECT_EQ(status->num_goals_received, 2);
+}
+
+// An invalid goal is received and answered (INVALID_GOAL), so the accounting still closes.
+TEST_F(NodeFixture, AnInvalidGoalCountsAsReceivedAndAnswered) {
+  send_goal(40, {0.5});
+  ASSERT_EQ(listener_->wait_plans(1).size(), 1u);
+  const auto status = listener_->wait_status_answered(1);
+  ASSERT_TRUE(status);
+  EXPECT_EQ(status->num_goals_received, 1);
+  EXPECT_EQ(status->num_goals_answered, 1);
+  EXPECT_EQ(status->num_goals_superseded, 0);
+}
+
 // Replanning on the RR reach scene (robots/scenes/rr_reach.yaml: swing from leaning left to
 // leaning right past a fixed ball above the upright pose). Fixed obstacles come from the scene;
 // the tests add a "pebble" over LCM.
 class ReplanFixture : public NodeFixture {
  protected:
-  void SetUp() override {}
+  ReplanFixture() { defer_start_ = true; }
   void start_reach(PlannerNodeOptions options = {}) {
     scene_ =
         planning::load_scene(std::string(KINOGRAPH_SOURCE_DIR) + "/robots/scenes/rr_reach.yaml");
@@ -532,6 +659,56 @@ TEST_F(ReplanFixture, NaNObstacleIsRejectedWithoutReplanning) {
   const NodeCounters c = node_->counters();
   EXPECT_EQ(c.messages_rejected, 1);
   EXPECT_EQ(c.replans, 0);
+}
+
+// The box of side 1e80 m around the robot that Bullet measured as no collision: refused with a
+// reason, and the next goal is planned in the world without it.
+TEST_F(ReplanFixture, AnAbsurdlyLargeObstacleIsRefused) {
+  start_reach();
+  ASSERT_EQ(plan_goal(1, kGoal, 1).status, plan_t::SUCCESS);
+  obstacle_list_t list{};
+  obstacle_t o{};
+  o.id = "room";
+  o.action = obstacle_t::ADD_OR_MOVE;
+  o.shape = obstacle_t::BOX;
+  o.size[0] = o.size[1] = o.size[2] = 1e80;
+  o.quaternion[0] = 1;
+  list.obstacles = {o};
+  list.num_obstacles = 1;
+  lcm_.publish("RR_OBSTACLES", &list);
+  EXPECT_TRUE(listener_->wait_status_containing("(\"room\").size: box side x is 1e+80 m"));
+  const plan_t p = plan_goal(2, Eigen::Vector2d(1.1, 0.1), 2);
+  ASSERT_EQ(p.status, plan_t::SUCCESS) << describe(p);
+  EXPECT_EQ(node_->counters().replans, 0);
+}
+
+// Obstacles beyond the world's bound are not added (each named in the status); moves of known
+// ones still are.
+TEST_F(NodeFixture, TheWorldHoldsAtMostTheDocumentedNumberOfObstacles) {
+  auto batch = [](int first, int count) {
+    obstacle_list_t list{};
+    for (int i = first; i < first + count; ++i) {
+      obstacle_t o{};
+      o.id = "pebble" + std::to_string(i);
+      o.action = obstacle_t::ADD_OR_MOVE;
+      o.shape = obstacle_t::SPHERE;
+      o.size[0] = 0.01;
+      o.position[0] = 5.0 + 0.02 * (i % 50);
+      o.position[1] = 0.02 * (i / 50);
+      o.quaternion[0] = 1;
+      list.obstacles.push_back(o);
+    }
+    list.num_obstacles = static_cast<int32_t>(list.obstacles.size());
+    return list;
+  };
+  for (int first = 0; first < collision::kMaxObstacles + 10;
+       first += messages::kMaxObstaclesPerMessage) {
+    const obstacle_list_t list = batch(first, messages::kMaxObstaclesPerMessage);
+    lcm_.publish("RR_OBSTACLES", &list);
+  }
+  EXPECT_TRUE(listener_->wait_status_containing(
+      "obstacle \"pebble1024\" and 255 more not added: the world holds the most obstacles it "
+      "may, 1024"));
 }
 
 }  // namespace

@@ -41,7 +41,9 @@ TEST_F(AcrobotTest, ModelStructure) {
   ASSERT_EQ(model.nq(), 2);
   EXPECT_EQ(model.bodies[0].joint_name, "shoulder");
   EXPECT_EQ(model.bodies[1].joint_name, "elbow");
-  EXPECT_FALSE(model.bodies[0].actuated);
+  // URDF cannot mark the shoulder passive (its effort="0" reads as unknown): scenes declare it.
+  EXPECT_TRUE(model.bodies[0].actuated);
+  EXPECT_TRUE(std::isinf(model.bodies[0].limits.effort));
   EXPECT_TRUE(model.bodies[1].actuated);
   EXPECT_DOUBLE_EQ(model.bodies[0].damping, 0.1);
   EXPECT_DOUBLE_EQ(model.bodies[1].damping, 0.1);

@@ -1,6 +1,8 @@
 // URDF loading: tree flattening, fixed-joint merging, limits, geometry and mesh paths, and
 // every bad-input case (each must throw UrdfError naming the file and the element, silently).
 #include <gtest/gtest.h>
+#include <spdlog/sinks/ringbuffer_sink.h>
+#include <spdlog/spdlog.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -31,6 +33,118 @@ void expect_urdf_error(const std::string& path, std::initializer_list<std::strin
     }
   }
   EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
+}
+
+// The log lines (warnings and above) written while `load` runs.
+template <typename F>
+std::vector<std::string> warnings_of(F&& load) {
+  auto sink = std::make_shared<spdlog::sinks::ringbuffer_sink_mt>(64);
+  auto previous = spdlog::default_logger();
+  auto logger = std::make_shared<spdlog::logger>("capture", sink);
+  logger->set_level(spdlog::level::warn);
+  spdlog::set_default_logger(logger);
+  load();
+  spdlog::set_default_logger(previous);
+  return sink->last_formatted();
+}
+
+bool any_has(const std::vector<std::string>& lines, std::initializer_list<std::string> needles) {
+  for (const std::string& l : lines) {
+    bool all = true;
+    for (const std::string& n : needles) all = all && l.find(n) != std::string::npos;
+    if (all) return true;
+  }
+  return false;
+}
+
+// urdfdom alone drops the link's geometry for length="abc" and loads without error.
+TEST(UrdfBadInput, UnparsableNumberNamesLinkElementAndLine) {
+  expect_urdf_error(testing::data_path("bad_number.urdf"),
+                    {"bad_number.urdf", "line 13", "link 'arm'", "<collision><geometry>",
+                     "<cylinder length='abc'>", "not a number"});
+}
+
+TEST(UrdfBadInput, NonFiniteRadiusIsRefused) {
+  // A NaN or infinite collision radius would read as an infinite clearance and hide contact.
+  for (const char* v : {"nan", "inf"}) {
+    const std::string file = std::string(v) + "_radius.urdf";
+    expect_urdf_error(testing::data_path(file),
+                      {file, "line 13", "link 'arm'", "<collision><geometry>",
+                       "<sphere radius='" + std::string(v) + "'>", "not a number"});
+  }
+}
+
+TEST(UrdfBadInput, WrongNumberOfValues) {
+  expect_urdf_error(testing::data_path("wrong_count.urdf"),
+                    {"wrong_count.urdf", "line 7", "joint 'j1'", "<origin xyz='0 0.2'>",
+                     "needs 3 numbers, has 2"});
+}
+
+TEST(UrdfBadInput, GeometryUrdfdomCannotReadIsAnError) {
+  ::testing::internal::CaptureStderr();
+  try {
+    Model::from_urdf_file(testing::data_path("unknown_geometry.urdf"));
+    ADD_FAILURE() << "no UrdfError";
+  } catch (const UrdfError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("unknown_geometry.urdf"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("arm"), std::string::npos) << msg;
+  }
+  ::testing::internal::GetCapturedStderr();
+}
+
+TEST(UrdfBadInput, NonPositiveSize) {
+  const std::string xml = R"(<robot name="r"><link name="base">
+    <collision><geometry><sphere radius="-0.1"/></geometry></collision></link></robot>)";
+  try {
+    Model::from_urdf_string(xml);
+    ADD_FAILURE() << "no UrdfError";
+  } catch (const UrdfError& e) {
+    EXPECT_NE(std::string(e.what()).find("link 'base' <collision><geometry><sphere radius='-0.1'>: "
+                                         "must be > 0"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(UrdfBadInput, XacroRefusedByNameAndByContent) {
+  expect_urdf_error(testing::data_path("arm.urdf.xacro"),
+                    {"arm.urdf.xacro", "expand it with xacro first"});
+  expect_urdf_error(
+      testing::data_path("xacro_content.urdf"),
+      {"xacro_content.urdf", "line 4", "<xacro:property>", "expand it with xacro first"});
+  // A substitution left in an attribute, without any xacro element.
+  try {
+    Model::from_urdf_string(R"(<robot name="r"><link name="base">
+      <visual><geometry><sphere radius="${r}"/></geometry></visual></link></robot>)");
+    ADD_FAILURE() << "no UrdfError";
+  } catch (const UrdfError& e) {
+    EXPECT_NE(std::string(e.what()).find("line 2: <sphere radius='${r}'>: this is a xacro file"),
+              std::string::npos)
+        << e.what();
+  }
+  // xacro's output keeps the namespace declaration; expanded, the file loads.
+  EXPECT_NO_THROW(Model::from_urdf_string(
+      R"(<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro"><link name="base"/></robot>)"));
+}
+
+// effort="0" is a placeholder in many vendor files: unknown, not unactuated; one warning per
+// joint, naming it and its line.
+TEST(UrdfLoad, ZeroEffortIsUnknownWithAWarning) {
+  Model m;
+  const auto lines =
+      warnings_of([&] { m = Model::from_urdf_file(testing::data_path("zero_effort.urdf")); });
+  ASSERT_EQ(m.nq(), 2);
+  for (const Body& b : m.bodies) {
+    EXPECT_TRUE(b.actuated) << b.joint_name;
+    EXPECT_TRUE(std::isinf(b.limits.effort) && b.limits.effort > 0) << b.joint_name;
+  }
+  EXPECT_TRUE(
+      any_has(lines, {"zero_effort.urdf", "joint 'j1' (line 5)", "effort=\"0\"", "unknown"}));
+  EXPECT_TRUE(any_has(lines, {"joint 'j2' (line 13)", "unknown"}));
+  // A file with real limits loads without a warning.
+  EXPECT_TRUE(
+      warnings_of([] { Model::from_urdf_file(testing::robot_path("rr/rr.urdf")); }).empty());
 }
 
 TEST(UrdfBadInput, MissingFile) {
@@ -139,11 +253,12 @@ TEST(UrdfLoad, MeshesMaterialsAndMerging) {
   EXPECT_TRUE(Eigen::Vector3d(mc(2, 1), mc(0, 2), mc(1, 0))
                   .isApprox(0.5 * Eigen::Vector3d(0, 0.1, 0.3), 1e-12));
 
-  // Prismatic child of the merged link: placement through the fixed joint, effort 0.
+  // Prismatic child of the merged link: placement through the fixed joint, effort 0 (unknown).
   const Body& b1 = m.bodies[1];
   EXPECT_EQ(b1.joint_type, JointType::kPrismatic);
   EXPECT_EQ(b1.parent, 0);
-  EXPECT_FALSE(b1.actuated);
+  EXPECT_TRUE(b1.actuated);
+  EXPECT_TRUE(std::isinf(b1.limits.effort));
   EXPECT_DOUBLE_EQ(b1.damping, 3.0);
   EXPECT_DOUBLE_EQ(b1.limits.upper, 0.04);
   EXPECT_TRUE(b1.parent_to_joint.translation().isApprox(Eigen::Vector3d(0, 0, 0.3)));

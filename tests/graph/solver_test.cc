@@ -6,6 +6,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <limits>
 #include <memory>
 #include <numeric>
 #include <random>
@@ -479,6 +480,22 @@ TEST(Solver, CompactNonzeroRowsKeepsTheInformation) {
   Eigen::MatrixXd zero = Eigen::MatrixXd::Zero(3, 2);
   Eigen::VectorXd rz = Eigen::VectorXd::Ones(3);
   EXPECT_EQ(compact_nonzero_rows(zero, rz), 0);
+}
+
+TEST(Solver, AllFiniteFindsEveryNonFiniteEntry) {
+  Eigen::MatrixXd J = Eigen::MatrixXd::Constant(5, 9, 1e300);
+  EXPECT_TRUE(all_finite(J));
+  EXPECT_TRUE(all_finite(Eigen::MatrixXd::Zero(0, 3)));
+  for (const double bad : {std::numeric_limits<double>::infinity(),
+                           -std::numeric_limits<double>::infinity(),
+                           std::numeric_limits<double>::quiet_NaN()}) {
+    for (const auto& [i, j] : {std::pair{0, 0}, std::pair{4, 8}, std::pair{2, 5}}) {
+      Eigen::MatrixXd M = J;
+      M(i, j) = bad;
+      EXPECT_FALSE(all_finite(M)) << bad << " at " << i << "," << j;
+      EXPECT_FALSE(all_finite(M.topLeftCorner(i + 1, j + 1))) << "as a block";
+    }
+  }
 }
 
 TEST(Solver, JacobianGramIsJtJOnBothPaths) {

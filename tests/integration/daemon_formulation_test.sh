@@ -8,15 +8,7 @@
 set -euo pipefail
 BUILD=$1
 SRC=$2
-if [ -z "${KINOGRAPH_NETNS:-}" ]; then
-  if [ "$(id -u)" -ne 0 ] || ! command -v unshare >/dev/null; then
-    echo "SKIP: needs root for a private network namespace"; exit 77
-  fi
-  exec unshare -n env KINOGRAPH_NETNS=1 bash "$0" "$@"
-fi
-ip link set lo up
-ip link set lo multicast on
-ip route add 224.0.0.0/4 dev lo
+source "$SRC/tests/lib/private_netns.sh"
 
 KG="$BUILD/tools/kinograph"
 KGD="$BUILD/daemon/kinographd"

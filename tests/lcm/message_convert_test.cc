@@ -131,6 +131,70 @@ TEST(ObstaclesFromMessage, ConvertsAndRejectsBadShapes) {
   }
 }
 
+// A shape or position the collision engine cannot measure faithfully is refused, naming the
+// obstacle, the dimension and the limit (a 1e80 m box around the robot read as no collision).
+TEST(ObstaclesFromMessage, RefusesShapesAndPositionsBeyondTheFaithfulRange) {
+  struct Case {
+    int8_t shape;
+    double size[3];
+    double position_x;
+    std::string names;
+  };
+  const std::vector<Case> cases = {
+      {obstacle_t::BOX,
+       {1e80, 1e80, 1e80},
+       0,
+       "(\"a\").size: box side x is 1e+80 m, beyond the 10000 m"},
+      {obstacle_t::CYLINDER, {1e79, 1, 0}, 0, "cylinder radius is 1e+79 m, beyond the 10 m"},
+      {obstacle_t::CYLINDER, {1, 11, 0}, 0, "cylinder length is 11 m"},
+      {obstacle_t::SPHERE, {5e-5, 0, 0}, 0, "sphere radius is 5e-05 m, below the 0.0001 m"},
+      {obstacle_t::CAPSULE, {2e4, 1, 0}, 0, "capsule radius is 20000 m"},
+      {obstacle_t::BOX, {0.2, 0.2, 0.2}, 2e5, "(\"a\"): position x is 200000 m, beyond the"},
+  };
+  for (const Case& c : cases) {
+    obstacle_list_t msg{};
+    msg.obstacles = {box("a")};
+    msg.obstacles[0].shape = c.shape;
+    for (int i = 0; i < 3; ++i) msg.obstacles[0].size[i] = c.size[i];
+    msg.obstacles[0].position[0] = c.position_x;
+    msg.num_obstacles = 1;
+    std::vector<ObstacleUpdate> out;
+    const Check r = obstacles_from_message(msg, out);
+    EXPECT_FALSE(r.ok) << c.names;
+    EXPECT_NE(r.reason.find(c.names), std::string::npos) << r.reason;
+    EXPECT_TRUE(out.empty());
+  }
+  // The ends of the ranges are accepted.
+  obstacle_list_t edge{};
+  edge.obstacles = {box("floor"), box("can")};
+  edge.obstacles[0].size[0] = edge.obstacles[0].size[1] = 1e4;
+  edge.obstacles[1].shape = obstacle_t::CYLINDER;
+  edge.obstacles[1].size[0] = edge.obstacles[1].size[1] = 10;
+  edge.obstacles[1].position[0] = -1e5;
+  edge.num_obstacles = 2;
+  std::vector<ObstacleUpdate> out;
+  const Check r = obstacles_from_message(edge, out);
+  EXPECT_TRUE(r.ok) << r.reason;
+  EXPECT_EQ(out.size(), 2u);
+}
+
+TEST(ObstaclesFromMessage, RefusesMoreObstaclesThanOneMessageMayCarry) {
+  obstacle_list_t msg{};
+  msg.obstacles.assign(kMaxObstaclesPerMessage, box("x"));
+  msg.num_obstacles = kMaxObstaclesPerMessage;
+  std::vector<ObstacleUpdate> out;
+  EXPECT_TRUE(obstacles_from_message(msg, out).ok);
+  EXPECT_EQ(out.size(), static_cast<size_t>(kMaxObstaclesPerMessage));
+  msg.obstacles.push_back(box("y"));
+  msg.num_obstacles = kMaxObstaclesPerMessage + 1;
+  std::vector<ObstacleUpdate> none;
+  const Check r = obstacles_from_message(msg, none);
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.reason.find("num_obstacles is 257, more than the 256"), std::string::npos)
+      << r.reason;
+  EXPECT_TRUE(none.empty());
+}
+
 TEST(StateFromMessage, ReordersByJointNameAndRejectsUnknownNames) {
   robot_state_t s{};
   s.robot = rr().name;

@@ -128,6 +128,10 @@ TEST(LcmTypes, PlannerStatusRoundTrip) {
   EXPECT_EQ(out.last_plan_id, -1);
   EXPECT_EQ(out.message, m.message);
   EXPECT_EQ(out.num_failures, 1);
+  EXPECT_EQ(out.num_goals_received, 5);
+  EXPECT_EQ(out.num_goals_answered, 4);
+  EXPECT_EQ(out.num_goals_superseded, 1);
+  EXPECT_EQ(out.num_goals_dropped, 2);
 }
 
 TEST(LcmTypes, TruncatedBuffersAreRejected) {

@@ -131,6 +131,10 @@ inline planner_status_t make_planner_status() {
   m.message = "goal 3 rejected: joint_position has 3 entries, robot has 2 joints";
   m.num_plans = 2;
   m.num_failures = 1;
+  m.num_goals_received = 5;
+  m.num_goals_answered = 4;
+  m.num_goals_superseded = 1;
+  m.num_goals_dropped = 2;
   return m;
 }
 

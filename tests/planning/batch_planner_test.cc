@@ -10,6 +10,7 @@
 
 #include "kinograph/dynamics/kinematics.h"
 #include "kinograph/dynamics/payload.h"
+#include "test_problems.h"
 
 namespace kinograph::planning {
 namespace {
@@ -22,7 +23,7 @@ std::shared_ptr<const dynamics::Model> load(const std::string& rel) {
 Problem acrobot_swingup() {
   Problem p;
   p.name = "acrobot_swingup";
-  p.model = load("robots/acrobot/acrobot.urdf");
+  p.model = testing::acrobot_model();
   p.horizon = 10;
   p.steps = 100;
   p.start_q = Eigen::Vector2d(0, 0);

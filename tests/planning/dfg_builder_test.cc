@@ -27,6 +27,7 @@
 #include "kinograph/planning/formulation/planning_graph.h"
 #include "kinograph/planning/formulation/initialization.h"
 #include "kinograph/planning/problem.h"
+#include "test_problems.h"
 
 namespace kinograph::planning {
 namespace {
@@ -219,8 +220,7 @@ TEST(DfgBuilder, SingleStepSolveRecoversForwardDynamics) {
 TEST(DfgBuilder, ConstraintStepMatchesCondensedRows) {
   std::mt19937 rng(21);
   for (bool torque_vector : {false, true}) {
-    auto model =
-        std::make_shared<const Model>(Model::from_urdf_file(robot("acrobot/acrobot.urdf")));
+    auto model = testing::acrobot_model();
     const int n = model->nq();
     DfgOptions options;
     options.keys.torque_vector = torque_vector;
@@ -281,7 +281,7 @@ TEST(DfgBuilder, ConstraintStepMatchesCondensedRows) {
 // (τ₁ = 0) and the elbow's ±8 N·m. The augmented-Lagrangian loop on the DFG and on the condensed
 // factor reach the same q̈ and torques.
 TEST(DfgBuilder, ConstrainedSingleStepAgreesWithCondensed) {
-  auto model = std::make_shared<const Model>(Model::from_urdf_file(robot("acrobot/acrobot.urdf")));
+  auto model = testing::acrobot_model();
   const int n = model->nq();
   const Eigen::Vector2d q(0.4, -0.9), qd(1.5, -2.0), target(6.0, -9.0);
   DynamicsStepOptions rows;

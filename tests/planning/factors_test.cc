@@ -14,6 +14,7 @@
 #include "kinograph/planning/factors/pose_factors.h"
 #include "kinograph/planning/factors/state_target_factor.h"
 #include "kinograph/planning/factors/trajectory_factors.h"
+#include "test_problems.h"
 
 namespace kinograph::planning {
 namespace {
@@ -189,7 +190,7 @@ TEST(DynamicsStepFactor, JacobiansOnIiwaWithPayloadAndAcrobot) {
   auto iiwa = std::make_shared<const dynamics::Model>(dynamics::attach_box_payload(
       *load("robots/iiwa14/iiwa14.urdf"), "iiwa_link_ee_kuka", 2.0, {0.1, 0.1, 0.1},
       Eigen::Isometry3d(Eigen::Translation3d(0, 0, 0.05))));
-  for (auto model : {iiwa, load("robots/acrobot/acrobot.urdf")}) {
+  for (auto model : {iiwa, testing::acrobot_model()}) {
     const int n = model->nq();
     graph::Values v = random_states(n, 0, rng);
     DynamicsStepOptions o;

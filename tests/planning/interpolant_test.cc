@@ -113,7 +113,7 @@ Plan consistent_acrobot_interval(const dynamics::Model& model, double dt, std::m
 }
 
 TEST(Interpolant, UnactuatedJointFollowsTheDynamics) {
-  const auto model = load_robot("robots/acrobot/acrobot.urdf");
+  const auto model = testing::acrobot_model();
   ASSERT_FALSE(model->bodies[0].actuated);
   std::mt19937 rng(5);
   for (int trial = 0; trial < 5; ++trial) {
@@ -125,7 +125,7 @@ TEST(Interpolant, UnactuatedJointFollowsTheDynamics) {
 TEST(Interpolant, ComputedTorqueExecutesThePlan) {
   // The executor's contract: apply τ_a(t) of the interpolant, nothing on the shoulder, and the
   // true Acrobot (forward dynamics, fine RK4) stays on the interpolant.
-  const auto model = load_robot("robots/acrobot/acrobot.urdf");
+  const auto model = testing::acrobot_model();
   std::mt19937 rng(11);
   const double dt = 0.2;
   const Plan plan = consistent_acrobot_interval(*model, dt, rng);
@@ -155,7 +155,7 @@ TEST(Interpolant, ComputedTorqueExecutesThePlan) {
 }
 
 TEST(Interpolant, SamplerRefusesPlansThatDoNotFit) {
-  const auto model = load_robot("robots/acrobot/acrobot.urdf");
+  const auto model = testing::acrobot_model();
   std::mt19937 rng(1);
   Plan plan = consistent_acrobot_interval(*model, 0.1, rng);
   plan.t = {0.0, 0.0};
@@ -165,35 +165,93 @@ TEST(Interpolant, SamplerRefusesPlansThatDoNotFit) {
   EXPECT_THROW(TrajectorySampler(*model, plan), std::invalid_argument);
 }
 
-// The factor's raw rows checked against central differences (hinges have kinks in the
-// whitened form; the raw rows are smooth).
-void expect_jacobians(const std::string& urdf, int checks, unsigned seed) {
-  const auto model = load_robot(urdf);
+// The factor's raw rows z (compute(), not the hinged residual, which is zero for rows inside
+// their bounds) as a factor of their own, so their Jacobians are checked against central
+// differences row by row.
+class RawRows final : public graph::Factor {
+ public:
+  explicit RawRows(const ConstrainedFactor& f)
+      : graph::Factor(f.keys(), f.dims(), f.residual_dim()), f_(f) {}
+  void evaluate(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> e,
+                const graph::Jacobians* J) const override {
+    f_.compute(x, e, J);
+  }
+
+ private:
+  const ConstrainedFactor& f_;
+};
+
+// A random interval with the unactuated joints' knot k+1 moved off the defect's zero.
+graph::Values off_defect_interval(int n, double dt, std::mt19937& rng) {
+  graph::Values x = random_interval(n, dt, rng);
+  x.update(q_key(1), Eigen::VectorXd(x.at(q_key(1)) + Eigen::VectorXd::Constant(n, 0.05)));
+  return x;
+}
+
+void expect_raw_jacobians(std::shared_ptr<const dynamics::Model> model, int checks,
+                          unsigned seed) {
   IntervalDynamicsOptions o;
   o.checks = checks;
   const double dt = 0.1;
   IntervalDynamicsFactor f(0, dt, model, o);
   std::mt19937 rng(seed);
   for (int trial = 0; trial < 3; ++trial) {
-    graph::Values x = random_interval(model->nq(), dt, rng);
-    // Off the defect's zero, so its rows are not trivially satisfied.
-    x.update(q_key(1), Eigen::VectorXd(x.at(q_key(1)) + Eigen::VectorXd::Constant(2, 0.05)));
+    const graph::Values x = off_defect_interval(model->nq(), dt, rng);
     graph::testing::JacobianCheckOptions c;
     c.tolerance = 1e-6;
-    const auto check = check_jacobians(f, x, c);
-    EXPECT_TRUE(check.ok) << urdf << " trial " << trial << "\n" << check.report();
+    const auto check = check_jacobians(RawRows(f), x, c);
+    EXPECT_TRUE(check.ok) << model->name << " trial " << trial << "\n" << check.report();
   }
 }
 
 TEST(IntervalDynamicsFactor, JacobiansUnderactuated) {
-  expect_jacobians("robots/acrobot/acrobot.urdf", 3, 21);
+  expect_raw_jacobians(testing::acrobot_model(), 3, 21);
 }
 TEST(IntervalDynamicsFactor, JacobiansFullyActuated) {
-  expect_jacobians("robots/rr/rr.urdf", 2, 22);
+  expect_raw_jacobians(load_robot("robots/rr/rr.urdf"), 2, 22);
+}
+
+// While linearizing, the factor skips the derivatives of check points whose rows are all off.
+// The hinged residual's Jacobian must still be exact: rows violated, rows inside their bound
+// but kept on by a multiplier, and rows off, against central differences of the residual.
+TEST(IntervalDynamicsFactor, LinearizationIsExactWithRowsOnAndOff) {
+  for (const auto& robot : {testing::acrobot_model(), load_robot("robots/rr/rr.urdf")}) {
+    auto model = std::make_shared<dynamics::Model>(*robot);
+    const std::string& urdf = model->name;
+    for (dynamics::Body& b : model->bodies) b.limits.effort = std::min(b.limits.effort, 0.5);
+    IntervalDynamicsOptions o;
+    o.checks = 5;
+    const double dt = 0.1;
+    IntervalDynamicsFactor f(0, dt, model, o);
+    std::mt19937 rng(31);
+    const graph::Values x = off_defect_interval(model->nq(), dt, rng);
+    Eigen::VectorXd z;
+    f.values_at(x, z);
+    auto m = std::make_shared<Multipliers>(f.residual_dim(), 4.0);
+    int on = 0, off = 0, kept_on = 0;
+    for (int i = 0; i < f.residual_dim(); ++i) {
+      const RowSpec& r = f.rows()[i];
+      if (r.kind != RowKind::kBounds) continue;
+      const bool violated = z[i] > r.upper || z[i] < r.lower;
+      if (!violated && off % 2 == 0) {
+        m->upper[i] = 50.0;  // inside its bound, but on through its multiplier
+        ++kept_on;
+      }
+      (violated ? on : off) += 1;
+    }
+    f.bind(m);
+    ASSERT_GT(on, 0) << urdf;
+    ASSERT_GT(off, kept_on) << urdf;
+    ASSERT_GT(kept_on, 0) << urdf;
+    graph::testing::JacobianCheckOptions c;
+    c.tolerance = 1e-6;
+    const auto check = check_jacobians(f, x, c);
+    EXPECT_TRUE(check.ok) << urdf << "\n" << check.report();
+  }
 }
 
 TEST(IntervalDynamicsFactor, RowsOfTheAcrobot) {
-  const auto model = load_robot("robots/acrobot/acrobot.urdf");
+  const auto model = testing::acrobot_model();
   IntervalDynamicsOptions o;
   o.checks = 4;
   // 2 defect rows; per point the elbow's τ, both q and both q̇ limits.
@@ -205,7 +263,7 @@ TEST(IntervalDynamicsFactor, RowsOfTheAcrobot) {
 }
 
 TEST(IntervalDynamicsFactor, DefectIsZeroOnTheInterpolant) {
-  const auto model = load_robot("robots/acrobot/acrobot.urdf");
+  const auto model = testing::acrobot_model();
   std::mt19937 rng(8);
   const Plan plan = consistent_acrobot_interval(*model, 0.1, rng);
   graph::Values x;

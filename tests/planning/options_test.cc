@@ -910,6 +910,10 @@ TEST(IncrementalPlannerOptions, MaxUpdates) {
   const Plan re = planner.set_goal(far_goal());
   EXPECT_EQ(re.stats.status, PlanStatus::kMaxUpdates);
   EXPECT_EQ(planner.last_stats().updates, 2);
+  // Stopped short, the reason names what still fails in the user's terms.
+  EXPECT_NE(re.stats.reason.find("the worst violation: "), std::string::npos) << re.stats.reason;
+  EXPECT_NE(re.stats.reason.find("t = "), std::string::npos) << re.stats.reason;
+  EXPECT_EQ(re.stats.reason.find("Factor"), std::string::npos) << re.stats.reason;
 }
 
 TEST(IncrementalPlannerOptions, MaxRounds) {

@@ -252,7 +252,8 @@ horizon: 2
 steps: 10
 start: {q: [0, 0, 0, 0, 0, 0, 0]}
 goal: {q: [0.1, 0, 0, 0, 0, 0, 0]}
-limits: {iiwa_joint_2: {velocity: 0.5, lower: -1}, iiwa_joint_7: {effort: 0}}
+limits: {iiwa_joint_2: {velocity: 0.5, lower: -1}}
+unactuated: [iiwa_joint_7]
 obstacles:
   - {id: post, shape: cylinder, size: [0.1, 0.4], position: [0.5, 0, 0.2], rpy: [0.3, 0, 0]}
   - id: ball
@@ -368,6 +369,10 @@ TEST(PlanFile, ErrorsNameTheKey) {
   expect("limits.effort", [](json& j) { j["limits"]["effort"] = {1, 2}; });
   expect("'q'", [](json& j) { j.erase("q"); });
   expect("iiwa_joint_3", [](json& j) { j["joint_names"][2] = "elbow"; });
+  // Passive joints are named, never written as effort 0.
+  expect("joint 'iiwa_joint_2' has effort limit 0", [](json& j) { j["limits"]["effort"][1] = 0; });
+  expect("no joint 'elbow'", [](json& j) { j["unactuated"] = {"elbow"}; });
+  expect("'unactuated'", [](json& j) { j["unactuated"] = "iiwa_joint_7"; });
   EXPECT_THROW(read_plan_file("/no/such/plan.json"), PlanFileError);
 }
 

@@ -38,7 +38,8 @@ goal:
   position_only: false
 limits:
   iiwa_joint_2: {lower: -1.5, upper: 1.6, velocity: 1.2, effort: 250, acceleration: 10}
-  iiwa_joint_7: {effort: 0}
+  iiwa_joint_6: {effort: 35}
+unactuated: [iiwa_joint_7]
 obstacles:
   - {id: table, shape: box, size: [1, 0.5, 0.04], position: [0.7, 0, 0.4], rpy: [0, 0, 0.3]}
   - {id: ball, shape: sphere, size: [0.1], position: [0.3, 0.4, 0.9]}
@@ -184,9 +185,11 @@ TEST_F(FullScene, EveryFieldReachesTheProblem) {
   EXPECT_EQ(l2.velocity, 1.2);
   EXPECT_EQ(l2.effort, 250);
   EXPECT_EQ(l2.acceleration, 10);
-  EXPECT_FALSE(p.model->bodies[6].actuated);  // effort 0 means unactuated
+  EXPECT_FALSE(p.model->bodies[6].actuated);  // listed under `unactuated`
+  EXPECT_EQ(p.model->bodies[6].limits.effort, bare.bodies[6].limits.effort);
   EXPECT_TRUE(p.model->bodies[5].actuated);
-  EXPECT_EQ(p.model->bodies[5].limits.effort, bare.bodies[5].limits.effort);
+  EXPECT_EQ(p.model->bodies[5].limits.effort, 35);
+  EXPECT_EQ(s.unactuated, std::vector<std::string>{"iiwa_joint_7"});
   EXPECT_EQ(p.horizon, 2.5);
   EXPECT_EQ(p.steps, 25);
   EXPECT_DOUBLE_EQ(p.dt(), 0.1);
@@ -299,6 +302,25 @@ TEST(SceneErrors, DuplicateKeys) {
   EXPECT_NE(std::string(e.what()).find("duplicate"), std::string::npos);
   e = parse_error(std::string(kBase) + "limits:\n  joint1: {effort: 1}\n  joint1: {effort: 2}\n");
   EXPECT_EQ(e.key(), "limits.joint1");
+}
+
+// Passive joints are listed, not given effort 0 (which would mean "no torque allowed").
+TEST(SceneErrors, UnactuatedJoints) {
+  SceneError e = parse_error(std::string(kBase) + "unactuated: [joint3]\n");
+  EXPECT_EQ(e.key(), "unactuated[0]");
+  EXPECT_EQ(e.line(), 6);
+  EXPECT_NE(std::string(e.what()).find("no joint 'joint3'"), std::string::npos) << e.what();
+  e = parse_error(std::string(kBase) + "unactuated: [joint1, joint1]\n");
+  EXPECT_EQ(e.key(), "unactuated[1]");
+  EXPECT_NE(std::string(e.what()).find("twice"), std::string::npos) << e.what();
+  e = parse_error(std::string(kBase) + "unactuated: joint1\n");
+  EXPECT_EQ(e.key(), "unactuated");
+  e = parse_error(std::string(kBase) + "limits: {joint1: {effort: 0}}\n");
+  EXPECT_EQ(e.key(), "limits.joint1.effort");
+  EXPECT_NE(std::string(e.what()).find("'unactuated'"), std::string::npos) << e.what();
+  const Scene ok = parse_scene(std::string(kBase) + "unactuated: [joint2]\n");
+  EXPECT_TRUE(ok.problem.model->bodies[0].actuated);
+  EXPECT_FALSE(ok.problem.model->bodies[1].actuated);
 }
 
 TEST(SceneErrors, UnknownNestedKey) {
@@ -424,6 +446,43 @@ TEST(SceneErrors, InconsistentValues) {
   std::string text = kBase;
   text.replace(text.find("steps: 10"), 9, "steps: 0");
   EXPECT_EQ(parse_error(text).key(), "steps");
+}
+
+// Obstacles the collision engine cannot measure faithfully, or too many of them, are refused
+// with the key, the line, the obstacle and the limit.
+TEST(SceneErrors, ObstaclesBeyondTheCollisionEnginesRangeOrCount) {
+  const SceneError huge = parse_error(
+      std::string(kBase) + "obstacles:\n  - {id: room, shape: box, size: [1e80, 1, 1]}\n");
+  EXPECT_EQ(huge.key(), "obstacles[0].size");
+  EXPECT_NE(std::string(huge.what())
+                .find("obstacle 'room': box side x is 1e+80 m, beyond the "
+                      "10000 m"),
+            std::string::npos)
+      << huge.what();
+  EXPECT_NE(std::string(huge.what()).find("line 7"), std::string::npos) << huge.what();
+  EXPECT_EQ(parse_error(std::string(kBase) +
+                        "obstacles:\n  - {id: can, shape: cylinder, size: [1e79, 1]}\n")
+                .key(),
+            "obstacles[0].size");
+  EXPECT_EQ(parse_error(std::string(kBase) + "obstacles:\n  - {id: far, shape: sphere, size: "
+                                             "[0.1], position: [0, 0, 1e6]}\n")
+                .key(),
+            "obstacles[0].position");
+  std::string many = std::string(kBase) + "obstacles:\n";
+  for (int i = 0; i <= collision::kMaxObstacles; ++i) {
+    many += "  - {id: b" + std::to_string(i) + ", shape: sphere, size: [0.01], position: [3, 3, " +
+            std::to_string(i) + "]}\n";
+  }
+  const SceneError crowd = parse_error(many);
+  EXPECT_EQ(crowd.key(), "obstacles");
+  EXPECT_NE(std::string(crowd.what()).find("1025 obstacles, more than the 1024"), std::string::npos)
+      << crowd.what();
+  // At the limits: accepted.
+  const Scene ok = parse_scene(std::string(kBase) +
+                               "obstacles:\n  - {id: floor, shape: box, size: [1e4, 1e4, 0.1]}\n"
+                               "  - {id: can, shape: cylinder, size: [10, 10], position: [20, 0, "
+                               "0]}\n");
+  EXPECT_EQ(ok.problem.obstacles.size(), 2u);
 }
 
 TEST(SceneErrors, SyntaxErrorsAndMissingFiles) {

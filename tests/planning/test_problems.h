@@ -9,6 +9,7 @@
 #include "kinograph/dynamics/inverse_dynamics.h"
 #include "kinograph/dynamics/kinematics.h"
 #include "kinograph/dynamics/payload.h"
+#include "kinograph/planning/io/scene.h"
 #include "kinograph/planning/plan.h"
 #include "kinograph/planning/problem.h"
 
@@ -26,11 +27,17 @@ inline std::shared_ptr<const dynamics::Model> load_robot(const std::string& rel)
       dynamics::Model::from_urdf_file(std::string(KINOGRAPH_SOURCE_DIR) + "/" + rel));
 }
 
+/// The Acrobot as its shipped scene declares it: the URDF with the shoulder unactuated.
+inline std::shared_ptr<const dynamics::Model> acrobot_model() {
+  return load_scene(std::string(KINOGRAPH_SOURCE_DIR) + "/robots/scenes/acrobot_swingup.yaml")
+      .problem.model;
+}
+
 /// Rest to upright in 10 s over 100 steps, elbow limited by the URDF's ±8 N·m.
 inline Problem acrobot_swingup() {
   Problem p;
   p.name = "acrobot_swingup";
-  p.model = load_robot("robots/acrobot/acrobot.urdf");
+  p.model = acrobot_model();
   p.horizon = 10;
   p.steps = 100;
   p.start_q = Eigen::Vector2d(0, 0);

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "kinograph/dynamics/inverse_dynamics.h"
+#include "kinograph/dynamics/kinematics.h"
 #include "kinograph/planning/trajectory_sampler.h"
 
 #include "tests/planning/test_problems.h"
@@ -27,6 +28,62 @@ TEST(Validate, AcceptsAConsistentPlan) {
   EXPECT_TRUE(v.valid) << (v.failures.empty() ? "" : v.failures.front());
   EXPECT_LT(v.max_dynamics_residual, 1e-9);
   EXPECT_EQ(v.goal_error, 0);
+}
+
+bool mentions_all(const Validation& v, std::initializer_list<std::string> parts) {
+  for (const auto& f : v.failures) {
+    bool all = true;
+    for (const std::string& p : parts) all = all && f.find(p) != std::string::npos;
+    if (all) return true;
+  }
+  return false;
+}
+
+std::string all_failures(const Validation& v) {
+  std::string s;
+  for (const auto& f : v.failures) s += " | " + f;
+  return s;
+}
+
+// Start, goal and task failures say which joint or frame misses, by how much, and when.
+TEST(Validate, StartGoalAndTaskFailuresNameJointFrameAndTime) {
+  {
+    Fixture f;
+    f.problem.goal.q[1] += 0.2;
+    const Validation v = validate(f.problem, f.plan);
+    EXPECT_TRUE(mentions_all(v, {"goal error", "joint 2 (joint2) ends at -0.3 rad, its goal is -0.1",
+                                 "at t = 1 s"}))
+        << all_failures(v);
+  }
+  {
+    Fixture f;
+    f.problem.start_q[0] += 0.05;
+    const Validation v = validate(f.problem, f.plan);
+    EXPECT_TRUE(mentions_all(v, {"start state error", "joint 1 (joint1) position 0.5 rad instead of "
+                                 "0.55", "at t = 0"}))
+        << all_failures(v);
+  }
+  {
+    Fixture f;
+    f.plan.qd(10, 1) = 0.05;
+    const Validation v = validate(f.problem, f.plan);
+    EXPECT_TRUE(mentions_all(v, {"final velocity", "joint 2 (joint2) velocity 0.05 rad/s",
+                                 "at t = 1 s"}))
+        << all_failures(v);
+  }
+  {
+    Fixture f;
+    dynamics::Data d(*f.problem.model);
+    dynamics::forward_kinematics(*f.problem.model, d, f.problem.goal.q);
+    TaskConstraint task;
+    task.frame = "ee";
+    task.target = dynamics::frame_pose(*f.problem.model, d, f.problem.model->frame_index("ee"));
+    task.tolerance = 0.05;
+    f.problem.task_constraints.push_back(task);
+    f.plan.q(7, 0) += 0.3;  // the ee tilts by 0.3 rad at step 7 only (both joints turn about y)
+    const Validation v = validate(f.problem, f.plan);
+    EXPECT_TRUE(mentions_all(v, {"task constraint on 'ee'", "at t = 0.7 s"})) << all_failures(v);
+  }
 }
 
 TEST(Validate, CatchesEachViolation) {

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "kinograph/planning/formulation/initialization.h"
+#include "kinograph/planning/solver/violation_text.h"
 
 namespace kinograph::planning {
 
@@ -146,7 +147,8 @@ Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init, const s
       dfg_steps.empty() ? options_.outer_loop : outer_loop_options(options_);
   ConstraintState state;
   AugmentedLagrangian al(pg.constraints(false), state, options_.augmented_lagrangian);
-  const OuterLoopResult r = solve_outer_loop(pg.graph, pg.values, al, loop, problem.name);
+  OuterLoopResult r = solve_outer_loop(pg.graph, pg.values, al, loop, problem.name);
+  if (r.status == PlanStatus::kInfeasible) r.reason = infeasible_reason(problem, r);
 
   Plan plan = solved_plan(problem, pg, r, method, options_);
   plan.stats.solve_time_s =

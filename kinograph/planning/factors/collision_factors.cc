@@ -4,18 +4,24 @@
 #include <stdexcept>
 
 #include "kinograph/dynamics/kinematics.h"
+#include "kinograph/planning/clearance_world.h"
 #include "kinograph/planning/factors/trajectory_factors.h"
+#include "kinograph/planning/user_terms.h"
 
 namespace kinograph::planning {
 
 CollisionContext::CollisionContext(std::shared_ptr<const dynamics::Model> m,
                                    const std::vector<collision::Obstacle>& obstacles,
-                                   double query_dist)
+                                   double query_dist, const SelfPairs* self)
     : model(std::move(m)),
       world(*model,
             [&] {
               collision::CollisionWorldOptions o;
               o.query_distance = query_dist;
+              if (self != nullptr) {
+                o.self_collision = true;
+                o.self_collision_excluded = self->allowed;
+              }
               return o;
             }()),
       data(*model),
@@ -34,6 +40,22 @@ CollisionContext::CollisionContext(std::shared_ptr<const dynamics::Model> m,
     geoms.push_back(static_cast<int>(g));
     for (size_t o = 0; o < obstacle_ids.size(); ++o) row_of[g][o] = num_pairs++;
   }
+  num_obstacle_rows = num_pairs;
+  self_row_of.assign(model->collision.size(), std::vector<int>(model->collision.size(), -1));
+  if (self != nullptr) {
+    self_epsilon = self->epsilon;
+    for (const auto& [a, b] : world.self_pairs())
+      self_row_of[a][b] = self_row_of[b][a] = num_pairs++;
+  }
+}
+
+int CollisionContext::row(const collision::Proximity& p) const {
+  if (p.robot_geom < 0) return -1;
+  if (p.is_self_collision()) return self_row_of[p.robot_geom][p.other_geom];
+  for (size_t o = 0; o < obstacle_ids.size(); ++o) {
+    if (obstacle_ids[o] == p.obstacle) return row_of[p.robot_geom][o];
+  }
+  return -1;
 }
 
 namespace {
@@ -41,14 +63,18 @@ std::vector<graph::Key> collision_keys(int k, double s) {
   if (s == 0) return {q_key(k)};
   return {q_key(k), v_key(k), q_key(k + 1), v_key(k + 1)};
 }
-std::vector<RowSpec> collision_rows(int pairs, double epsilon, double scale) {
-  if (pairs == 0) throw std::invalid_argument("CollisionFactor needs robot geometry and obstacles");
+std::vector<RowSpec> collision_rows(const CollisionContext& c, double epsilon, double scale) {
+  if (c.num_pairs == 0) {
+    throw std::invalid_argument("CollisionFactor needs robot geometry and obstacles or self pairs");
+  }
   RowSpec r;
   r.kind = RowKind::kBounds;
   r.lower = epsilon;
   r.upper = std::numeric_limits<double>::infinity();
   r.scale = scale;
-  return std::vector<RowSpec>(pairs, r);
+  std::vector<RowSpec> rows(c.num_pairs, r);
+  for (int i = c.num_obstacle_rows; i < c.num_pairs; ++i) rows[i].lower = c.self_epsilon;
+  return rows;
 }
 }  // namespace
 
@@ -56,7 +82,7 @@ CollisionFactor::CollisionFactor(int k, double s, double dt, double epsilon, dou
                                  std::shared_ptr<CollisionContext> context)
     : ConstrainedFactor(collision_keys(k, s),
                         std::vector<int>(s == 0 ? 1 : 4, context->model->nq()),
-                        collision_rows(context->num_pairs, epsilon, scale)),
+                        collision_rows(*context, epsilon, scale)),
       s_(s),
       dt_(dt),
       t_((k + s) * dt),
@@ -79,13 +105,7 @@ void CollisionFactor::compute(const graph::FactorValues& x, Eigen::Ref<Eigen::Ve
   dynamics::forward_kinematics(model, c.data, q);
   z.setConstant(c.query_distance);
   for (const collision::Proximity& p : c.world.query(c.data, t_)) {
-    if (p.is_self_collision() || p.robot_geom < 0) continue;
-    int slot = -1;
-    for (size_t o = 0; o < c.obstacle_ids.size(); ++o) {
-      if (c.obstacle_ids[o] == p.obstacle) slot = static_cast<int>(o);
-    }
-    if (slot < 0) continue;
-    const int row = c.row_of[p.robot_geom][slot];
+    const int row = c.row(p);
     if (row < 0) continue;
     z[row] = p.distance;
     if (J == nullptr) continue;
@@ -99,6 +119,36 @@ void CollisionFactor::compute(const graph::FactorValues& x, Eigen::Ref<Eigen::Ve
       J->block(3).row(row) = h_[3] * dt_ * c.gradient.transpose();
     }
   }
+}
+
+namespace {
+// The pair of row `row` in the user's terms ("link 'a' and obstacle 3", "link 'a' and the
+// floor", "links 'a' and 'b'"), empty when the row is not in the context.
+std::string collision_pair(const CollisionContext& ctx, int row) {
+  const auto link = [&](size_t g) { return "'" + ctx.model->collision[g].link_name + "'"; };
+  for (size_t g = 0; g < ctx.row_of.size(); ++g) {
+    for (size_t slot = 0; slot < ctx.row_of[g].size(); ++slot) {
+      if (ctx.row_of[g][slot] != row) continue;
+      const int id = ctx.obstacle_ids[slot];
+      return "link " + link(g) +
+             (id == kFloorId ? std::string(" and the floor") : " and obstacle " + std::to_string(id));
+    }
+  }
+  for (size_t a = 0; a < ctx.self_row_of.size(); ++a) {
+    for (size_t b = a + 1; b < ctx.self_row_of[a].size(); ++b) {
+      if (ctx.self_row_of[a][b] == row) return "links " + link(a) + " and " + link(b);
+    }
+  }
+  return "";
+}
+}  // namespace
+
+std::string CollisionFactor::describe_row(int row, double z, const RowContext&) const {
+  const std::string pair = collision_pair(*ctx_, row);
+  if (pair.empty()) return "";
+  if (z < 0) return pair + " overlap by " + number(-z) + " m at " + at_time(t_);
+  return pair + " are " + number(z) + " m apart at " + at_time(t_) + ", inside the planner's " +
+         number(rows()[static_cast<size_t>(row)].lower) + " m safety distance";
 }
 
 }  // namespace kinograph::planning

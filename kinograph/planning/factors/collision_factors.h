@@ -1,7 +1,8 @@
 #pragma once
 // The collision hinge (the paper's c_sdf) as an inequality constraint: the signed distance of
-// every (robot collision geometry, obstacle) pair stays at least ε, at each step and at states
-// interpolated between steps (so thin obstacles are not jumped over).
+// every (robot collision geometry, obstacle) pair, and of every self-collision pair of two robot
+// geometries, stays at least its ε, at each step and at states interpolated between steps (so
+// thin obstacles are not jumped over).
 #include <Eigen/Core>
 #include <memory>
 #include <vector>
@@ -14,13 +15,21 @@
 
 namespace kinograph::planning {
 
+/// Self-collision rows of a CollisionContext: the robot's non-adjacent geometry pairs.
+struct SelfPairs {
+  std::vector<std::pair<int, int>> allowed;  ///< body pairs never checked (−1 = the base)
+  double epsilon = 0.01;                     ///< m, the hinge's safety distance of these rows
+};
+
 /// The collision scene shared by all collision factors of one graph (single-threaded use):
-/// Bullet world with the problem's obstacles, a kinematics workspace, and the row of each
-/// (robot geometry, obstacle) pair.
+/// Bullet world with the problem's obstacles (and, with `self`, the robot's own pairs), a
+/// kinematics workspace, and the row of each (robot geometry, obstacle) pair, then of each
+/// self pair.
 struct CollisionContext {
   /// Builds the world; throws std::invalid_argument if an obstacle id repeats or a shape is bad.
   CollisionContext(std::shared_ptr<const dynamics::Model> model,
-                   const std::vector<collision::Obstacle>& obstacles, double query_distance);
+                   const std::vector<collision::Obstacle>& obstacles, double query_distance,
+                   const SelfPairs* self = nullptr);
 
   std::shared_ptr<const dynamics::Model> model;
   collision::CollisionWorld world;
@@ -31,20 +40,32 @@ struct CollisionContext {
   std::vector<int> obstacle_ids;         ///< obstacle of each column of row_of
   std::vector<int> geoms;                ///< robot geometries that take part
   std::vector<std::vector<int>> row_of;  ///< [robot geometry][obstacle slot] → row, −1 if none
-  int num_pairs = 0;
+  /// [robot geometry][robot geometry] → row of a self pair (both orders), −1 if none.
+  std::vector<std::vector<int>> self_row_of;
+  int num_obstacle_rows = 0;  ///< rows 0..num_obstacle_rows−1 are obstacle pairs
+  int num_pairs = 0;          ///< all rows, self pairs last
+  double self_epsilon = 0.0;  ///< ε of the self rows
   double query_distance;
+
+  /// The row of a reported pair, −1 when it has none.
+  int row(const collision::Proximity& p) const;
 };
 
-/// Signed distances d ≥ ε of every pair at the state q(s) between steps k and k+1 (s = 0: state
-/// k exactly, keys q_k only; 0 < s < 1: the cubic Hermite interpolation of q_k, q̇_k, q_{k+1},
-/// q̇_{k+1}, keys in that order). Pairs farther than the query distance read as that distance.
-/// Obstacles are taken at time t = (k + s)Δt.
+/// Signed distances d ≥ ε of every pair (self rows: d ≥ the context's self ε) at the state q(s)
+/// between steps k and k+1 (s = 0: state k exactly, keys q_k only; 0 < s < 1: the cubic Hermite
+/// interpolation of q_k, q̇_k, q_{k+1}, q̇_{k+1}, keys in that order). Pairs farther than the query
+/// distance read as that distance. Obstacles are taken at time t = (k + s)Δt.
 class CollisionFactor final : public ConstrainedFactor {
  public:
   CollisionFactor(int k, double s, double dt, double epsilon, double scale,
                   std::shared_ptr<CollisionContext> context);
   void compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
                const graph::Jacobians* J) const override;
+  std::string describe_row(int row, double z, const RowContext& c) const override;
+  /// The time (s) of the state the rows are checked at.
+  double time() const { return t_; }
+  /// The collision scene, whose row_of names each row's (geometry, obstacle) pair.
+  const CollisionContext& context() const { return *ctx_; }
 
  private:
   double s_, dt_, t_;

@@ -5,10 +5,15 @@
 // only reads. The outer loop changes them between solves without touching the graph's structure.
 #include <Eigen/Core>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "kinograph/graph/factor.h"
 #include "kinograph/graph/values.h"
+
+namespace kinograph::dynamics {
+class Model;
+}
 
 namespace kinograph::planning {
 
@@ -58,6 +63,21 @@ class ConstrainedFactor : public graph::Factor {
                 const graph::Jacobians* J) const final;
 
   const std::vector<RowSpec>& rows() const { return rows_; }
+
+  /// What describe_row needs besides the factor: the robot, the time and purpose of the row.
+  struct RowContext {
+    const dynamics::Model& model;
+    double t = 0;                  ///< time of the factor's state (s)
+    double dt = 0;                 ///< time between states (s)
+    const char* role = "";         ///< the row's purpose ("goal", "start", "task constraint", …)
+    int index = -1;                ///< which task constraint (0-based); −1 for other rows
+    double violation = 0;          ///< how far the row is past its bound, in its own units
+  };
+  /// Row `row` with raw value z in the user's terms (joint, link, obstacle, time, amount);
+  /// empty when the factor knows nothing better to say than its role and time.
+  virtual std::string describe_row(int /*row*/, double /*z*/, const RowContext& /*c*/) const {
+    return "";
+  }
   /// Whether any row is a constraint (so the augmented Lagrangian must track this factor).
   bool has_constraints() const { return num_constraints_ > 0; }
   /// Whether any row is soft (part of the objective).
@@ -80,6 +100,8 @@ class ConstrainedFactor : public graph::Factor {
   struct Violation {
     double scaled = 0;
     double own_units = 0;
+    int row = -1;      ///< the worst constraint row, −1 when every row holds
+    double value = 0;  ///< its raw value z
   };
   /// The worst constraint row at `values` (one evaluation, no allocation).
   Violation check(const graph::Values& values) const;
@@ -98,6 +120,10 @@ class ConstrainedFactor : public graph::Factor {
   Violation update_multipliers(const graph::Values& values, Multipliers& m) const;
 
  protected:
+  /// Whether compute() must fill row `row`'s Jacobian for raw value z: false only while
+  /// evaluate() runs and the row is a bound whose hinge is off under the bound multipliers
+  /// (its residual and Jacobian row are then zero whatever compute() writes).
+  bool jacobian_row_needed(int row, double z) const;
   /// For a subclass whose compute() is linear in the variables: with soft and equality rows only
   /// the whitened Jacobian is then constant between penalty changes (Factor::jacobian_version).
   /// Throws std::logic_error if a row is a bound.

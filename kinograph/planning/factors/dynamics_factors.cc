@@ -5,6 +5,7 @@
 
 #include "kinograph/dynamics/inverse_dynamics.h"
 #include "kinograph/planning/factors/trajectory_factors.h"
+#include "kinograph/planning/user_terms.h"
 
 namespace kinograph::planning {
 
@@ -72,6 +73,12 @@ void DynamicsStepFactor::compute(const graph::FactorValues& x, Eigen::Ref<Eigen:
       J->block(2).row(r) = d.M.row(j);
     }
   }
+}
+
+std::string DynamicsStepFactor::describe_row(int row, double z, const RowContext& c) const {
+  const RowSpec& spec = rows()[static_cast<size_t>(row)];
+  return torque_text(c.model, joint_of_row_[static_cast<size_t>(row)],
+                     spec.kind == RowKind::kEquality, z, spec.lower, spec.upper, c.violation, c.t);
 }
 
 }  // namespace kinograph::planning

@@ -29,11 +29,14 @@ class DynamicsStepFactor final : public ConstrainedFactor {
                      std::shared_ptr<dynamics::Data> workspace, const DynamicsStepOptions& options);
   void compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
                const graph::Jacobians* J) const override;
+  std::string describe_row(int row, double z, const RowContext& c) const override;
 
   /// Rows this factor would have for `model` (also used to tell whether it is needed).
   static std::vector<RowSpec> rows_for(const dynamics::Model& model,
                                        const DynamicsStepOptions& options,
                                        std::vector<int>* joint_of_row = nullptr);
+  /// The joint whose torque each row holds.
+  const std::vector<int>& joint_of_row() const { return joint_of_row_; }
 
  private:
   std::shared_ptr<const dynamics::Model> model_;

@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "kinograph/planning/factors/trajectory_factors.h"
+#include "kinograph/planning/user_terms.h"
 
 namespace kinograph::planning {
 namespace {
@@ -71,51 +72,88 @@ IntervalDynamicsFactor::IntervalDynamicsFactor(int k, double dt,
       interpolant_(*model_) {
   for (int i = 1; i <= options.checks; ++i) times_.push_back(dt * i / (options.checks + 1));
   times_.push_back(dt);
+  points_.resize(times_.size());
+  while (defect_rows_ < static_cast<int>(layout_.size()) && layout_[defect_rows_].point < 0) {
+    ++defect_rows_;
+  }
+  int row = defect_rows_;
+  for (int i = 0; i < options.checks; ++i) {
+    point_begin_.push_back(row);
+    while (row < static_cast<int>(layout_.size()) && layout_[row].point == i) ++row;
+  }
+  point_begin_.push_back(row);
+}
+
+void IntervalDynamicsFactor::jacobian_row(int row, const Eigen::MatrixXd& d, double sign,
+                                          const graph::Jacobians& J) const {
+  const int n = model_->nq(), j = layout_[static_cast<size_t>(row)].joint;
+  // d's blocks 0, 1, 2 are q_k, q̇_k, q̈_k; its fourth, q̈_{k+1}, is key 5.
+  const int key_of[4] = {0, 1, 2, 5};
+  for (int b = 0; b < 4; ++b) J.block(key_of[b]).row(row) += sign * d.block(j, b * n, 1, n);
 }
 
 void IntervalDynamicsFactor::compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
                                      const graph::Jacobians* J) const {
   using Kind = Row::Kind;
-  const int n = model_->nq();
-  interpolant_.evaluate(x[0], x[1], x[2], x[5], dt_, times_, J != nullptr, points_);
-  const InterpolantPoint& end = points_.back();
-  for (size_t i = 0; i < layout_.size(); ++i) {
-    const Row& r = layout_[i];
-    const int row = static_cast<int>(i), j = r.joint;
-    // The value's derivative row with respect to z = [q_k; q̇_k; q̈_k; q̈_{k+1}], and its sign.
-    const Eigen::MatrixXd* d = nullptr;
-    double sign = 1;
+  const int checks = static_cast<int>(times_.size()) - 1;
+  // The defect needs the sensitivities to the end; check points only if a row of theirs is on.
+  const bool derivatives = J != nullptr;
+  interpolant_.start(x[0], x[1], x[2], x[5], dt_, derivatives);
+  for (int i = 0; i < checks; ++i) interpolant_.at(times_[i], false, points_[i]);
+  // The value of a row at a point.
+  const auto value = [&](const Row& r, const InterpolantPoint& p) {
     switch (r.kind) {
-      case Kind::kDefectQ:
-        z[row] = x[3][j] - end.q[j];
-        d = &end.dq;
-        sign = -1;
-        break;
-      case Kind::kDefectQd:
-        z[row] = x[4][j] - end.qd[j];
-        d = &end.dqd;
-        sign = -1;
-        break;
-      case Kind::kTau:
-        z[row] = points_[r.point].tau[j];
-        d = &points_[r.point].dtau;
-        break;
-      case Kind::kQ:
-        z[row] = points_[r.point].q[j];
-        d = &points_[r.point].dq;
-        break;
-      case Kind::kQd:
-        z[row] = points_[r.point].qd[j];
-        d = &points_[r.point].dqd;
-        break;
+      case Kind::kTau: return p.tau[r.joint];
+      case Kind::kQ: return p.q[r.joint];
+      default: return p.qd[r.joint];
     }
-    if (J == nullptr) continue;
-    if (r.kind == Kind::kDefectQ) J->block(3)(row, j) = 1;
-    if (r.kind == Kind::kDefectQd) J->block(4)(row, j) = 1;
-    // z's blocks 0, 1, 2 are q_k, q̇_k, q̈_k; its fourth, q̈_{k+1}, is key 5.
-    const int key_of[4] = {0, 1, 2, 5};
-    for (int b = 0; b < 4; ++b) J->block(key_of[b]).row(row) += sign * d->block(j, b * n, 1, n);
+  };
+  if (defect_rows_ > 0) {
+    InterpolantPoint& end = points_.back();
+    interpolant_.at(dt_, derivatives, end);
+    for (int row = 0; row < defect_rows_; ++row) {
+      const Row& r = layout_[row];
+      const bool q = r.kind == Kind::kDefectQ;
+      z[row] = x[q ? 3 : 4][r.joint] - (q ? end.q : end.qd)[r.joint];
+      if (!derivatives) continue;
+      J->block(q ? 3 : 4)(row, r.joint) = 1;
+      jacobian_row(row, q ? end.dq : end.dqd, -1, *J);
+    }
   }
+  for (int i = 0; i < checks; ++i) {
+    bool needed = false;
+    for (int row = point_begin_[i]; row < point_begin_[i + 1]; ++row) {
+      z[row] = value(layout_[row], points_[i]);
+      needed = needed || (derivatives && jacobian_row_needed(row, z[row]));
+    }
+    if (!needed) continue;
+    interpolant_.at(times_[i], true, with_derivatives_);
+    for (int row = point_begin_[i]; row < point_begin_[i + 1]; ++row) {
+      if (!jacobian_row_needed(row, z[row])) continue;
+      const Kind kind = layout_[row].kind;
+      jacobian_row(row,
+                   kind == Kind::kTau  ? with_derivatives_.dtau
+                   : kind == Kind::kQ ? with_derivatives_.dq
+                                      : with_derivatives_.dqd,
+                   1, *J);
+    }
+  }
+}
+
+std::string IntervalDynamicsFactor::describe_row(int row, double z, const RowContext& c) const {
+  const Row& r = layout_[static_cast<size_t>(row)];
+  const RowSpec& spec = rows()[static_cast<size_t>(row)];
+  if (r.kind == Row::Kind::kDefectQ || r.kind == Row::Kind::kDefectQd) {
+    const int derivative = r.kind == Row::Kind::kDefectQ ? 0 : 1;
+    return joint_label(c.model, r.joint) + " (unactuated) following its dynamics from " +
+           at_time(c.t) + " arrives at " + number(c.t + dt_) + " s with a " +
+           (derivative == 0 ? "position " : "velocity ") + number(c.violation) + " " +
+           joint_unit(c.model, r.joint, derivative) + " off the plan's knot";
+  }
+  const double t = c.t + times_[static_cast<size_t>(r.point)];
+  const int derivative = r.kind == Row::Kind::kQ ? 0 : r.kind == Row::Kind::kQd ? 1 : 3;
+  return limit_text(c.model, derivative, r.joint, z, spec.lower, spec.upper, c.violation, t) +
+         " (between the knots)";
 }
 
 }  // namespace kinograph::planning

@@ -2,6 +2,7 @@
 
 #include "kinograph/dynamics/kinematics.h"
 #include "kinograph/planning/factors/trajectory_factors.h"
+#include "kinograph/planning/user_terms.h"
 
 namespace kinograph::planning {
 namespace {
@@ -63,6 +64,19 @@ void PoseFactor::compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorX
     dynamics::point_jacobian(*model_, d, body_, T.translation(), J3_);
     B.block(row, 0, 3, model_->nq()) = J3_;
   }
+}
+
+std::string PoseFactor::describe_row(int row, double, const RowContext& c) const {
+  const bool rotation = orientation_row(row);
+  const std::string off =
+      rotation ? number(c.violation) + " (sine of the angle)" : number(c.violation) + " m";
+  const std::string what = rotation ? "orientation" : "position";
+  if (c.index >= 0) {
+    return "task constraint " + std::to_string(c.index + 1) + " on frame '" + frame_name() +
+           "' is off in " + what + " by " + off + " at " + at_time(c.t);
+  }
+  return "frame '" + frame_name() + "' misses its goal " + what + " by " + off + " at " +
+         at_time(c.t);
 }
 
 }  // namespace kinograph::planning

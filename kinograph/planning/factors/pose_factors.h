@@ -24,6 +24,11 @@ class PoseFactor final : public ConstrainedFactor {
              const Eigen::Isometry3d& target, PoseParts parts, double scale);
   void compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
                const graph::Jacobians* J) const override;
+  std::string describe_row(int row, double z, const RowContext& c) const override;
+  /// The frame's name in the model.
+  const std::string& frame_name() const { return model_->frames[frame_].name; }
+  /// Whether row `row` is an orientation row (else a position row, m).
+  bool orientation_row(int row) const { return orientation_ && row < 3; }
 
  private:
   std::shared_ptr<const dynamics::Model> model_;

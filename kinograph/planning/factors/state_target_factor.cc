@@ -1,4 +1,5 @@
 #include "kinograph/planning/factors/state_target_factor.h"
+#include "kinograph/planning/user_terms.h"
 
 #include <stdexcept>
 
@@ -54,6 +55,18 @@ Eigen::VectorXd StateTargetFactor::target() const {
   Eigen::VectorXd t(residual_dim());
   for (int i = 0; i < residual_dim(); ++i) t[i] = rows()[i].lower;
   return t;
+}
+
+std::string StateTargetFactor::describe_row(int row, double z, const RowContext& c) const {
+  const int j = row % n_;
+  const graph::Key key = keys()[static_cast<size_t>(row / n_)];
+  const int derivative = key.kind() == 'v' ? 1 : key.kind() == 'a' ? 2 : 0;
+  const char* const quantity[] = {"position", "velocity", "acceleration"};
+  const std::string u = joint_unit(c.model, j, derivative);
+  return joint_label(c.model, j) + " " + quantity[derivative] + " is " + number(z) + " " + u +
+         ", " + number(c.violation) + " " + u + " from its " + c.role + " " +
+         number(rows()[static_cast<size_t>(row)].lower) + " " + u + " at " +
+         at_time(key.step() * c.dt);
 }
 
 }  // namespace kinograph::planning

@@ -1,4 +1,5 @@
 #include "kinograph/planning/factors/trajectory_factors.h"
+#include "kinograph/planning/user_terms.h"
 
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
@@ -138,6 +139,20 @@ void StateLimitFactor::compute(const graph::FactorValues& x, Eigen::Ref<Eigen::V
     z[i] = x[l.variable][l.joint];
     if (J != nullptr) J->block(l.variable)(static_cast<int>(i), l.joint) = 1;
   }
+}
+
+std::string CollocationFactor::describe_row(int row, double, const RowContext& c) const {
+  const int m = static_cast<int>(joints_.size());
+  const int j = joints_[static_cast<size_t>(row % m)], derivative = row < m ? 0 : 1;
+  return joint_label(c.model, j) + (derivative == 0 ? " position" : " velocity") + " between " +
+         at_time(c.t) + " and " + number(c.t + c.dt) + " s disagrees with its " +
+         (derivative == 0 ? "velocity and acceleration" : "acceleration") + " by " +
+         number(c.violation) + " " + joint_unit(c.model, j, derivative);
+}
+
+std::string StateLimitFactor::describe_row(int row, double z, const RowContext& c) const {
+  const Limit& l = limits_[static_cast<size_t>(row)];
+  return limit_text(c.model, l.variable, l.joint, z, l.lower, l.upper, c.violation, c.t);
 }
 
 }  // namespace kinograph::planning

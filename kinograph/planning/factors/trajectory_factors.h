@@ -49,6 +49,7 @@ class CollocationFactor final : public ConstrainedFactor {
   CollocationFactor(int k, int n, double dt, double scale = 1.0, std::vector<int> joints = {});
   void compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
                const graph::Jacobians* J) const override;
+  std::string describe_row(int row, double z, const RowContext& c) const override;
 
  private:
   int n_;
@@ -70,6 +71,9 @@ class StateLimitFactor final : public ConstrainedFactor {
   StateLimitFactor(int k, int n, std::vector<Limit> limits, double scale = 1.0);
   void compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
                const graph::Jacobians* J) const override;
+  std::string describe_row(int row, double z, const RowContext& c) const override;
+  /// What each row limits, in row order.
+  const std::vector<Limit>& limits() const { return limits_; }
 
  private:
   std::vector<Limit> limits_;

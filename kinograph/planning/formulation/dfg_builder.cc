@@ -7,6 +7,7 @@
 
 #include "kinograph/dynamics/data.h"
 #include "kinograph/graph/noise_model.h"
+#include "kinograph/planning/user_terms.h"
 
 namespace kinograph::planning {
 
@@ -292,6 +293,17 @@ Eigen::VectorXd dfg_torques(const graph::Values& values, const dynamics::Model& 
   Eigen::VectorXd tau(n);
   for (int i = 0; i < n; ++i) tau[i] = values.at(keys.torque_key(i, step))[0];
   return tau;
+}
+
+std::string DfgTorqueRowsFactor::describe_row(int row, double z, const RowContext& c) const {
+  // The condensed factor's rows: its constraint rows come first and do not depend on the
+  // margins or the soft weight.
+  std::vector<int> joints;
+  DynamicsStepFactor::rows_for(c.model, DynamicsStepOptions{}, &joints);
+  if (row >= static_cast<int>(joints.size())) return "";
+  const RowSpec& spec = rows()[static_cast<size_t>(row)];
+  return torque_text(c.model, joints[static_cast<size_t>(row)], spec.kind == RowKind::kEquality,
+                     z, spec.lower, spec.upper, c.violation, c.t);
 }
 
 }  // namespace kinograph::planning

@@ -129,6 +129,7 @@ class DfgTorqueRowsFactor final : public ConstrainedFactor {
                       const DfgKeys& keys = {});
   void compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
                const graph::Jacobians* J) const override;
+  std::string describe_row(int row, double z, const RowContext& c) const override;
 
  private:
   std::vector<int> slot_of_row_, comp_of_row_;

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "kinograph/dynamics/inverse_dynamics.h"
+#include "kinograph/planning/clearance_world.h"
 #include "kinograph/planning/factors/dynamics_factors.h"
 #include "kinograph/planning/factors/interval_factors.h"
 #include "kinograph/planning/factors/pose_factors.h"
@@ -172,9 +173,13 @@ std::shared_ptr<CollisionContext> collision_context(
       problem.objectives.collision_epsilon + options.collision_query_margin);
 }
 
-std::vector<FactorEntry> collision_entries(const Problem& problem,
-                                           const std::shared_ptr<CollisionContext>& context,
-                                           int obstacle, const GraphOptions& options) {
+namespace {
+
+// Hinges of `context` at every free state and sub-step, keyed by `role` and `obstacle`.
+std::vector<FactorEntry> hinge_entries(const Problem& problem,
+                                       const std::shared_ptr<CollisionContext>& context,
+                                       FactorRole role, int obstacle, double epsilon,
+                                       const GraphOptions& options) {
   std::vector<FactorEntry> out;
   if (!context || context->num_pairs == 0) return out;
   const Objectives& obj = problem.objectives;
@@ -183,19 +188,44 @@ std::vector<FactorEntry> collision_entries(const Problem& problem,
   for (int k = 0; k <= N; ++k) {
     if (k > 0) {  // the start state is fixed; its clearance is checked before planning
       out.push_back(make_entry(
-          std::make_shared<CollisionFactor>(k, 0.0, dt, obj.collision_epsilon,
-                                            options.collision_scale, context),
-          {FactorRole::kCollision, k, 0, obstacle}));
+          std::make_shared<CollisionFactor>(k, 0.0, dt, epsilon, options.collision_scale,
+                                            context),
+          {role, k, 0, obstacle}));
     }
     if (k == N) break;
     for (int i = 1; i <= sub; ++i) {
       out.push_back(make_entry(std::make_shared<CollisionFactor>(
-                                   k, static_cast<double>(i) / (sub + 1), dt,
-                                   obj.collision_epsilon, options.collision_scale, context),
-                               {FactorRole::kCollision, k, i, obstacle}));
+                                   k, static_cast<double>(i) / (sub + 1), dt, epsilon,
+                                   options.collision_scale, context),
+                               {role, k, i, obstacle}));
     }
   }
   return out;
+}
+
+}  // namespace
+
+std::vector<FactorEntry> collision_entries(const Problem& problem,
+                                           const std::shared_ptr<CollisionContext>& context,
+                                           int obstacle, const GraphOptions& options) {
+  return hinge_entries(problem, context, FactorRole::kCollision, obstacle,
+                       problem.objectives.collision_epsilon, options);
+}
+
+std::vector<FactorEntry> self_collision_entries(const Problem& problem,
+                                                const GraphOptions& options) {
+  const SelfAndFloor& sf = problem.self_and_floor;
+  if (problem.model->collision.empty() || (!sf.self_collision && !sf.floor)) return {};
+  std::vector<collision::Obstacle> floor;
+  if (sf.floor) floor.push_back(floor_obstacle(*sf.floor));
+  SelfPairs self{sf.allowed_pairs, problem.objectives.self_collision_epsilon};
+  const Objectives& obj = problem.objectives;
+  // The floor takes the self ε too: arms work close to the surface they stand on.
+  auto ctx = std::make_shared<CollisionContext>(
+      problem.model, floor, obj.self_collision_epsilon + options.collision_query_margin,
+      sf.self_collision ? &self : nullptr);
+  return hinge_entries(problem, ctx, FactorRole::kSelfCollision, -1, obj.self_collision_epsilon,
+                       options);
 }
 
 FactorEntry start_entry(const Problem& problem) {
@@ -252,11 +282,13 @@ PlanningGraph build_graph(const Problem& problem, const Trajectory& init,
       pg.collision[-1] = ctx;
       for (FactorEntry& e : collision_entries(problem, ctx, -1, options)) pg.add(std::move(e));
     }
+    for (FactorEntry& e : self_collision_entries(problem, options)) pg.add(std::move(e));
     add_task_factors(pg, problem, options);
     return pg;
   }
   for (FactorEntry& e : timing_entries(problem, options)) pg.add(std::move(e));
   add_state_factors(pg, problem, options);
+  for (FactorEntry& e : self_collision_entries(problem, options)) pg.add(std::move(e));
   add_task_factors(pg, problem, options);
   pg.add(start_entry(problem));
   pg.add(goal_entry(problem, pg.dynamics_workspace, options));

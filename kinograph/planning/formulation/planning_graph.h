@@ -42,6 +42,9 @@ enum class FactorRole {
   kDynamics,     ///< equations of motion and torque rows of state k
   kCollision,    ///< hinges of state k (sub-step s) against one obstacle or all of them
   kTask,         ///< a task constraint at state k
+  /// hinges of state k (sub-step s) between the robot's own links and against the floor:
+  /// unchanged by obstacle changes, so replans keep them
+  kSelfCollision,
 };
 
 /// Names one factor of a planning graph, stable across rebuilds and replans (so constraint
@@ -61,7 +64,8 @@ struct FactorKey {
   /// Whether the factor depends on the time step Δt (replaced when the horizon changes).
   bool depends_on_dt() const {
     return role == FactorRole::kGpPrior || role == FactorRole::kCollocation ||
-           role == FactorRole::kInterval || role == FactorRole::kCollision;
+           role == FactorRole::kInterval || role == FactorRole::kCollision ||
+           role == FactorRole::kSelfCollision;
   }
 };
 
@@ -125,6 +129,10 @@ std::vector<FactorEntry> timing_entries(const Problem& problem, const GraphOptio
 std::vector<FactorEntry> collision_entries(const Problem& problem,
                                            const std::shared_ptr<CollisionContext>& context,
                                            int obstacle, const GraphOptions& options);
+/// The self-collision and floor hinges of every free state and sub-step (role kSelfCollision,
+/// in a collision world of their own); none when the problem has neither.
+std::vector<FactorEntry> self_collision_entries(const Problem& problem,
+                                                const GraphOptions& options);
 /// A collision world of `obstacles` with the problem's query distance.
 std::shared_ptr<CollisionContext> collision_context(
     const Problem& problem, const std::vector<collision::Obstacle>& obstacles,

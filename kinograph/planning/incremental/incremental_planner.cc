@@ -10,6 +10,7 @@
 #include "kinograph/planning/incremental/incremental_tree.h"
 #include "kinograph/planning/incremental/stopping_rule.h"
 #include "kinograph/planning/problem_check.h"
+#include "kinograph/planning/solver/violation_text.h"
 #include "kinograph/planning/validate.h"
 
 namespace kinograph::planning {
@@ -252,6 +253,16 @@ Plan IncrementalPlanner::replan(const ProblemChange& change) {
        << stats_.cliques_reeliminated << " cliques re-eliminated";
     plan.stats.reason = os.str();
   }
+  if (!valid_plan && (status == PlanStatus::kMaxUpdates || status == PlanStatus::kMaxRounds)) {
+    std::vector<const FactorEntry*> constraints;
+    for (const FactorEntry& e : tree_->entries) {
+      if (tracked(e)) constraints.push_back(&e);
+    }
+    const ConstraintReport worst = worst_constraint(constraints, tree_->isam->estimate());
+    if (worst.scaled_violation > options_.batch.outer_loop.constraint_tolerance) {
+      plan.stats.reason += "; the worst violation: " + describe_violation(problem_, worst);
+    }
+  }
   plan.stats.solve_time_s = seconds_since(t0);
   plan_ = plan;
   return plan;
@@ -289,6 +300,7 @@ void IncrementalPlanner::replace_factors(const ProblemChange& change, const Prob
   if (change.goal) added.push_back(goal_entry(next, t.workspace, go));
   if (timing) {
     for (FactorEntry& e : timing_entries(next, go)) added.push_back(std::move(e));
+    for (FactorEntry& e : self_collision_entries(next, go)) added.push_back(std::move(e));
   }
   for (const collision::Obstacle& o : next.obstacles) {
     if (!timing && changed_obstacles.count(o.id) == 0) continue;

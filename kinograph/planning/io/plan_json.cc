@@ -434,7 +434,7 @@ json plan_to_json(const Plan& plan, const Scene& scene) {
     }
     j["obstacles"].push_back(oj);
   }
-  json names = json::array();
+  json names = json::array(), passive = json::array();
   json lower = json::array(), upper = json::array(), velocity = json::array(),
        acceleration = json::array(), effort = json::array();
   if (problem.model) {
@@ -445,9 +445,11 @@ json plan_to_json(const Plan& plan, const Scene& scene) {
       velocity.push_back(number(b.limits.velocity));
       acceleration.push_back(number(b.limits.acceleration));
       effort.push_back(number(b.limits.effort));
+      if (!b.actuated) passive.push_back(b.joint_name);
     }
   }
   j["joint_names"] = names;
+  j["unactuated"] = passive;
   j["t"] = plan.t;
   j["q"] = matrix_rows(plan.q);
   j["qd"] = matrix_rows(plan.qd);
@@ -554,14 +556,18 @@ PlanFileInfo plan_info_from_json(const json& j, const std::string& source) {
       info.obstacle_rgba.push_back(rgba);
     }
   }
-  if (j.contains("joint_names")) {
-    const json& names = j["joint_names"];
-    if (!names.is_array()) fail(source, "joint_names", "must be an array of strings");
+  // A list of joint names under `key` (absent: empty).
+  const auto names_at = [&](const char* key, std::vector<std::string>& out) {
+    if (!j.contains(key)) return;
+    const json& names = j[key];
+    if (!names.is_array()) fail(source, key, "must be an array of strings");
     for (const json& name : names) {
-      if (!name.is_string()) fail(source, "joint_names", "must be an array of strings");
-      info.joint_names.push_back(name.get<std::string>());
+      if (!name.is_string()) fail(source, key, "must be an array of strings");
+      out.push_back(name.get<std::string>());
     }
-  }
+  };
+  names_at("joint_names", info.joint_names);
+  names_at("unactuated", info.unactuated);
   if (j.contains("limits")) {
     const json& limits = j["limits"];
     if (!limits.is_object()) fail(source, "limits", "must be an object");
@@ -626,8 +632,21 @@ dynamics::Model load_plan_model(const PlanFileInfo& info) {
     apply(info.limits.acceleration, body.limits.acceleration);
     if (column < info.limits.effort.size()) {
       body.limits.effort = info.limits.effort[column];
-      body.actuated = body.limits.effort > 0;  // the URDF convention: effort 0 is unactuated
+      if (!(body.limits.effort > 0)) {
+        fail(info.source, "limits.effort",
+             "joint '" + body.joint_name + "' has effort limit " +
+                 std::to_string(body.limits.effort) +
+                 "; a passive joint is named in \"unactuated\", not given effort 0");
+      }
     }
+  }
+  for (const std::string& name : info.unactuated) {
+    const auto it = std::find_if(model.bodies.begin(), model.bodies.end(),
+                                 [&](const dynamics::Body& b) { return b.joint_name == name; });
+    if (it == model.bodies.end()) {
+      fail(info.source, "unactuated", "no joint '" + name + "' in the robot '" + model.name + "'");
+    }
+    it->actuated = false;
   }
   return model;
 }

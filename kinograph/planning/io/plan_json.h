@@ -8,7 +8,7 @@
 //                 "position": [x,y,z], "quaternion": [w,x,y,z],
 //                 "motion": [{"t": s, "position": [..], "quaternion": [..]}] (moving only),
 //                 "rgba": [r,g,b,a] (optional, for pictures; the planner writes none)}],
-//  "joint_names": [...], "t": [...], "q": [[...], ...], "qd": ..., "qdd": ..., "tau": ...,
+//  "joint_names": [...], "unactuated": [joint names], "t": [...], "q": [[...], ...], "qd": ..., "qdd": ..., "tau": ...,
 //  "limits": {"lower": [...], "upper": [...], "velocity": [...], "acceleration": [...],
 //             "effort": [...]}, "stats": {...}, "validation": {...}}
 //
@@ -79,6 +79,7 @@ struct PlanFileInfo {
   std::vector<std::string> obstacle_names;     ///< their "id"s ("obstacles[i]" when absent)
   std::vector<std::optional<Eigen::Vector4d>> obstacle_rgba;  ///< their "rgba", when given
   std::vector<std::string> joint_names;  ///< column order of q, qd, qdd, tau; empty if absent
+  std::vector<std::string> unactuated;   ///< "unactuated": the passive joints, by name
   PlanLimits limits;
 };
 

@@ -9,8 +9,12 @@
 #include <set>
 #include <sstream>
 
+#include "kinograph/collision/obstacle.h"
+#include "kinograph/collision/shape.h"
 #include "kinograph/dynamics/payload.h"
 #include "kinograph/planning/batch/batch_planner.h"
+#include "kinograph/planning/clearance_world.h"
+#include "kinograph/planning/io/srdf.h"
 
 namespace kinograph::planning {
 namespace {
@@ -206,12 +210,14 @@ class SceneParser {
     if (!root.IsDefined() || root.IsNull()) r_.fail(root, "", "the file is empty");
     r_.expect_map(root, "",
                   {"name", "robot", "horizon", "steps", "start", "goal", "obstacles", "limits",
-                   "task_constraints", "objectives", "planner", "camera"});
+                   "unactuated", "task_constraints", "objectives", "planner", "camera",
+                   "self_collision", "allowed_collisions", "floor"});
     Problem& problem = scene.problem;
     problem.name = root["name"] ? r_.string(root["name"], "name")
                                 : (source_.empty() ? "scene" : fs::path(source_).stem().string());
     dynamics::Model model = parse_robot(root, scene);
     if (const YAML::Node limits = root["limits"]) parse_limits(limits, scene, model);
+    if (const YAML::Node passive = root["unactuated"]) parse_unactuated(passive, scene, model);
     problem.model = std::make_shared<const dynamics::Model>(std::move(model));
     const dynamics::Model& m = *problem.model;
 
@@ -228,6 +234,7 @@ class SceneParser {
 
     parse_goal(r_.required(root, "", "goal"), problem.goal, m);
     if (const YAML::Node obstacles = root["obstacles"]) parse_obstacles(obstacles, scene);
+    parse_self_and_floor(root, scene);
     if (const YAML::Node tasks = root["task_constraints"]) parse_tasks(tasks, problem, m);
     if (const YAML::Node objectives = root["objectives"]) {
       parse_objectives(objectives, problem.objectives);
@@ -253,7 +260,7 @@ class SceneParser {
 
   dynamics::Model parse_robot(const YAML::Node& root, Scene& scene) {
     const YAML::Node robot = r_.required(root, "", "robot");
-    r_.expect_map(robot, "robot", {"urdf", "payload"});
+    r_.expect_map(robot, "robot", {"urdf", "payload", "srdf"});
     const YAML::Node urdf = r_.required(robot, "robot", "urdf");
     scene.urdf = r_.string(urdf, "robot.urdf");
     scene.urdf_path = resolve(urdf, "robot.urdf", scene.urdf);
@@ -281,6 +288,54 @@ class SceneParser {
       scene.payload = payload;
     }
     return model;
+  }
+
+  // robot.srdf, allowed_collisions, self_collision and floor: what the robot must clear
+  // besides the obstacles.
+  void parse_self_and_floor(const YAML::Node& root, Scene& scene) {
+    SelfAndFloor& sf = scene.problem.self_and_floor;
+    const dynamics::Model& m = *scene.problem.model;
+    if (const YAML::Node srdf = root["robot"]["srdf"]) {
+      scene.srdf = r_.string(srdf, "robot.srdf");
+      scene.srdf_path = resolve(srdf, "robot.srdf", scene.srdf);
+      try {
+        for (const auto& pair : allowed_body_pairs(m, load_srdf(scene.srdf_path), scene.srdf_path))
+          sf.allowed_pairs.push_back(pair);
+      } catch (const SrdfError& e) {
+        r_.fail(srdf, "robot.srdf", e.what());
+      }
+    }
+    if (const YAML::Node list = root["allowed_collisions"]) {
+      if (!list.IsSequence()) r_.fail(list, "allowed_collisions", "must be a list of [link, link]");
+      for (std::size_t i = 0; i < list.size(); ++i) {
+        const std::string key = index_key("allowed_collisions", i);
+        if (!list[i].IsSequence() || list[i].size() != 2)
+          r_.fail(list[i], key, "must be [link, link]");
+        std::pair<std::string, std::string> names;
+        int body[2];
+        for (std::size_t j = 0; j < 2; ++j) {
+          const std::string k = index_key(key, j);
+          const std::string link = r_.string(list[i][j], k);
+          check_frame(list[i][j], k, link, m);
+          body[j] = m.frames[m.frame_index(link)].body;
+          (j == 0 ? names.first : names.second) = link;
+        }
+        sf.allowed_pairs.emplace_back(body[0], body[1]);
+        scene.allowed_collisions.push_back(std::move(names));
+      }
+    }
+    if (root["self_collision"])
+      sf.self_collision = r_.boolean(root["self_collision"], "self_collision");
+    sf.floor = mounting_floor(m);
+    if (const YAML::Node floor = root["floor"]) {
+      r_.expect_map(floor, "floor", {"enabled", "height"});
+      const bool enabled = !floor["enabled"] || r_.boolean(floor["enabled"], "floor.enabled");
+      const double height = floor["height"] ? r_.finite(floor["height"], "floor.height") : 0.0;
+      if (floor["height"] && !enabled) {
+        r_.fail(floor["height"], "floor.height", "a disabled floor takes no height");
+      }
+      sf.floor = enabled ? std::optional<double>(height) : std::nullopt;
+    }
   }
 
   void parse_limits(const YAML::Node& limits, Scene& scene, dynamics::Model& model) {
@@ -312,8 +367,31 @@ class SceneParser {
       bound("velocity", o.velocity, l.velocity);
       bound("effort", o.effort, l.effort);
       bound("acceleration", o.acceleration, l.acceleration);
-      if (o.effort) model.bodies[body].actuated = *o.effort > 0;
+      if (o.effort && *o.effort == 0) {
+        r_.fail(node["effort"], join(key, "effort"),
+                "0 would forbid any torque; list a passive joint under 'unactuated' instead");
+      }
       scene.limits.emplace_back(joint, o);
+    }
+  }
+
+  // The passive joints: URDF has no way to say a joint has no motor.
+  void parse_unactuated(const YAML::Node& list, Scene& scene, dynamics::Model& model) {
+    if (!list.IsSequence()) r_.fail(list, "unactuated", "must be a list of joint names");
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const std::string key = index_key("unactuated", i);
+      const std::string joint = r_.string(list[i], key);
+      int body = -1;
+      for (int b = 0; b < model.nq(); ++b) {
+        if (model.bodies[b].joint_name == joint) body = b;
+      }
+      if (body < 0)
+        r_.fail(list[i], key, "no joint '" + joint + "' in the robot '" + model.name + "'");
+      for (const std::string& other : scene.unactuated) {
+        if (other == joint) r_.fail(list[i], key, "joint '" + joint + "' is listed twice");
+      }
+      model.bodies[body].actuated = false;
+      scene.unactuated.push_back(joint);
     }
   }
 
@@ -353,6 +431,11 @@ class SceneParser {
 
   void parse_obstacles(const YAML::Node& list, Scene& scene) {
     if (!list.IsSequence()) r_.fail(list, "obstacles", "must be a list");
+    if (list.size() > static_cast<std::size_t>(collision::kMaxObstacles)) {
+      r_.fail(list, "obstacles",
+              "holds " + std::to_string(list.size()) + " obstacles, more than the " +
+                  std::to_string(collision::kMaxObstacles) + " a world may hold");
+    }
     for (std::size_t i = 0; i < list.size(); ++i) {
       const YAML::Node node = list[i];
       const std::string key = index_key("obstacles", i);
@@ -367,9 +450,16 @@ class SceneParser {
       collision::Obstacle obstacle;
       obstacle.id = static_cast<int>(scene.obstacle_names.size());
       obstacle.shape = parse_shape(node, key);
+      if (const std::string e = collision::range_error(obstacle.shape); !e.empty()) {
+        const char* k = obstacle.shape.kind == collision::ShapeKind::kMesh ? "scale" : "size";
+        r_.fail(node[k], join(key, k), "obstacle '" + name + "': " + e);
+      }
       const Eigen::Vector3d position = node["position"]
                                            ? r_.vector3(node["position"], join(key, "position"))
                                            : Eigen::Vector3d::Zero().eval();
+      if (const std::string e = collision::position_range_error(position); !e.empty()) {
+        r_.fail(node["position"], join(key, "position"), "obstacle '" + name + "': " + e);
+      }
       obstacle.pose =
           make_pose(position, r_.rotation(node, key).value_or(Eigen::Matrix3d::Identity()));
       if (const YAML::Node motion = node["motion"]) {
@@ -478,7 +568,7 @@ class SceneParser {
   void parse_objectives(const YAML::Node& node, Objectives& o) {
     r_.expect_map(node, "objectives",
                   {"min_torque", "qc", "collision_epsilon", "limit_epsilon", "collision_substeps",
-                   "limit_substeps"});
+                   "self_collision_epsilon", "limit_substeps"});
     if (node["min_torque"]) {
       o.min_torque = r_.non_negative(node["min_torque"], "objectives.min_torque");
     }
@@ -489,6 +579,10 @@ class SceneParser {
     }
     if (node["limit_epsilon"]) {
       o.limit_epsilon = r_.non_negative(node["limit_epsilon"], "objectives.limit_epsilon");
+    }
+    if (node["self_collision_epsilon"]) {
+      o.self_collision_epsilon =
+          r_.non_negative(node["self_collision_epsilon"], "objectives.self_collision_epsilon");
     }
     if (node["collision_substeps"]) {
       o.collision_substeps =
@@ -644,6 +738,9 @@ void emit_limits(YAML::Emitter& out, const Scene& scene) {
     }
     out << YAML::EndMap;
   }
+  if (!scene.unactuated.empty()) {
+    out << YAML::Key << "unactuated" << YAML::Value << YAML::Flow << scene.unactuated;
+  }
 }
 
 // The obstacles section, in the problem's order, named as in the file.
@@ -693,6 +790,23 @@ void emit_obstacles(YAML::Emitter& out, const Scene& scene) {
   }
 }
 
+// self_collision, allowed_collisions (the scene's own; the SRDF's stay in its file) and floor.
+void emit_self_and_floor(YAML::Emitter& out, const Scene& scene) {
+  const SelfAndFloor& sf = scene.problem.self_and_floor;
+  out << YAML::Key << "self_collision" << YAML::Value << sf.self_collision;
+  if (!scene.allowed_collisions.empty()) {
+    out << YAML::Key << "allowed_collisions" << YAML::Value << YAML::BeginSeq;
+    for (const auto& [a, b] : scene.allowed_collisions) {
+      out << YAML::Flow << YAML::BeginSeq << a << b << YAML::EndSeq;
+    }
+    out << YAML::EndSeq;
+  }
+  out << YAML::Key << "floor" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "enabled" << YAML::Value << sf.floor.has_value();
+  if (sf.floor) out << YAML::Key << "height" << YAML::Value << *sf.floor;
+  out << YAML::EndMap;
+}
+
 }  // namespace
 
 std::string scene_to_yaml(const Scene& scene) {
@@ -714,6 +828,7 @@ std::string scene_to_yaml(const Scene& scene) {
     emit_vector(out, pl.offset);
     out << YAML::EndMap;
   }
+  if (!scene.srdf_path.empty()) out << YAML::Key << "srdf" << YAML::Value << scene.srdf_path;
   out << YAML::EndMap;
   out << YAML::Key << "horizon" << YAML::Value << p.horizon;
   out << YAML::Key << "steps" << YAML::Value << p.steps;
@@ -735,6 +850,7 @@ std::string scene_to_yaml(const Scene& scene) {
   out << YAML::EndMap;
   emit_limits(out, scene);
   emit_obstacles(out, scene);
+  emit_self_and_floor(out, scene);
   if (!p.task_constraints.empty()) {
     out << YAML::Key << "task_constraints" << YAML::Value << YAML::BeginSeq;
     for (const TaskConstraint& t : p.task_constraints) {
@@ -758,6 +874,7 @@ std::string scene_to_yaml(const Scene& scene) {
   out << YAML::Key << "collision_epsilon" << YAML::Value << o.collision_epsilon;
   out << YAML::Key << "limit_epsilon" << YAML::Value << o.limit_epsilon;
   out << YAML::Key << "collision_substeps" << YAML::Value << o.collision_substeps;
+  out << YAML::Key << "self_collision_epsilon" << YAML::Value << o.self_collision_epsilon;
   out << YAML::Key << "limit_substeps" << YAML::Value << o.limit_substeps;
   out << YAML::EndMap;
   out << YAML::Key << "planner" << YAML::Value << YAML::BeginMap;

@@ -41,7 +41,7 @@ struct PayloadSpec {
 };
 
 /// Replacement limits for one joint (scene key limits.<joint>); unset entries keep the URDF's.
-/// An effort of 0 makes the joint unactuated, as in the URDF convention.
+/// An effort must be > 0 (a passive joint is listed in Scene::unactuated instead).
 struct LimitOverride {
   std::optional<double> lower, upper, velocity, effort, acceleration;
 };
@@ -64,8 +64,15 @@ struct Scene {
   std::optional<PayloadSpec> payload;
   /// Limit overrides in file order, by joint name.
   std::vector<std::pair<std::string, LimitOverride>> limits;
+  /// Passive joints (scene key `unactuated`), by name in file order: their torque is held at 0.
+  std::vector<std::string> unactuated;
   /// Obstacle names; problem.obstacles[i] has id i and the name obstacle_names[i].
   std::vector<std::string> obstacle_names;
+  std::string srdf;       ///< robot.srdf as written in the file; empty when none
+  std::string srdf_path;  ///< robot.srdf resolved to an absolute path
+  /// The scene's allowed_collisions link pairs, as named; problem.self_and_floor.allowed_pairs
+  /// holds their bodies and the SRDF's.
+  std::vector<std::pair<std::string, std::string>> allowed_collisions;
   PlannerSpec planner;
   /// The problem; problem.model is the URDF with payload attached and overrides applied.
   Problem problem;

@@ -21,19 +21,27 @@ AugmentedLagrangian::AugmentedLagrangian(std::vector<const FactorEntry*> constra
   state_.set_penalty(options_.initial_penalty);
 }
 
-ConstraintReport AugmentedLagrangian::report(const graph::Values& values) const {
+ConstraintReport worst_constraint(const std::vector<const FactorEntry*>& constraints,
+                                  const graph::Values& values) {
   ConstraintReport r;
   const ConstrainedFactor* worst = nullptr;
-  for (const FactorEntry* e : constraints_) {
+  for (const FactorEntry* e : constraints) {
     const ConstrainedFactor::Violation v = e->constrained->check(values);
     if (v.scaled > r.scaled_violation) {
       r.scaled_violation = v.scaled;
       r.violation = v.own_units;
+      r.entry = e;
+      r.row = v.row;
+      r.value = v.value;
       worst = e->constrained.get();
     }
   }
   if (worst != nullptr) r.where = worst->name() + " " + worst->keys().front().to_string();
   return r;
+}
+
+ConstraintReport AugmentedLagrangian::report(const graph::Values& values) const {
+  return worst_constraint(constraints_, values);
 }
 
 double AugmentedLagrangian::update(const graph::Values& values) {

@@ -29,7 +29,16 @@ struct ConstraintReport {
   double scaled_violation = 0;  ///< max |c| (violation / scale)
   double violation = 0;         ///< the same row's violation in its own units
   std::string where;            ///< factor name and first key, e.g. "DynamicsStepFactor q(0,12)"
+  /// The entry and row of that worst violation (null / −1 when every row holds), and the row's
+  /// raw value, from which describe_violation says what it means to the user.
+  const FactorEntry* entry = nullptr;
+  int row = -1;
+  double value = 0;
 };
+
+/// The worst constraint row over `constraints` at `values` (one evaluation of each).
+ConstraintReport worst_constraint(const std::vector<const FactorEntry*>& constraints,
+                                  const graph::Values& values);
 
 /// The schedule over a set of constraint entries whose multipliers live in `state`.
 class AugmentedLagrangian {

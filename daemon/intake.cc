@@ -1,0 +1,37 @@
+#include "daemon/intake.h"
+
+#include <iterator>
+#include <utility>
+
+namespace kinograph::daemon {
+
+bool Intake::empty() const {
+  return !goal && superseded.empty() && lost.empty() && obstacles.empty() && !replace_all &&
+         states == 0;
+}
+
+void Intake::absorb(Intake&& newer) {
+  if (newer.goal) {
+    if (goal) superseded.push_back(goal->goal_id);
+    goal = std::move(newer.goal);
+  }
+  superseded.insert(superseded.end(), newer.superseded.begin(), newer.superseded.end());
+  lost.insert(lost.end(), newer.lost.begin(), newer.lost.end());
+  if (newer.replace_all) {
+    obstacles.clear();
+    replace_all = true;
+  }
+  obstacles.insert(obstacles.end(), std::make_move_iterator(newer.obstacles.begin()),
+                   std::make_move_iterator(newer.obstacles.end()));
+  if (newer.state) state = std::move(newer.state);
+  states += newer.states;
+}
+
+std::optional<LostGoals> GoalIdSequence::next(int64_t id) {
+  const int64_t previous = last_;
+  last_ = id;
+  if (previous < 0 || id <= previous + 1 || id - previous - 1 > max_gap_) return std::nullopt;
+  return LostGoals{previous + 1, id - 1, id};
+}
+
+}  // namespace kinograph::daemon

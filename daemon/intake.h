@@ -1,0 +1,57 @@
+#pragma once
+// What the daemon has taken off LCM and not yet handed to its planner, and the goal-id
+// bookkeeping that finds goals LCM or the network lost. The LCM thread fills an Intake without
+// blocking on the planner; the worker takes it whole, answers every superseded or lost goal and
+// plans only the newest one.
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "kinograph/lcm/message_convert.h"
+
+namespace kinograph::daemon {
+
+/// Goal ids first..last (inclusive) that never arrived, found missing when goal `revealed_by`
+/// did.
+struct LostGoals {
+  int64_t first = 0;
+  int64_t last = 0;
+  int64_t revealed_by = 0;
+  /// How many ids never arrived.
+  int64_t count() const { return last - first + 1; }
+};
+
+/// Messages received but not yet planned, coalesced: the newest valid goal, the goals it
+/// replaced (each to be answered SUPERSEDED), goal ids found missing, the obstacle changes in
+/// arrival order and the latest measured state.
+struct Intake {
+  std::optional<messages::GoalRequest> goal;
+  std::vector<int64_t> superseded;
+  std::vector<LostGoals> lost;
+  std::vector<messages::ObstacleUpdate> obstacles;
+  bool replace_all = false;  ///< the obstacle list starts from an empty world
+  std::optional<messages::MeasuredState> state;
+  std::uint64_t states = 0;  ///< measured states received
+
+  /// Nothing arrived.
+  bool empty() const;
+  /// Adds what arrived after this intake: a newer goal supersedes the one held here, a
+  /// replace_all discards the obstacle changes held here, a newer state replaces the old one.
+  void absorb(Intake&& newer);
+};
+
+/// Goal ids as one sender numbers them (1, 2, 3, ...): finds the ids skipped between two
+/// consecutive goals. A jump of more than `max_gap` ids, or a step back, is taken as a new
+/// numbering (a restarted or another sender), not as a loss.
+class GoalIdSequence {
+ public:
+  explicit GoalIdSequence(int64_t max_gap) : max_gap_(max_gap) {}
+  /// Records the goal `id` just received; returns the ids skipped since the previous goal.
+  std::optional<LostGoals> next(int64_t id);
+
+ private:
+  int64_t max_gap_;
+  int64_t last_ = -1;
+};
+
+}  // namespace kinograph::daemon

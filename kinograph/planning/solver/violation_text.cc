@@ -1,0 +1,62 @@
+#include "kinograph/planning/solver/violation_text.h"
+
+#include <sstream>
+
+#include "kinograph/planning/user_terms.h"
+
+namespace kinograph::planning {
+namespace {
+
+const char* role_name(FactorRole role) {
+  switch (role) {
+    case FactorRole::kStart:
+      return "start";
+    case FactorRole::kGoal:
+      return "goal";
+    case FactorRole::kGpPrior:
+      return "smoothness prior";
+    case FactorRole::kCollocation:
+      return "collocation";
+    case FactorRole::kLimits:
+      return "limits";
+    case FactorRole::kDynamics:
+      return "equations of motion";
+    case FactorRole::kInterval:
+      return "dynamics between the knots";
+    case FactorRole::kCollision:
+      return "collision";
+    case FactorRole::kSelfCollision:
+      return "self-collision";
+    case FactorRole::kTask:
+      return "task constraint";
+  }
+  return "constraint";
+}
+
+}  // namespace
+
+std::string describe_violation(const Problem& problem, const ConstraintReport& worst) {
+  if (worst.entry == nullptr || worst.row < 0 || !worst.entry->constrained || !problem.model) {
+    return worst.where.empty() ? "all constraints hold" : worst.where;
+  }
+  const FactorEntry& e = *worst.entry;
+  const double dt = problem.dt(), t = e.key.step * dt;
+  ConstrainedFactor::RowContext context{*problem.model, t, dt, role_name(e.key.role),
+                                        e.key.role == FactorRole::kTask ? e.key.index : -1,
+                                        worst.violation};
+  const std::string text = e.constrained->describe_row(worst.row, worst.value, context);
+  if (!text.empty()) return text;
+  // The DFG's equations: the role and time, with the factor for the specialist.
+  return std::string(role_name(e.key.role)) + " at " + at_time(t) + " off by " +
+         number(worst.violation) + " (" + worst.where + ")";
+}
+
+std::string infeasible_reason(const Problem& problem, const OuterLoopResult& result) {
+  std::ostringstream os;
+  os << "constraints still violated after " << result.outer_iterations << " outer and "
+     << result.iterations
+     << " LM iterations; the worst: " << describe_violation(problem, result.worst);
+  return os.str();
+}
+
+}  // namespace kinograph::planning
