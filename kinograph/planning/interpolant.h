@@ -58,6 +58,12 @@ class IntervalInterpolant {
   /// Throws std::invalid_argument for s outside [0, dt] or derivatives without them.
   void at(double s, bool derivatives, InterpolantPoint& p);
 
+  /// Where the unactuated joints arrive at dt, y = [q_u; q̇_u] (joints in unactuated() order),
+  /// and, after a start() with derivatives, dy/dz (2m × 4n): the shooting defect's ingredients
+  /// without the inverse dynamics of a full point.
+  const Eigen::VectorXd& end_state() const { return y_[steps_]; }
+  const Eigen::MatrixXd& end_sensitivity() const { return S_[steps_]; }
+
   /// start() and at() for the times `s` (ascending, in [0, dt]); `out` is resized to match.
   void evaluate(const Eigen::Ref<const Eigen::VectorXd>& q0,
                 const Eigen::Ref<const Eigen::VectorXd>& qd0,

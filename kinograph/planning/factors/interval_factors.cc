@@ -108,17 +108,17 @@ void IntervalDynamicsFactor::compute(const graph::FactorValues& x, Eigen::Ref<Ei
       default: return p.qd[r.joint];
     }
   };
-  if (defect_rows_ > 0) {
-    InterpolantPoint& end = points_.back();
-    interpolant_.at(dt_, derivatives, end);
-    for (int row = 0; row < defect_rows_; ++row) {
-      const Row& r = layout_[row];
-      const bool q = r.kind == Kind::kDefectQ;
-      z[row] = x[q ? 3 : 4][r.joint] - (q ? end.q : end.qd)[r.joint];
-      if (!derivatives) continue;
-      J->block(q ? 3 : 4)(row, r.joint) = 1;
-      jacobian_row(row, q ? end.dq : end.dqd, -1, *J);
-    }
+  // Defect rows come in unactuated() order, positions first: row i reads y[i] and S.row(i).
+  const Eigen::VectorXd& y = interpolant_.end_state();
+  for (int row = 0; row < defect_rows_; ++row) {
+    const Row& r = layout_[row];
+    const int block = r.kind == Kind::kDefectQ ? 3 : 4;
+    z[row] = x[block][r.joint] - y[row];
+    if (!derivatives) continue;
+    J->block(block)(row, r.joint) = 1;
+    const Eigen::MatrixXd& S = interpolant_.end_sensitivity();
+    const int n = model_->nq(), key_of[4] = {0, 1, 2, 5};
+    for (int b = 0; b < 4; ++b) J->block(key_of[b]).row(row) -= S.block(row, b * n, 1, n);
   }
   for (int i = 0; i < checks; ++i) {
     bool needed = false;
