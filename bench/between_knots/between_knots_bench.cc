@@ -8,6 +8,7 @@
 #include <cmath>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -85,24 +86,30 @@ int run(int argc, char** argv) {
                                                      "/robots/scenes/acrobot_swingup.yaml");
   const planning::BatchPlanner planner;
   json result = json::array();
-  // The coarse plan that finer grids are refined from (its interpolant sampled at their knots).
+  // Successful plans by grid: a finer grid is refined from the finest one that divides it
+  // (its interpolant sampled at the finer knots), starting from the `refine_from` grid.
+  std::map<int, planning::Plan> solved;
   planning::Problem coarse_problem = scene.problem;
   coarse_problem.steps = refine_from;
   const planning::Plan coarse = planner.plan(coarse_problem);
+  if (coarse.success()) solved[refine_from] = coarse;
   std::vector<std::pair<int, bool>> cases;
   for (int steps : grids) {
     cases.push_back({steps, false});
-    if (coarse.success() && steps > refine_from && steps % refine_from == 0) {
-      cases.push_back({steps, true});
-    }
+    if (steps > refine_from && steps % refine_from == 0) cases.push_back({steps, true});
   }
   for (const auto& [steps, refined] : cases) {
     planning::Problem problem = scene.problem;
     problem.steps = steps;
     planning::Plan warm;
+    int source = 0;
     if (refined) {
+      for (const auto& [grid, plan] : solved) {
+        if (grid < steps && steps % grid == 0) source = grid;
+      }
+      if (source == 0) continue;  // no coarser plan to refine from
       const planning::SampledPath path =
-          planning::sample_plan(*problem.model, coarse, steps / refine_from);
+          planning::sample_plan(*problem.model, solved.at(source), steps / source);
       warm.t = path.t;
       warm.q = path.q;
       warm.qd = path.qd;
@@ -118,7 +125,7 @@ int run(int argc, char** argv) {
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     }
     json row = {{"steps", steps},
-                {"init", refined ? "refined from " + std::to_string(refine_from) + " steps"
+                {"init", refined ? "refined from " + std::to_string(source) + " steps"
                                  : std::string("straight line")},
                 {"success", plan.success()},
                 {"status", to_string(plan.stats.status)},
@@ -134,6 +141,7 @@ int run(int argc, char** argv) {
       row["validator_tau_violation_between"] = plan.validation.max_tau_violation_between;
       row["validator_position_consistency"] = plan.validation.max_position_consistency;
     }
+    if (plan.success() && (refined || solved.count(steps) == 0)) solved[steps] = plan;
     std::cerr << row.dump() << "\n";
     result.push_back(row);
   }

@@ -262,6 +262,35 @@ TEST(IntervalDynamicsFactor, RowsOfTheAcrobot) {
   EXPECT_THROW(IntervalDynamicsFactor(0, 0.1, rr, o), std::invalid_argument);
 }
 
+// Rows in the user's terms: the defect as the unactuated joint missing the next knot, a limit
+// row at its check point's own time.
+TEST(IntervalDynamicsFactor, RowsSpeakUserTerms) {
+  const auto model = testing::acrobot_model();
+  IntervalDynamicsOptions o;
+  o.checks = 4;
+  IntervalDynamicsFactor f(55, 0.1, model, o);
+  const auto context = [&](double violation) {
+    return ConstrainedFactor::RowContext{*model, 5.5, 0.1, "dynamics between the knots", -1,
+                                         violation};
+  };
+  EXPECT_EQ(f.describe_row(0, 0.02, context(0.02)),
+            "joint 1 (shoulder), unactuated, follows its dynamics from t = 5.5 s and arrives at "
+            "t = 5.6 s 0.02 rad off the next knot's position");
+  EXPECT_EQ(f.describe_row(1, -0.3, context(0.3)),
+            "joint 1 (shoulder), unactuated, follows its dynamics from t = 5.5 s and arrives at "
+            "t = 5.6 s 0.3 rad/s off the next knot's velocity");
+  // Rows of check point 1 (t = 5.5 + 2·0.1/5 s): shoulder q, q̇, then the elbow's τ first.
+  int tau_row = -1;
+  for (int i = 0; i < f.residual_dim(); ++i) {
+    if (tau_row < 0 && f.rows()[i].upper == 8.0) tau_row = i;
+  }
+  ASSERT_GE(tau_row, 0);
+  const int per_point = 5;  // elbow τ, both q and both q̇
+  EXPECT_EQ(f.describe_row(tau_row + per_point, 8.6, context(0.6)),
+            "joint 2 (elbow) torque 8.6 N·m exceeds its 8 N·m limit by 0.6 N·m at t = 5.54 s "
+            "(between the knots)");
+}
+
 TEST(IntervalDynamicsFactor, DefectIsZeroOnTheInterpolant) {
   const auto model = testing::acrobot_model();
   std::mt19937 rng(8);

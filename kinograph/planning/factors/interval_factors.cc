@@ -145,10 +145,10 @@ std::string IntervalDynamicsFactor::describe_row(int row, double z, const RowCon
   const RowSpec& spec = rows()[static_cast<size_t>(row)];
   if (r.kind == Row::Kind::kDefectQ || r.kind == Row::Kind::kDefectQd) {
     const int derivative = r.kind == Row::Kind::kDefectQ ? 0 : 1;
-    return joint_label(c.model, r.joint) + " (unactuated) following its dynamics from " +
-           at_time(c.t) + " arrives at " + number(c.t + dt_) + " s with a " +
-           (derivative == 0 ? "position " : "velocity ") + number(c.violation) + " " +
-           joint_unit(c.model, r.joint, derivative) + " off the plan's knot";
+    return joint_label(c.model, r.joint) + ", unactuated, follows its dynamics from " +
+           at_time(c.t) + " and arrives at " + at_time(c.t + dt_) + " " + number(c.violation) +
+           " " + joint_unit(c.model, r.joint, derivative) + " off the next knot's " +
+           (derivative == 0 ? "position" : "velocity");
   }
   const double t = c.t + times_[static_cast<size_t>(r.point)];
   const int derivative = r.kind == Row::Kind::kQ ? 0 : r.kind == Row::Kind::kQd ? 1 : 3;
