@@ -8,14 +8,17 @@ PACKAGES=(
   cmake ninja-build pkg-config g++ git
   # messaging
   liblcm-dev liblcm-bin libglib2.0-dev
+  # lcm-spy with kinograph's types (the jar is built when a JDK, e.g. openjdk-17-jdk-headless,
+  # is present too; this script does not install one)
+  liblcm-java libjchart2d-java
   # numerics, collision, models, meshes
   libeigen3-dev libsuitesparse-dev libbullet-dev liburdfdom-dev libassimp-dev
   # rendering and plots
-  libosmesa6-dev libpng-dev libfreetype-dev fonts-dejavu-core libcairo2-dev
+  libosmesa6-dev libpng-dev fonts-dejavu-core libcairo2-dev
   # tools, config, logging
   nlohmann-json3-dev libyaml-cpp-dev libexpat1-dev libcli11-dev libspdlog-dev
-  # tests and benchmarks (KDL and Ceres are test/bench-only oracles; OMPL for the SST baseline)
-  libgtest-dev libgmock-dev libbenchmark-dev liborocos-kdl-dev libceres-dev libompl-dev
+  # tests and benchmarks (KDL and Ceres are test/bench-only oracles)
+  libgtest-dev libgmock-dev libbenchmark-dev liborocos-kdl-dev libceres-dev
   # third-party URDFs with real meshes for renderer tests
   dart-doc
   # network namespaces for LCM multicast tests

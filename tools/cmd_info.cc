@@ -5,11 +5,13 @@
 #include <cmath>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "kinograph/dynamics/data.h"
 #include "kinograph/dynamics/inverse_dynamics.h"
 #include "kinograph/dynamics/model.h"
 #include "tools/command_registry.h"
+#include "tools/number_list.h"
 
 namespace kinograph::tools {
 namespace {
@@ -19,36 +21,15 @@ struct InfoArgs {
   std::string q;
 };
 
-// "0.1,-0.2,..." → exactly n numbers; anything else is a clean error naming the token.
+// "0.1,pi/2,..." → exactly n joint positions (all zero when empty).
 Eigen::VectorXd parse_configuration(const std::string& text, int n) {
-  Eigen::VectorXd q = Eigen::VectorXd::Zero(n);
-  if (text.empty()) return q;
-  int count = 0;
-  size_t start = 0;
-  while (true) {
-    const size_t comma = text.find(',', start);
-    const std::string token =
-        text.substr(start, comma == std::string::npos ? comma : comma - start);
-    size_t used = 0;
-    double value = 0;
-    try {
-      value = std::stod(token, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != token.size() || !std::isfinite(value)) {
-      throw CommandFailure("--q: '" + token + "' is not a number");
-    }
-    if (count < n) q[count] = value;
-    ++count;
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
-  if (count != n) {
+  if (text.empty()) return Eigen::VectorXd::Zero(n);
+  const std::vector<double> q = parse_number_list(text, "--q");
+  if (static_cast<int>(q.size()) != n) {
     throw CommandFailure(
-        fmt::format("--q: the robot has {} joints but {} values were given", n, count));
+        fmt::format("--q: the robot has {} joints but {} values were given", n, q.size()));
   }
-  return q;
+  return Eigen::Map<const Eigen::VectorXd>(q.data(), n);
 }
 
 std::string limit(double v) {
@@ -110,8 +91,9 @@ const bool kRegistered = register_command([](CLI::App& root) {
       "info", "Print a robot's joint table, total mass and gravity torques at a configuration");
   cmd->add_option("urdf", args->urdf, "Robot description (URDF file)")->required();
   cmd->add_option("--q", args->q,
-                  "Joint positions, comma-separated, one per joint (default: all zero); write "
-                  "--q=-0.5,1.2 when the first value is negative");
+                  "Joint positions (rad, or m for prismatic joints), comma-separated, one per "
+                  "joint; angles may use pi (pi/2); default: all zero. Write --q=-0.5,1.2 when "
+                  "the first value is negative");
   cmd->callback([args] { run_info(*args); });
 });
 

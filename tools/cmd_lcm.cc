@@ -20,6 +20,8 @@
 #include "lcmtypes/safe_decode.h"
 #include "tools/command_registry.h"
 #include "tools/lcm_client.h"
+#include "tools/number_list.h"
+#include "tools/plan_file.h"
 
 namespace kinograph::tools {
 
@@ -54,11 +56,11 @@ lcm::LCM& open_lcm(const std::string& url) {
 }
 
 std::string summarize(const plan_t& p) {
-  static const char* kStatus[] = {"SUCCESS",       "FAILED",    "INVALID_GOAL",
-                                  "INVALID_STATE", "CANCELLED", "NOT_CONVERGED"};
+  static const char* kStatus[] = {"SUCCESS",   "FAILED",        "INVALID_GOAL", "INVALID_STATE",
+                                  "CANCELLED", "NOT_CONVERGED", "SUPERSEDED"};
   std::ostringstream s;
   s << "plan " << p.plan_id << " for goal " << p.goal_id << ": "
-    << (p.status >= 0 && p.status <= 5 ? kStatus[p.status] : "UNKNOWN");
+    << (p.status >= 0 && p.status <= plan_t::SUPERSEDED ? kStatus[p.status] : "UNKNOWN");
   if (!p.status_message.empty()) s << " (" << p.status_message << ")";
   if (p.num_steps > 0) {
     s << "\n  method " << p.method << ", " << p.num_steps << " states, " << p.iterations
@@ -72,28 +74,13 @@ std::string summarize(const plan_t& p) {
 
 namespace {
 
-std::vector<double> parse_list(const std::string& text, const std::string& option) {
-  std::vector<double> values;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    try {
-      size_t used = 0;
-      values.push_back(std::stod(item, &used));
-      if (used != item.size()) throw std::invalid_argument(item);
-    } catch (const std::exception&) {
-      throw CommandFailure(option + ": \"" + item + "\" is not a number");
-    }
+std::string join_names(const std::vector<std::string>& names) {
+  std::string text;
+  for (const std::string& n : names) {
+    if (!text.empty()) text += ", ";
+    text += n;
   }
-  return values;
-}
-
-std::vector<double> parse_fixed(const std::string& text, const std::string& option, size_t n) {
-  auto v = parse_list(text, option);
-  if (v.size() != n) {
-    throw CommandFailure(option + " needs " + std::to_string(n) + " comma-separated numbers");
-  }
-  return v;
+  return text;
 }
 
 int64_t now_utime() {
@@ -110,36 +97,49 @@ struct Common {
     sub->add_option("--lcm-url", url, "LCM URL (default: $LCM_DEFAULT_URL or udpm)");
     if (!waits) return;
     sub->add_option("--wait", wait_s, "wait this many seconds for the answering plan");
-    sub->add_option("--out", out, "write the answering plan as JSON (needs --scene)");
+    sub->add_option("--out", out, "write the answering plan as JSON (needs --wait and --scene)");
     sub->add_option("--scene", scene, "the daemon's scene (robot for --out)");
+  }
+  // The scene --out writes plans for, read before anything is sent so that a command that
+  // cannot finish sends nothing. @throws CommandFailure for --out without --wait or --scene.
+  std::optional<planning::Scene> output_scene() const {
+    if (out.empty()) return std::nullopt;
+    if (scene.empty()) throw CommandFailure("--out needs --scene (the robot the plan file names)");
+    if (wait_s <= 0) throw CommandFailure("--out needs --wait (how long to wait for the plan)");
+    try {
+      return planning::load_scene(scene);
+    } catch (const std::exception& e) {
+      throw CommandFailure(e.what());
+    }
   }
 };
 
-// Waits for the plan answering goal_id, prints it, writes it if asked; returns the exit code.
-// `extra` is an obstacle this command sent, written into the plan file with the scene's own.
+// Waits for the plan answering goal_id, prints it, writes it to c.out for `scene` if asked;
+// returns the exit code. `extra` is an obstacle this command sent, written into the plan file
+// with the scene's own.
 int finish(PlanWaiter& waiter, const Common& c, int64_t goal_id,
+           std::optional<planning::Scene> scene,
            const std::optional<std::pair<std::string, collision::Obstacle>>& extra = {}) {
   if (c.wait_s <= 0) return 0;
   auto plan = waiter.wait(goal_id, c.wait_s);
   if (!plan) {
     throw CommandFailure("no plan for goal " + std::to_string(goal_id) + " within " +
                              std::to_string(c.wait_s) + " s",
-                         3);
+                         kExitTimeout);
   }
   std::cout << summarize(*plan) << "\n";
-  if (!c.out.empty()) {
-    if (c.scene.empty()) throw CommandFailure("--out needs --scene");
-    auto scene = planning::load_scene(c.scene);
+  if (scene) {
     if (extra) {
-      scene.obstacle_names.push_back(extra->first);
-      scene.problem.obstacles.push_back(extra->second);
-      scene.problem.obstacles.back().id = static_cast<int>(scene.problem.obstacles.size()) - 1;
+      scene->obstacle_names.push_back(extra->first);
+      scene->problem.obstacles.push_back(extra->second);
+      scene->problem.obstacles.back().id = static_cast<int>(scene->problem.obstacles.size()) - 1;
     }
-    if (plan->num_steps == 0) throw CommandFailure("plan has no trajectory to write", 2);
-    planning::write_plan(messages::plan_from_message(*plan), scene, c.out);
+    if (plan->num_steps == 0)
+      throw CommandFailure("plan has no trajectory to write", kExitInvalidPlan);
+    write_plan_json(messages::plan_from_message(*plan), *scene, c.out);
     std::cout << "wrote " << c.out << "\n";
   }
-  return plan->status == plan_t::SUCCESS ? 0 : 2;
+  return plan->status == plan_t::SUCCESS ? kExitOk : kExitInvalidPlan;
 }
 
 const bool kSendGoal = register_command([](CLI::App& root) {
@@ -148,16 +148,18 @@ const bool kSendGoal = register_command([](CLI::App& root) {
   auto q = std::make_shared<std::string>();
   auto frame = std::make_shared<std::string>();
   auto position = std::make_shared<std::string>();
-  auto quaternion = std::make_shared<std::string>("1,0,0,0");
+  auto quaternion = std::make_shared<std::string>();
   auto goal_id = std::make_shared<int64_t>(-1);
   auto duration = std::make_shared<double>(0);
   auto robot = std::make_shared<std::string>();
   c->add(sub, true);
   sub->add_option("--id", *goal_id, "goal id (default: current time in µs)");
-  sub->add_option("--q", *q, "joint goal, comma-separated");
+  sub->add_option("--q", *q, "joint goal (rad), comma-separated; angles may use pi");
   sub->add_option("--frame", *frame, "end-effector frame for a pose goal");
   sub->add_option("--position", *position, "pose goal position x,y,z (m)");
-  sub->add_option("--quaternion", *quaternion, "pose goal orientation w,x,y,z");
+  sub->add_option("--quaternion", *quaternion,
+                  "pose goal orientation w,x,y,z (required with --frame; 1,0,0,0 = the "
+                  "world's axes)");
   sub->add_option("--duration", *duration, "plan duration (s), 0 = the daemon's default");
   sub->add_option("--robot", *robot, "robot name in the message (default: empty = any)");
   sub->callback([=] {
@@ -169,26 +171,40 @@ const bool kSendGoal = register_command([](CLI::App& root) {
     std::fill(std::begin(msg.ee_position), std::end(msg.ee_position), 0.0);
     std::fill(std::begin(msg.ee_quaternion), std::end(msg.ee_quaternion), 0.0);
     msg.ee_quaternion[0] = 1;
+    const bool pose = !frame->empty() || !position->empty() || !quaternion->empty();
+    if (!q->empty() && pose) {
+      throw CommandFailure(
+          "send-goal: give a joint goal (--q) or a pose goal (--frame, "
+          "--position, --quaternion), not both");
+    }
     if (!q->empty()) {
       msg.kind = goal_t::KIND_JOINT_CONFIGURATION;
-      msg.joint_position = parse_list(*q, "--q");
+      msg.joint_position = parse_number_list(*q, "--q");
       msg.num_joints = static_cast<int32_t>(msg.joint_position.size());
-    } else if (!frame->empty() && !position->empty()) {
+    } else if (pose) {
+      if (frame->empty() || position->empty() || quaternion->empty()) {
+        throw CommandFailure(
+            "send-goal: a pose goal needs --frame, --position and --quaternion "
+            "(--quaternion 1,0,0,0 keeps the world's axes)");
+      }
       msg.kind = goal_t::KIND_END_EFFECTOR_POSE;
       msg.num_joints = 0;
       msg.ee_frame = *frame;
-      auto p = parse_fixed(*position, "--position", 3);
-      auto r = parse_fixed(*quaternion, "--quaternion", 4);
+      auto p = parse_number_list(*position, "--position", 3);
+      auto r = parse_number_list(*quaternion, "--quaternion", 4);
       std::copy(p.begin(), p.end(), msg.ee_position);
       std::copy(r.begin(), r.end(), msg.ee_quaternion);
     } else {
-      throw CommandFailure("send-goal needs --q, or --frame with --position");
+      throw CommandFailure("send-goal needs --q, or --frame with --position and --quaternion");
     }
+    std::optional<planning::Scene> scene = c->output_scene();
     lcm::LCM& lcm = open_lcm(c->url);
     PlanWaiter waiter(lcm, c->prefix + "_PLAN");
     lcm.publish(c->prefix + "_GOAL", &msg);
     std::cout << "sent goal " << msg.goal_id << " on " << c->prefix << "_GOAL\n";
-    if (int code = finish(waiter, *c, msg.goal_id); code != 0) throw CommandFailure("", code);
+    if (int code = finish(waiter, *c, msg.goal_id, std::move(scene)); code != 0) {
+      throw CommandFailure("", code);
+    }
   });
 });
 
@@ -221,12 +237,12 @@ const bool kSendObstacle = register_command([](CLI::App& root) {
                                      : obstacle_t::CAPSULE;
     std::fill(std::begin(o.size), std::end(o.size), 0.0);
     if (!*remove) {
-      auto s = parse_list(*size, "--size");
+      auto s = parse_number_list(*size, "--size");
       if (s.empty() || s.size() > 3) throw CommandFailure("--size needs 1 to 3 numbers");
       std::copy(s.begin(), s.end(), o.size);
     }
-    auto p = parse_fixed(*position, "--position", 3);
-    auto r = parse_fixed(*quaternion, "--quaternion", 4);
+    auto p = parse_number_list(*position, "--position", 3);
+    auto r = parse_number_list(*quaternion, "--quaternion", 4);
     std::copy(p.begin(), p.end(), o.position);
     std::copy(r.begin(), r.end(), o.quaternion);
     obstacle_list_t msg;
@@ -235,6 +251,7 @@ const bool kSendObstacle = register_command([](CLI::App& root) {
     msg.obstacles.push_back(o);
     msg.replace_all = false;
     if (c->wait_s > 0 && *goal_id < 0) throw CommandFailure("--wait needs --goal-id");
+    std::optional<planning::Scene> scene = c->output_scene();
     lcm::LCM& lcm = open_lcm(c->url);
     PlanWaiter waiter(lcm, c->prefix + "_PLAN");
     lcm.publish(c->prefix + "_OBSTACLES", &msg);
@@ -249,7 +266,9 @@ const bool kSendObstacle = register_command([](CLI::App& root) {
         extra.emplace(o.id, obstacle);
       }
     }
-    if (int code = finish(waiter, *c, *goal_id, extra); code != 0) throw CommandFailure("", code);
+    if (int code = finish(waiter, *c, *goal_id, std::move(scene), extra); code != 0) {
+      throw CommandFailure("", code);
+    }
   });
 });
 
@@ -271,9 +290,9 @@ const bool kSendState = register_command([](CLI::App& root) {
     msg.robot = model.name;
     msg.num_joints = model.nq();
     for (const auto& b : model.bodies) msg.joint_name.push_back(b.joint_name);
-    msg.position = parse_fixed(*q, "--q", model.nq());
-    msg.velocity =
-        qd->empty() ? std::vector<double>(model.nq(), 0.0) : parse_fixed(*qd, "--qd", model.nq());
+    msg.position = parse_number_list(*q, "--q", model.nq());
+    msg.velocity = qd->empty() ? std::vector<double>(model.nq(), 0.0)
+                               : parse_number_list(*qd, "--qd", model.nq());
     open_lcm(c->url).publish(c->prefix + "_STATE", &msg);
     std::cout << "sent state on " << c->prefix << "_STATE\n";
   });
@@ -305,11 +324,20 @@ const bool kLogPlans = register_command([](CLI::App& root) {
   sub->add_option("--scene", *scene, "the daemon's scene (robot for the JSON)")->required();
   sub->add_option("--out-dir", *out_dir, "folder for plan_<goal>_<plan>.json");
   sub->callback([=] {
-    const auto s = planning::load_scene(*scene);
+    planning::Scene s;
+    try {
+      s = planning::load_scene(*scene);
+    } catch (const std::exception& e) {
+      throw CommandFailure(e.what());
+    }
+    std::vector<std::string> joints;
+    for (const auto& b : s.problem.model->bodies) joints.push_back(b.joint_name);
     lcm::LogFile file(*log, "r");
     if (!file.good()) throw CommandFailure("cannot read LCM log " + *log);
-    std::filesystem::create_directories(*out_dir);
-    int written = 0, rejected = 0;
+    // Every plan is checked against the scene's robot before any file is written, so a wrong
+    // --scene writes nothing.
+    std::vector<plan_t> plans;
+    int rejected = 0;
     while (const lcm::LogEvent* event = file.readNextEvent()) {
       if (event->channel != *channel) continue;
       plan_t msg;
@@ -319,12 +347,22 @@ const bool kLogPlans = register_command([](CLI::App& root) {
       }
       std::cout << summarize(msg) << "\n";
       if (msg.num_steps == 0) continue;
+      if (msg.joint_name != joints) {
+        throw CommandFailure("plan " + std::to_string(msg.plan_id) + " for goal " +
+                             std::to_string(msg.goal_id) + " moves joints [" +
+                             join_names(msg.joint_name) + "] but the robot of " + *scene +
+                             " has [" + join_names(joints) +
+                             "]; give the scene the daemon served (nothing written)");
+      }
+      plans.push_back(std::move(msg));
+    }
+    std::filesystem::create_directories(*out_dir);
+    for (const plan_t& msg : plans) {
       const std::string path = *out_dir + "/plan_" + std::to_string(msg.goal_id) + "_" +
                                std::to_string(msg.plan_id) + ".json";
-      planning::write_plan(messages::plan_from_message(msg), s, path);
-      ++written;
+      write_plan_json(messages::plan_from_message(msg), s, path);
     }
-    std::cout << written << " plans written to " << *out_dir;
+    std::cout << plans.size() << " plans written to " << *out_dir;
     if (rejected) std::cout << ", " << rejected << " malformed messages skipped";
     std::cout << "\n";
   });

@@ -57,8 +57,9 @@ void run_plan(const PlanArgs& args) {
               << planning::summarize(plan);
   }
   if (!plan.success()) {
-    throw CommandFailure(
-        "the plan of '" + args.scene + "' does not validate (" + planning::to_string(plan.stats.status) + ")", 2);
+    throw CommandFailure("the plan of '" + args.scene + "' does not validate (" +
+                             planning::to_string(plan.stats.status) + ")",
+                         kExitInvalidPlan);
   }
 }
 

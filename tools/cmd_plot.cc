@@ -11,6 +11,7 @@
 #include "render/image.h"
 #include "render/plot.h"
 #include "tools/command_registry.h"
+#include "tools/png_path.h"
 
 namespace kinograph::tools {
 namespace {
@@ -68,7 +69,9 @@ const bool kRegistered = register_command([](CLI::App& root) {
   CLI::App* cmd = root.add_subcommand(
       "plot", "Plot a plan's joint torques (and overlay a second plan) as a PNG");
   cmd->add_option("plans", args->plans, "One or two plan files (JSON)")->required()->expected(1, 2);
-  cmd->add_option("--out", args->out, "Output PNG")->capture_default_str();
+  cmd->add_option("--out", args->out, "Output picture (.png)")
+      ->check(png_path())
+      ->capture_default_str();
   cmd->add_option(
       "--label", args->labels,
       "Legend name of each plan, in order (default: the plan's name, else the file name)");

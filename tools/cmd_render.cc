@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <optional>
 #include <string>
 
 #include "kinograph/planning/io/plan_json.h"
@@ -12,6 +13,8 @@
 #include "render/scene_camera.h"
 #include "render/scene_renderer.h"
 #include "tools/command_registry.h"
+#include "tools/plan_file.h"
+#include "tools/png_path.h"
 
 namespace kinograph::tools {
 namespace {
@@ -39,7 +42,10 @@ void run_render(const RenderArgs& args) {
     const planning::PlanFile plan = planning::read_plan_file(args.plan);
     render::RenderScene scene = render::plan_scene(plan);
     scene.end_effector_frame = args.ee_frame;
-    if (!args.scene.empty()) scene.camera = render::read_scene_camera(args.scene);
+    // The scene's camera: --scene's, else that of the scene the plan file names.
+    const std::optional<std::string> scene_file =
+        args.scene.empty() ? plan_scene_path(args.plan) : std::optional<std::string>(args.scene);
+    if (scene_file) scene.camera = render::read_scene_camera(*scene_file);
     render::FrameOptions options;
     options.frames = args.frames;
     options.width = args.width;
@@ -82,8 +88,8 @@ const bool kRegistered = register_command([](CLI::App& root) {
                   "Second plan file (e.g. the replan): both in one view, the first as grey "
                   "ghosts, the second in colour among its obstacles (changed ones highlighted)");
   cmd->add_option("--scene", args->scene,
-                  "Scene file (YAML); its optional 'camera' block (eye, target, up, fov_y_deg) "
-                  "replaces the automatic framing");
+                  "Scene file (YAML) whose optional 'camera' block (eye, target, up, fov_y_deg) "
+                  "replaces the automatic framing; default: the scene the plan file names");
   cmd->add_option("--frames", args->frames, "Number of robot poses, evenly spaced in time")
       ->capture_default_str();
   cmd->add_option("--style", args->style, "strip (side by side) or ghost (one overlaid view)")
@@ -91,7 +97,9 @@ const bool kRegistered = register_command([](CLI::App& root) {
       ->capture_default_str();
   cmd->add_option("--width", args->width, "Picture width, pixels")->capture_default_str();
   cmd->add_option("--height", args->height, "Picture height, pixels")->capture_default_str();
-  cmd->add_option("--out", args->out, "Output PNG")->capture_default_str();
+  cmd->add_option("--out", args->out, "Output picture (.png)")
+      ->check(png_path())
+      ->capture_default_str();
   cmd->add_option("--ee-frame", args->ee_frame,
                   "Frame whose path a ghost overlay draws (default: the model's last frame)");
   cmd->add_option("--before-label", args->before_label, "Legend line of the plan (--compare)")

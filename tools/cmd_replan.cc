@@ -35,10 +35,10 @@ std::string describe(const planning::ReplanReport& r, const planning::Plan& plan
                 "re-eliminated, %ld variables relinearized, %d factors replaced, %d added, "
                 "%d re-added; incremental %.1f ms, total %.1f ms\n",
                 r.method.c_str(),
-                r.fell_back ? " (fell back: the incremental plan did not validate)" : "",
-                s.updates, s.rounds, s.cliques_reeliminated, s.variables_relinearized,
-                s.factors_replaced, s.factors_added, s.factors_readded,
-                s.incremental_time_s * 1e3, plan.stats.solve_time_s * 1e3);
+                r.fell_back ? " (fell back: the incremental plan did not validate)" : "", s.updates,
+                s.rounds, s.cliques_reeliminated, s.variables_relinearized, s.factors_replaced,
+                s.factors_added, s.factors_readded, s.incremental_time_s * 1e3,
+                plan.stats.solve_time_s * 1e3);
   return buf;
 }
 
@@ -85,8 +85,9 @@ void run_replan(const ReplanArgs& args) {
     throw CommandFailure(e.what());
   }
   if (!after.success()) {
-    throw CommandFailure(
-        "the replan after '" + args.change + "' does not validate (" + planning::to_string(after.stats.status) + ")", 2);
+    throw CommandFailure("the replan after '" + args.change + "' does not validate (" +
+                             planning::to_string(after.stats.status) + ")",
+                         kExitInvalidPlan);
   }
 }
 

@@ -31,7 +31,8 @@ void run_validate(const ValidateArgs& args) {
   std::cout << "validate " << args.plan << " against " << args.scene << "\n"
             << planning::summarize(validation);
   if (!validation.valid) {
-    throw CommandFailure("plan '" + args.plan + "' is not valid for '" + args.scene + "'", 2);
+    throw CommandFailure("plan '" + args.plan + "' is not valid for '" + args.scene + "'",
+                         kExitInvalidPlan);
   }
 }
 

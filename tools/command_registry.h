@@ -2,7 +2,6 @@
 // Verbs of the `kinograph` CLI register themselves here, one file per verb (cmd_<verb>.cc),
 // so adding a verb never touches main.cc.
 #include <CLI/CLI.hpp>
-
 #include <functional>
 #include <vector>
 
@@ -17,9 +16,20 @@ std::vector<CommandSetup>& command_registry();
 /// Registers a verb; use as `static const bool kRegistered = register_command(...)`.
 bool register_command(CommandSetup setup);
 
+/// Exit codes of every verb (the table in `kinograph --help` and the README).
+inline constexpr int kExitOk = 0;           ///< done; a plan validates
+inline constexpr int kExitBadInput = 1;     ///< a file, robot, scene, message or value is wrong
+inline constexpr int kExitInvalidPlan = 2;  ///< a plan was made or received but is not valid
+inline constexpr int kExitTimeout = 3;      ///< no answer within --wait
+/// The command line itself is wrong: unknown verb or option, missing or malformed argument.
+inline constexpr int kExitUsage = 64;
+
+/// The exit-code table as printed at the end of `kinograph --help`.
+const char* exit_code_table();
+
 /// Thrown by a verb's callback to end the CLI with a message and a non-zero exit code.
 struct CommandFailure : CLI::RuntimeError {
-  explicit CommandFailure(const std::string& message, int exit_code = 1)
+  explicit CommandFailure(const std::string& message, int exit_code = kExitBadInput)
       : CLI::RuntimeError(message, exit_code) {}
 };
 

@@ -1,10 +1,8 @@
 #include "tools/formulation.h"
 
-#include <filesystem>
-#include <fstream>
-
 #include "kinograph/planning/io/plan_json.h"
 #include "tools/command_registry.h"
+#include "tools/plan_file.h"
 
 namespace kinograph::tools {
 
@@ -28,14 +26,7 @@ void write_plan_file(const planning::Plan& plan, const planning::Scene& scene,
                      planning::Formulation formulation, const std::string& path) {
   nlohmann::json json = planning::plan_to_json(plan, scene);
   json["stats"]["formulation"] = planning::to_string(formulation);
-  const std::filesystem::path p(path);
-  if (p.has_parent_path()) {
-    std::error_code ec;
-    std::filesystem::create_directories(p.parent_path(), ec);
-  }
-  std::ofstream out(path);
-  out << json.dump(1) << "\n";
-  if (!out) throw CommandFailure("cannot write plan file '" + path + "'");
+  write_plan_json(std::move(json), scene, path);
 }
 
 }  // namespace kinograph::tools

@@ -4,14 +4,13 @@
 // to the solver's tolerance, while the condensed torques are RNEA of the trajectory itself.
 #include <gtest/gtest.h>
 
-#include <array>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
 
 #include "kinograph/planning/io/scene.h"
+#include "tests/tools/cli_run.h"
 
 namespace kinograph::tools {
 namespace {
@@ -20,22 +19,6 @@ namespace fs = std::filesystem;
 
 // A dynamics residual above this is not rounding: the plan's τ are not RNEA of its trajectory.
 constexpr double kRoundoff = 1e-9;
-
-struct CliRun {
-  int status = -1;
-  std::string output;
-};
-
-CliRun run(const std::string& args) {
-  const std::string command = std::string(KINOGRAPH_CLI) + " " + args + " 2>&1";
-  CliRun result;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return result;
-  std::array<char, 512> buffer;
-  while (fgets(buffer.data(), buffer.size(), pipe) != nullptr) result.output += buffer.data();
-  result.status = pclose(pipe);
-  return result;
-}
 
 nlohmann::json read_json(const fs::path& path) {
   std::ifstream in(path);
@@ -65,7 +48,7 @@ class CliFormulation : public ::testing::Test {
   nlohmann::json plan(const std::string& scene, const std::string& flags,
                       const std::string& formulation) {
     const fs::path out = dir_ / "plan.json";
-    const CliRun r = run("plan " + scene + " " + flags + " --out " + out.string());
+    const CliRun r = run_cli("plan " + scene + " " + flags + " --out " + out.string());
     EXPECT_EQ(r.status, 0) << r.output;
     EXPECT_NE(r.output.find("formulation: " + formulation + "\n"), std::string::npos) << r.output;
     return read_json(out);
@@ -105,8 +88,8 @@ TEST_F(CliFormulation, ReplanPlansInTheFormulationOfTheFlagOrTheScene) {
   const fs::path before = dir_ / "before.json", after = dir_ / "after.json";
   const auto replan = [&](const std::string& scene, const std::string& flags,
                           const std::string& formulation) {
-    const CliRun r = run("replan " + scene + " " + change + " " + flags + " --out-before " +
-                         before.string() + " --out-after " + after.string());
+    const CliRun r = run_cli("replan " + scene + " " + change + " " + flags + " --out-before " +
+                             before.string() + " --out-after " + after.string());
     EXPECT_EQ(r.status, 0) << r.output;
     EXPECT_NE(r.output.find("formulation: " + formulation + "\n"), std::string::npos) << r.output;
     EXPECT_EQ(read_json(before)["stats"]["formulation"], formulation);
@@ -119,8 +102,8 @@ TEST_F(CliFormulation, ReplanPlansInTheFormulationOfTheFlagOrTheScene) {
 }
 
 TEST_F(CliFormulation, AnUnknownFormulationIsABadFlag) {
-  const CliRun r = run("plan " + repo("robots/scenes/rr_reach.yaml") +
-                       " --formulation fast --out " + (dir_ / "plan.json").string());
+  const CliRun r = run_cli("plan " + repo("robots/scenes/rr_reach.yaml") +
+                           " --formulation fast --out " + (dir_ / "plan.json").string());
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.output.find("formulation"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(dir_ / "plan.json"));

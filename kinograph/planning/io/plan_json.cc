@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "kinograph/dynamics/payload.h"
+#include "kinograph/planning/io/data_dir.h"
 
 namespace kinograph::planning {
 namespace {
@@ -51,17 +52,6 @@ double read_number(const json& j, const std::string& source, const std::string& 
   if (j.is_null()) return null_value;
   if (!j.is_number()) fail(source, key, "must be a number");
   return j.get<double>();
-}
-
-// The URDF path as the plan file names it: relative to the repository root when inside it
-// (the renderer resolves that), absolute otherwise.
-std::string portable_path(const std::string& path) {
-  if (path.empty()) return path;
-  const fs::path root = fs::weakly_canonical(KINOGRAPH_SOURCE_DIR);
-  const fs::path p = fs::weakly_canonical(path);
-  const fs::path rel = p.lexically_relative(root);
-  if (!rel.empty() && *rel.begin() != "..") return rel.string();
-  return p.string();
 }
 
 // A list of `size` finite numbers (any length when size < 0).
@@ -390,7 +380,7 @@ json plan_to_json(const Plan& plan, const Scene& scene) {
   const Problem& problem = scene.problem;
   json j;
   j["name"] = problem.name;
-  j["robot"]["urdf"] = portable_path(scene.urdf_path);
+  j["robot"]["urdf"] = data_relative_path(scene.urdf_path);
   if (scene.payload) {
     const PayloadSpec& p = *scene.payload;
     j["robot"]["payload"] = {{"frame", p.frame},
@@ -596,7 +586,7 @@ dynamics::Model load_plan_model(const PlanFileInfo& info) {
     fail(info.source, "robot.urdf",
          "file '" + info.urdf +
              "' not found (looked in the working directory, next to the plan and in " +
-             KINOGRAPH_SOURCE_DIR + ")");
+             describe_data_dirs() + ")");
   }
   dynamics::Model model;
   try {

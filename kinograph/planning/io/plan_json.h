@@ -96,7 +96,7 @@ struct PlanFile {
 /// are resolved (resolve_plan_path). Throws PlanFileError naming `source` and the key.
 PlanFileInfo plan_info_from_json(const nlohmann::json& json, const std::string& source = "");
 /// Finds a file a plan names: absolute as is; else relative to the working directory, the plan
-/// file's directory or the repository root, the first that exists. Empty when none does.
+/// file's directory or a data directory (data_dir.h), the first that exists. Empty when none does.
 std::optional<std::string> resolve_plan_path(const std::string& path,
                                              const std::string& plan_source);
 /// The robot a plan file names: its URDF, the payload attached and the file's limits applied

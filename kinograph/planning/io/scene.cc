@@ -5,7 +5,6 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <regex>
 #include <set>
 #include <sstream>
 
@@ -14,6 +13,8 @@
 #include "kinograph/dynamics/payload.h"
 #include "kinograph/planning/batch/batch_planner.h"
 #include "kinograph/planning/clearance_world.h"
+#include "kinograph/planning/io/data_dir.h"
+#include "kinograph/planning/io/number_text.h"
 #include "kinograph/planning/io/srdf.h"
 
 namespace kinograph::planning {
@@ -86,22 +87,10 @@ class Reader {
   double number(const YAML::Node& node, const std::string& key) const {
     if (!node.IsScalar()) fail(node, key, "must be a number");
     const std::string text = node.Scalar();
-    // Angles may be written with pi: "pi", "-pi/2", "2*pi", "0.5*pi/3".
-    static const std::regex kPi(
-        R"(^\s*([+-]?)\s*(?:([0-9]*\.?[0-9]+(?:[eE][+-]?[0-9]+)?)\s*\*\s*)?pi\s*(?:/\s*([0-9]*\.?[0-9]+))?\s*$)");
-    std::smatch m;
-    if (std::regex_match(text, m, kPi)) {
-      double value = M_PI;
-      if (m[2].matched) value *= std::stod(m[2].str());
-      if (m[3].matched) value /= std::stod(m[3].str());
-      return m[1].str() == "-" ? -value : value;
-    }
-    double value = 0;
-    if (!YAML::convert<double>::decode(node, value)) {
-      fail(node, key, "must be a number, got '" + text + "'");
-    }
-    if (std::isnan(value)) fail(node, key, "must not be NaN");
-    return value;
+    const std::optional<double> value = parse_number_text(text);  // angles may use pi
+    if (!value) fail(node, key, "must be a number, got '" + text + "'");
+    if (std::isnan(*value)) fail(node, key, "must not be NaN");
+    return *value;
   }
 
   double positive(const YAML::Node& node, const std::string& key) const {
@@ -252,8 +241,8 @@ class SceneParser {
     const std::optional<std::string> resolved = resolve_scene_path(path, anchor_);
     if (!resolved) {
       r_.fail(node, key,
-              "file '" + path + "' not found (looked next to the scene and in the " +
-                  "repository root)");
+              "file '" + path + "' not found (looked next to the scene and in " +
+                  describe_data_dirs() + ")");
     }
     return *resolved;
   }
@@ -692,7 +681,9 @@ std::optional<std::string> resolve_scene_path(const std::string& path,
     if (fs::exists(p)) return p.lexically_normal().string();
     return std::nullopt;
   }
-  for (const fs::path& base : {fs::path(anchor_dir), fs::path(KINOGRAPH_SOURCE_DIR)}) {
+  std::vector<fs::path> bases{fs::path(anchor_dir)};
+  for (const fs::path& dir : data_dirs()) bases.push_back(dir);
+  for (const fs::path& base : bases) {
     const fs::path candidate = base / p;
     if (fs::exists(candidate)) return fs::weakly_canonical(candidate).string();
   }

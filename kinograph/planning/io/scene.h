@@ -79,7 +79,7 @@ struct Scene {
 };
 
 /// Reads a scene file. Relative paths inside (URDF, meshes, warm-start plan) resolve against
-/// the scene file's directory first, then the repository root. Throws SceneError.
+/// the scene file's directory first, then the data directories (data_dir.h). Throws SceneError.
 Scene load_scene(const std::string& path);
 
 /// Parses scene text; `source` names it in errors and anchors relative paths (its directory;
@@ -99,7 +99,7 @@ std::optional<collision::ShapeKind> shape_kind_from_name(const std::string& name
 std::optional<Formulation> formulation_from_name(const std::string& name);
 
 /// Resolves a path named in a scene: absolute as is; else relative to `anchor_dir` if it
-/// exists there, else relative to the repository root. Empty optional when neither exists.
+/// exists there, else relative to a data directory (data_dir.h). Empty when none holds it.
 std::optional<std::string> resolve_scene_path(const std::string& path,
                                               const std::string& anchor_dir);
 

@@ -1,5 +1,6 @@
 #include "kinograph/planning/solver/violation_text.h"
 
+#include <iterator>
 #include <sstream>
 
 #include "kinograph/planning/user_terms.h"
@@ -7,30 +8,23 @@
 namespace kinograph::planning {
 namespace {
 
+// The user's name of each role, in FactorRole's declaration order.
+constexpr const char* kRoleNames[] = {"start",
+                                      "goal",
+                                      "smoothness prior",
+                                      "collocation",
+                                      "dynamics between the knots",
+                                      "limits",
+                                      "equations of motion",
+                                      "collision",
+                                      "task constraint",
+                                      "self-collision"};
+static_assert(std::size(kRoleNames) == static_cast<size_t>(FactorRole::kSelfCollision) + 1,
+              "one name per role: a new role needs its name here");
+
 const char* role_name(FactorRole role) {
-  switch (role) {
-    case FactorRole::kStart:
-      return "start";
-    case FactorRole::kGoal:
-      return "goal";
-    case FactorRole::kGpPrior:
-      return "smoothness prior";
-    case FactorRole::kCollocation:
-      return "collocation";
-    case FactorRole::kLimits:
-      return "limits";
-    case FactorRole::kDynamics:
-      return "equations of motion";
-    case FactorRole::kInterval:
-      return "dynamics between the knots";
-    case FactorRole::kCollision:
-      return "collision";
-    case FactorRole::kSelfCollision:
-      return "self-collision";
-    case FactorRole::kTask:
-      return "task constraint";
-  }
-  return "constraint";
+  const auto i = static_cast<size_t>(role);
+  return i < std::size(kRoleNames) ? kRoleNames[i] : "constraint";
 }
 
 }  // namespace
