@@ -7,7 +7,7 @@ namespace kinograph::daemon {
 
 bool Intake::empty() const {
   return !goal && superseded.empty() && lost.empty() && obstacles.empty() && !replace_all &&
-         states == 0;
+         states == 0 && state_refused.empty();
 }
 
 void Intake::absorb(Intake&& newer) {
@@ -23,7 +23,11 @@ void Intake::absorb(Intake&& newer) {
   }
   obstacles.insert(obstacles.end(), std::make_move_iterator(newer.obstacles.begin()),
                    std::make_move_iterator(newer.obstacles.end()));
-  if (newer.state) state = std::move(newer.state);
+  if (newer.state) {
+    state = std::move(newer.state);
+    state_refused.clear();
+  }
+  if (!newer.state_refused.empty()) state_refused = std::move(newer.state_refused);
   states += newer.states;
 }
 

@@ -5,6 +5,7 @@
 // plans only the newest one.
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "kinograph/lcm/message_convert.h"
@@ -32,11 +33,15 @@ struct Intake {
   bool replace_all = false;  ///< the obstacle list starts from an empty world
   std::optional<messages::MeasuredState> state;
   std::uint64_t states = 0;  ///< measured states received
+  /// Why the newest measured state was refused as a start (beyond the limits), or empty when
+  /// the newest one is `state`.
+  std::string state_refused;
 
   /// Nothing arrived.
   bool empty() const;
   /// Adds what arrived after this intake: a newer goal supersedes the one held here, a
-  /// replace_all discards the obstacle changes held here, a newer state replaces the old one.
+  /// replace_all discards the obstacle changes held here, a newer state, usable or refused,
+  /// replaces the old one.
   void absorb(Intake&& newer);
 };
 

@@ -1,7 +1,8 @@
 // kinographd: the kinograph planner daemon for one robot on an LCM network.
 //   kinographd SCENE.yaml [--prefix IIWA] [--lcm-url URL] [--status-period 1.0]
 //              [--batch-only] [--max-goal-change RAD] [--formulation condensed|dfg]
-//              [--ignore-goal-id-gaps]
+//              [--ignore-goal-id-gaps] [--max-state-age 0.5]
+//              [--iiwa-status-channel IIWA_STATUS] [--drake-plan-channel COMMITTED_ROBOT_PLAN]
 // The scene gives the robot, default horizon and steps, start, fixed obstacles, objective
 // weights and the batch formulation; goals, obstacle updates and measured states arrive over
 // LCM.
@@ -50,6 +51,16 @@ int main(int argc, char** argv) {
   app.add_flag("--ignore-goal-id-gaps", ignore_gaps,
                "goal ids are not numbered 1, 2, 3, ... by one sender: do not answer skipped ids "
                "as lost (default: answer them SUPERSEDED and count them as dropped)");
+  app.add_option("--max-state-age", options.max_state_age_s,
+                 "refuse a goal (INVALID_STATE) issued more than this many seconds after the "
+                 "latest measured state, on the robot's clock")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--iiwa-status-channel", options.iiwa_status_channel,
+                 "also read Drake's lcmt_iiwa_status on this channel as the measured state "
+                 "(joints in the URDF's order), e.g. IIWA_STATUS; default: none");
+  app.add_option("--drake-plan-channel", options.drake_plan_channel,
+                 "also publish every valid plan as Drake's lcmt_robot_plan on this channel, "
+                 "e.g. COMMITTED_ROBOT_PLAN; default: none");
   CLI11_PARSE(app, argc, argv);
   options.answer_goal_id_gaps = !ignore_gaps;
   options.replanning.use_incremental = !batch_only;

@@ -3,45 +3,35 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
-#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstring>
 #include <lcm/lcm-cpp.hpp>
 #include <stdexcept>
+#include <string_view>
 #include <thread>
 
+#include "daemon/state_limits.h"
+#include "daemon/wire_strings.h"
+#include "kinograph/lcm/drake_convert.h"
+#include "kinograph/lcm/lcm_connection.h"
 #include "kinograph/planner_status_t.hpp"
 #include "lcmtypes/safe_decode.h"
 
 namespace kinograph::daemon {
-namespace {
-
-std::string upper(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
-  return s;
-}
-
-}  // namespace
 
 PlannerNode::PlannerNode(planning::Scene scene, PlannerNodeOptions options, lcm::LCM* shared)
     : scene_(std::move(scene)), options_(std::move(options)), replanner_(options_.replanning) {
   if (!scene_.problem.model) throw std::invalid_argument("PlannerNode: the scene has no robot");
   identity_.model_name = scene_.problem.model->name;
-  identity_.channel_prefix =
-      options_.channel_prefix.empty() ? upper(identity_.model_name) : options_.channel_prefix;
+  identity_.channel_prefix = options_.channel_prefix.empty()
+                                 ? messages::default_channel_prefix(identity_.model_name)
+                                 : options_.channel_prefix;
   if (shared) {
     lcm_ = shared;
   } else {
-    owned_lcm_ = std::make_unique<lcm::LCM>(options_.lcm_url);
+    owned_lcm_ = messages::open_lcm(options_.lcm_url);
     lcm_ = owned_lcm_.get();
-  }
-  if (!lcm_->good()) {
-    throw std::runtime_error(
-        "LCM could not start on \"" +
-        (options_.lcm_url.empty() ? std::string("default URL") : options_.lcm_url) +
-        "\" (for udpm a multicast route is needed, see docs/network.md)");
   }
   next_obstacle_id_ = static_cast<int>(scene_.problem.obstacles.size());
   for (const auto& o : scene_.problem.obstacles) {
@@ -50,7 +40,15 @@ PlannerNode::PlannerNode(planning::Scene scene, PlannerNodeOptions options, lcm:
   subscriptions_ = {lcm_->subscribe(channel("GOAL"), &PlannerNode::on_goal, this),
                     lcm_->subscribe(channel("OBSTACLES"), &PlannerNode::on_obstacles, this),
                     lcm_->subscribe(channel("STATE"), &PlannerNode::on_state, this)};
-  const int capacities[] = {kGoalQueueCapacity, kObstacleQueueCapacity, kStateQueueCapacity};
+  subscriptions_.push_back(
+      lcm_->subscribe(channel("PLANNER_STATUS"), &PlannerNode::on_heartbeat, this));
+  std::vector<int> capacities = {kGoalQueueCapacity, kObstacleQueueCapacity, kStateQueueCapacity,
+                                 kHeartbeatQueueCapacity};
+  if (!options_.iiwa_status_channel.empty()) {
+    subscriptions_.push_back(
+        lcm_->subscribe(options_.iiwa_status_channel, &PlannerNode::on_iiwa_status, this));
+    capacities.push_back(kStateQueueCapacity);
+  }
   for (std::size_t i = 0; i < subscriptions_.size(); ++i) {
     subscriptions_[i]->setQueueCapacity(capacities[i]);
   }
@@ -72,34 +70,96 @@ NodeCounters PlannerNode::counters() const {
   return counters_;
 }
 
-int64_t PlannerNode::now_utime() const {
+int64_t PlannerNode::wall_utime() {
   using namespace std::chrono;
   return duration_cast<microseconds>(system_clock::now().time_since_epoch()).count();
 }
 
-void PlannerNode::reject(const std::string& reason) {
-  spdlog::warn("rejected: {}", reason);
+messages::PlanTime PlannerNode::clock_now_locked() const {
+  messages::PlanTime time;
+  if (latest_state_) {
+    time.clock = plan_t::CLOCK_ROBOT;
+    time.utime = latest_state_->utime;
+  } else {
+    time.clock = plan_t::CLOCK_WALL;
+    time.utime = wall_utime();
+  }
+  return time;
+}
+
+std::string PlannerNode::stale_state_reason(const GoalRequest& goal,
+                                            const MeasuredState& state) const {
+  const double age_s = static_cast<double>(goal.utime - state.utime) * 1e-6;
+  if (age_s <= options_.max_state_age_s) return {};
+  return "the latest measured state (utime " + std::to_string(state.utime) + " us) is " +
+         std::to_string(age_s) + " s older than goal " + std::to_string(goal.goal_id) + " (utime " +
+         std::to_string(goal.utime) + " us), more than the " +
+         std::to_string(options_.max_state_age_s) +
+         " s allowed (--max-state-age): has the robot's state stream stopped, or are the goal "
+         "and the states on different clocks?";
+}
+
+void PlannerNode::reject(const std::string& channel, const std::string& reason) {
+  bool log;
+  std::vector<std::string> summaries;
   {
     std::lock_guard lock(mutex_);
     ++counters_.messages_rejected;
     last_message_ = reason;
+    log = reject_log_.admit(channel, LogLimiter::Clock::now(), summaries);
   }
+  for (const std::string& line : summaries) spdlog::warn("{}", line);
+  if (log) spdlog::warn("rejected: {}", reason);
   publish_status();
 }
 
-void PlannerNode::answer_with_failure(int8_t status, const std::string& reason, int64_t goal_id) {
+void PlannerNode::flush_reject_log() {
+  std::vector<std::string> summaries;
+  {
+    std::lock_guard lock(mutex_);
+    summaries = reject_log_.flush(LogLimiter::Clock::now());
+  }
+  for (const std::string& line : summaries) spdlog::warn("{}", line);
+}
+
+template <class Message>
+void PlannerNode::publish(const std::string& channel, const Message& msg) {
+  std::vector<uint8_t> bytes(static_cast<std::size_t>(msg.getEncodedSize()));
+  msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  publish_bytes(Message::getTypeName(), channel, bytes.data(), static_cast<unsigned>(bytes.size()));
+}
+
+void PlannerNode::publish_bytes(const char* type, const std::string& channel, const void* data,
+                                unsigned size) {
+  const int status = lcm_->publish(channel, data, size);
+  if (status == 0) return;
+  int64_t failures;
+  {
+    std::lock_guard lock(mutex_);
+    failures = ++counters_.publish_failures;
+    last_publish_failure_ = channel;
+  }
+  spdlog::error("publishing {} on {} failed (LCM returned {}); {} publishes failed since start",
+                type, channel, status, failures);
+}
+
+void PlannerNode::answer_with_failure(int8_t status, const std::string& reason, int64_t goal_id,
+                                      bool first_answer) {
   int64_t plan_id;
+  messages::PlanTime time;
   {
     std::lock_guard lock(mutex_);
     plan_id = next_plan_id_++;
     ++counters_.plans_published;
     ++counters_.failures;
-    ++counters_.goals_answered;
+    if (first_answer) ++counters_.goals_answered;
     if (status == plan_t::SUPERSEDED) ++counters_.goals_superseded;
+    time = clock_now_locked();
+    if (latest_state_) time.state_utime = latest_state_->utime;
   }
-  plan_t answer = messages::failure_message(status, reason, identity_.model_name, plan_id, goal_id,
-                                            now_utime());
-  lcm_->publish(channel("PLAN"), &answer);
+  plan_t answer =
+      messages::failure_message(status, reason, identity_.model_name, plan_id, goal_id, time);
+  publish(channel("PLAN"), answer);
 }
 
 void PlannerNode::answer_superseded(const Intake& taken) {
@@ -125,7 +185,7 @@ void PlannerNode::answer_superseded(const Intake& taken) {
 void PlannerNode::on_goal(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
   goal_t msg;
   if (auto s = lcmtypes::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), msg); !s.ok) {
-    reject(channel + ": malformed goal_t: " + s.reason);
+    reject(channel, channel + ": malformed goal_t: " + s.reason);
     return;
   }
   if (msg.goal_id >= 0) {
@@ -140,9 +200,15 @@ void PlannerNode::on_goal(const lcm::ReceiveBuffer* rbuf, const std::string& cha
     }
   }
   GoalRequest request;
-  if (Check c = messages::goal_from_message(msg, *scene_.problem.model, identity_, request);
-      !c.ok) {
-    reject(channel + ": " + c.reason);
+  // Names are bounded first, so that no reason echoes an unbounded string.
+  Check c;
+  if (std::string overlong = overlong_name(msg); !overlong.empty()) {
+    c = Check::fail(overlong);
+  } else {
+    c = messages::goal_from_message(msg, *scene_.problem.model, identity_, request);
+  }
+  if (!c.ok) {
+    reject(channel, channel + ": " + c.reason);
     // The sender named a goal: answer it, so no goal ever goes unanswered.
     if (msg.goal_id >= 0) answer_with_failure(plan_t::INVALID_GOAL, c.reason, msg.goal_id);
     return;
@@ -155,12 +221,16 @@ void PlannerNode::on_goal(const lcm::ReceiveBuffer* rbuf, const std::string& cha
 void PlannerNode::on_obstacles(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
   obstacle_list_t msg;
   if (auto s = lcmtypes::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), msg); !s.ok) {
-    reject(channel + ": malformed obstacle_list_t: " + s.reason);
+    reject(channel, channel + ": malformed obstacle_list_t: " + s.reason);
+    return;
+  }
+  if (std::string overlong = overlong_name(msg); !overlong.empty()) {
+    reject(channel, channel + ": " + overlong);
     return;
   }
   Intake arrived;
   if (Check c = messages::obstacles_from_message(msg, arrived.obstacles); !c.ok) {
-    reject(channel + ": " + c.reason);
+    reject(channel, channel + ": " + c.reason);
     return;
   }
   arrived.replace_all = msg.replace_all;
@@ -170,17 +240,90 @@ void PlannerNode::on_obstacles(const lcm::ReceiveBuffer* rbuf, const std::string
 void PlannerNode::on_state(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
   robot_state_t msg;
   if (auto s = lcmtypes::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), msg); !s.ok) {
-    reject(channel + ": malformed robot_state_t: " + s.reason);
+    reject(channel, channel + ": malformed robot_state_t: " + s.reason);
+    return;
+  }
+  if (std::string overlong = overlong_name(msg); !overlong.empty()) {
+    reject(channel, channel + ": " + overlong);
+    return;
+  }
+  // A state of this robot with NaN or Inf in it is a sensor fault: goals get INVALID_STATE.
+  if (identity_.matches(msg.robot)) {
+    if (std::string bad = non_finite_joint(msg); !bad.empty()) {
+      refuse_state(channel, msg.utime, bad);
+      return;
+    }
+  }
+  MeasuredState state;
+  if (Check c = messages::state_from_message(msg, *scene_.problem.model, identity_, state); !c.ok) {
+    reject(channel, channel + ": " + c.reason);
+    return;
+  }
+  take_state(channel, std::move(state));
+}
+
+void PlannerNode::on_iiwa_status(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+  drake::lcmt_iiwa_status msg;
+  if (auto s = lcmtypes::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), msg); !s.ok) {
+    reject(channel, channel + ": malformed lcmt_iiwa_status: " + s.reason);
+    return;
+  }
+  MeasuredState state;
+  if (Check c = messages::state_from_iiwa_status(msg, *scene_.problem.model, state); !c.ok) {
+    reject(channel, channel + ": " + c.reason);
+    return;
+  }
+  take_state(channel, std::move(state));
+}
+
+void PlannerNode::on_heartbeat(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+  planner_status_t msg;
+  if (auto s = lcmtypes::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), msg); !s.ok) {
+    reject(channel, channel + ": malformed planner_status_t: " + s.reason);
+    return;
+  }
+  const std::size_t hash = std::hash<std::string_view>{}(
+      std::string_view(static_cast<const char*>(rbuf->data), rbuf->data_size));
+  std::string report;
+  {
+    std::lock_guard lock(mutex_);
+    if (own_heartbeats_.judge(msg.utime, hash) != OwnHeartbeats::Verdict::kForeign) return;
+    ++counters_.foreign_heartbeats;
+    foreign_daemon_ = "another planner daemon publishes on " + channel + " (robot \"" +
+                      truncated(msg.robot) + "\", its last plan id " +
+                      std::to_string(msg.last_plan_id) +
+                      "): both answer every goal, with colliding plan ids";
+    const int64_t now = wall_utime();
+    // Reported at once, then once a minute while it lasts.
+    if (foreign_logged_utime_ == 0 || now - foreign_logged_utime_ >= 60'000'000) {
+      foreign_logged_utime_ = now;
+      report = foreign_daemon_ + " (" + std::to_string(counters_.foreign_heartbeats) +
+               " of its heartbeats seen)";
+    }
+  }
+  if (!report.empty()) spdlog::warn("{}", report);
+}
+
+void PlannerNode::take_state(const std::string& channel, MeasuredState&& state) {
+  if (std::string beyond = state_beyond_limits(state, *scene_.problem.model); !beyond.empty()) {
+    refuse_state(channel, state.utime, beyond);
     return;
   }
   Intake arrived;
-  arrived.state.emplace();
-  if (Check c = messages::state_from_message(msg, *scene_.problem.model, identity_, *arrived.state);
-      !c.ok) {
-    reject(channel + ": " + c.reason);
-    return;
-  }
+  arrived.state = std::move(state);
   arrived.states = 1;
+  intake_.absorb(std::move(arrived));
+}
+
+void PlannerNode::refuse_state(const std::string& channel, int64_t utime, std::string reason) {
+  {
+    std::lock_guard lock(mutex_);
+    ++counters_.states_refused;
+  }
+  reject(channel, channel + ": measured state at utime " + std::to_string(utime) +
+                      " cannot be a start: " + reason);
+  Intake arrived;
+  arrived.state_refused = std::move(reason);
   intake_.absorb(std::move(arrived));
 }
 
@@ -188,10 +331,15 @@ void PlannerNode::hand_over() {
   if (intake_.empty()) return;
   {
     std::lock_guard lock(mutex_);
-    if (intake_.state) latest_state_ = std::move(intake_.state);
+    if (intake_.state) {
+      latest_state_ = std::move(intake_.state);
+      state_refusal_.clear();
+    }
+    if (!intake_.state_refused.empty()) state_refusal_ = std::move(intake_.state_refused);
     state_count_ += intake_.states;
     intake_.state.reset();
     intake_.states = 0;
+    intake_.state_refused.clear();
     pending_.absorb(std::move(intake_));
   }
   intake_ = Intake{};
@@ -230,7 +378,7 @@ bool PlannerNode::apply_obstacles(const std::vector<ObstacleUpdate>& updates, bo
         live_obstacles_.erase(it);
         changed = true;
       } else {
-        spdlog::info("obstacle \"{}\" to remove is not known; ignored", u.id);
+        spdlog::info("obstacle \"{}\" to remove is not known; ignored", truncated(u.id));
       }
       continue;
     }
@@ -242,10 +390,11 @@ bool PlannerNode::apply_obstacles(const std::vector<ObstacleUpdate>& updates, bo
     changed = true;
   }
   if (!refused.empty()) {
-    reject("obstacle \"" + refused.front() + "\"" +
-           (refused.size() > 1 ? " and " + std::to_string(refused.size() - 1) + " more" : "") +
-           " not added: the world holds the most obstacles it may, " +
-           std::to_string(collision::kMaxObstacles) + " (scene and LCM together)");
+    reject(channel("OBSTACLES"),
+           "obstacle \"" + truncated(refused.front()) + "\"" +
+               (refused.size() > 1 ? " and " + std::to_string(refused.size() - 1) + " more" : "") +
+               " not added: the world holds the most obstacles it may, " +
+               std::to_string(collision::kMaxObstacles) + " (scene and LCM together)");
   }
   return changed;
 }
@@ -253,16 +402,36 @@ bool PlannerNode::apply_obstacles(const std::vector<ObstacleUpdate>& updates, bo
 void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan) {
   planning::Problem problem = scene_.problem;
   bool new_state = false;
+  std::optional<int64_t> state_utime;  // of the measured state the plan starts from
+  std::string stale;
   {
     std::lock_guard lock(mutex_);
-    state_ = planner_status_t::PLANNING;
-    // A measured state, when there is one, is where the robot is: plan from it.
-    if (latest_state_) {
-      problem.start_q = latest_state_->q;
-      problem.start_qd = latest_state_->qd;
+    if (!state_refusal_.empty()) {
+      stale = "the robot's latest measured state cannot be a start, " + state_refusal_;
+    } else if (latest_state_) {
+      stale = stale_state_reason(goal, *latest_state_);
     }
-    new_state = state_count_ != used_state_count_;
-    used_state_count_ = state_count_;
+    if (stale.empty()) {
+      state_ = planner_status_t::PLANNING;
+      // A measured state, when there is one, is where the robot is: plan from it.
+      if (latest_state_) {
+        problem.start_q = latest_state_->q;
+        problem.start_qd = latest_state_->qd;
+        state_utime = latest_state_->utime;
+      }
+      new_state = state_count_ != used_state_count_;
+      used_state_count_ = state_count_;
+    }
+  }
+  if (!stale.empty()) {
+    spdlog::warn("goal {}: not planned: {}", goal.goal_id, stale);
+    answer_with_failure(plan_t::INVALID_STATE, stale, goal.goal_id, /*first_answer=*/!replan);
+    {
+      std::lock_guard lock(mutex_);
+      last_message_ = stale;
+    }
+    publish_status();
+    return;
   }
   for (const auto& [name, obstacle] : live_obstacles_) problem.obstacles.push_back(obstacle);
   problem.goal = goal.goal;
@@ -285,8 +454,10 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan) {
   }
 
   int64_t plan_id;
+  messages::PlanTime time;
   {
     std::lock_guard lock(mutex_);
+    time = clock_now_locked();
     plan_id = next_plan_id_++;
     last_plan_id_ = plan_id;
     ++counters_.plans_published;
@@ -298,20 +469,29 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan) {
     state_ = threw ? planner_status_t::ERROR : planner_status_t::IDLE;
     last_message_ = threw ? error : (plan.success() ? "" : plan.stats.reason);
   }
+  // Knot 0 is the measured state, at its own time; without a state the plan starts when it
+  // is published. Until replans join the motion under way, a plan takes over at its start.
+  time.state_utime = state_utime.value_or(-1);
+  time.start_utime = state_utime.value_or(time.utime);
+  time.takeover_utime = time.start_utime;
   plan_t msg;
   if (threw) {
     spdlog::error("goal {}: planner error: {}", goal.goal_id, error);
     msg = messages::failure_message(plan_t::FAILED, "planner error: " + error, identity_.model_name,
-                                    plan_id, goal.goal_id, now_utime());
+                                    plan_id, goal.goal_id, time);
   } else {
     msg = messages::plan_to_message(plan, *problem.model, identity_.model_name, plan_id,
-                                    goal.goal_id, now_utime());
+                                    goal.goal_id, time);
     msg.method = report.method;
     spdlog::info("goal {}: plan {} {} ({}, {} iterations, {:.1f} ms)", goal.goal_id, plan_id,
                  plan.success() ? "valid" : "INVALID", msg.method, plan.stats.iterations,
                  plan.stats.solve_time_s * 1e3);
   }
-  lcm_->publish(channel("PLAN"), &msg);
+  publish(channel("PLAN"), msg);
+  if (!options_.drake_plan_channel.empty() && msg.status == plan_t::SUCCESS) {
+    drake::lcmt_robot_plan drake_plan = messages::robot_plan_from_plan(msg);
+    publish(options_.drake_plan_channel, drake_plan);
+  }
   publish_status();
 }
 
@@ -339,27 +519,53 @@ void PlannerNode::worker_loop(const std::atomic<bool>& stop) {
 
 void PlannerNode::publish_status() {
   planner_status_t msg;
+  std::vector<uint8_t> bytes;
   {
     std::lock_guard lock(mutex_);
-    msg.utime = now_utime();
+    msg.utime = own_heartbeats_.next_utime(wall_utime());
     msg.robot = identity_.model_name;
     msg.state = state_;
     msg.last_goal_id = last_goal_id_;
     msg.last_plan_id = last_plan_id_;
     msg.message = last_message_;
+    // planner_status_t has no fields for failed publishes or a second daemon: the text says.
+    const auto append = [&](const std::string& text) {
+      msg.message += (msg.message.empty() ? "" : "; ") + text;
+    };
+    if (counters_.publish_failures > 0) {
+      append(std::to_string(counters_.publish_failures) +
+             " publishes failed since start, the last on " + last_publish_failure_);
+    }
+    if (!foreign_daemon_.empty()) append(foreign_daemon_);
     msg.num_plans = counters_.plans_published;
     msg.num_failures = counters_.failures;
     msg.num_goals_received = counters_.goals_received;
     msg.num_goals_answered = counters_.goals_answered;
     msg.num_goals_superseded = counters_.goals_superseded;
     msg.num_goals_dropped = counters_.goals_dropped;
+    // Recorded before it is sent, under the lock that gave it its utime, so that its
+    // loop-back is always recognised as ours.
+    bytes.resize(static_cast<std::size_t>(msg.getEncodedSize()));
+    msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+    own_heartbeats_.record(msg.utime,
+                           std::hash<std::string_view>{}(std::string_view(
+                               reinterpret_cast<const char*>(bytes.data()), bytes.size())));
   }
-  lcm_->publish(channel("PLANNER_STATUS"), &msg);
+  publish_bytes(planner_status_t::getTypeName(), channel("PLANNER_STATUS"), bytes.data(),
+                static_cast<unsigned>(bytes.size()));
 }
 
 void PlannerNode::run(const std::atomic<bool>& stop) {
   spdlog::info("kinographd: robot {} on channels {}_*", identity_.model_name,
                identity_.channel_prefix);
+  if (!options_.iiwa_status_channel.empty()) {
+    spdlog::info("kinographd: Drake's lcmt_iiwa_status on {} is the robot's state too",
+                 options_.iiwa_status_channel);
+  }
+  if (!options_.drake_plan_channel.empty()) {
+    spdlog::info("kinographd: valid plans also as Drake's lcmt_robot_plan on {}",
+                 options_.drake_plan_channel);
+  }
   // The worker stops on `done`, not on `stop`, so that an LCM failure also ends it.
   std::atomic<bool> done{false};
   std::thread worker([&] { worker_loop(done); });
@@ -368,6 +574,7 @@ void PlannerNode::run(const std::atomic<bool>& stop) {
   while (!stop.load()) {
     if (std::chrono::steady_clock::now() >= next_status) {
       publish_status();
+      flush_reject_log();
       next_status += std::chrono::duration_cast<std::chrono::steady_clock::duration>(
           std::chrono::duration<double>(options_.status_period_s));
     }

@@ -19,6 +19,8 @@
 #include <vector>
 
 #include "daemon/intake.h"
+#include "daemon/log_limiter.h"
+#include "daemon/own_heartbeats.h"
 #include "kinograph/lcm/message_convert.h"
 #include "kinograph/planning/io/scene.h"
 #include "kinograph/planning/replanner.h"
@@ -55,20 +57,32 @@ struct PlannerNodeOptions {
   /// the way and are answered SUPERSEDED and counted as dropped. Off when several senders
   /// share the channel or ids are not consecutive (then no id means a loss).
   bool answer_goal_id_gaps = true;
+  /// Oldest measured state a goal is planned from (s, robot clock): when the goal's utime is
+  /// later than the latest state's by more, the goal is answered INVALID_STATE instead.
+  double max_state_age_s = 0.5;
+  /// Channel of Drake's lcmt_iiwa_status (e.g. "IIWA_STATUS") read as the measured state too,
+  /// joints in the URDF's order; empty = none.
+  std::string iiwa_status_channel;
+  /// Channel on which every valid plan is also published as Drake's lcmt_robot_plan (e.g.
+  /// "COMMITTED_ROBOT_PLAN"); empty = none.
+  std::string drake_plan_channel;
 };
 
 /// What a node has done since it started (for its status and for tests).
 struct NodeCounters {
-  int64_t goals_received = 0;    ///< goal_t messages decoded with a goal_id (valid or not)
-  int64_t goals_answered = 0;    ///< goals answered once: planned, refused or superseded
-  int64_t goals_superseded = 0;  ///< of which SUPERSEDED: a newer goal was planned instead
-  int64_t goals_dropped = 0;     ///< goal ids skipped in the sender's sequence (lost), answered
-  int messages_rejected = 0;     ///< messages of any type that failed to decode or check
-  int plans_published = 0;       ///< plan_t messages sent (successes and failures)
-  int failures = 0;              ///< of which not SUCCESS
-  int replans = 0;               ///< plans triggered by an obstacle change for the current goal
-  int incremental = 0;           ///< plans answered by an incremental replan (validated or not)
-  int fallbacks = 0;             ///< incremental replans redone by a batch solve
+  int64_t goals_received = 0;      ///< goal_t messages decoded with a goal_id (valid or not)
+  int64_t goals_answered = 0;      ///< goals answered once: planned, refused or superseded
+  int64_t goals_superseded = 0;    ///< of which SUPERSEDED: a newer goal was planned instead
+  int64_t goals_dropped = 0;       ///< goal ids skipped in the sender's sequence (lost), answered
+  int messages_rejected = 0;       ///< messages of any type that failed to decode or check
+  int plans_published = 0;         ///< plan_t messages sent (successes and failures)
+  int failures = 0;                ///< of which not SUCCESS
+  int replans = 0;                 ///< plans triggered by an obstacle change for the current goal
+  int incremental = 0;             ///< plans answered by an incremental replan (validated or not)
+  int fallbacks = 0;               ///< incremental replans redone by a batch solve
+  int64_t publish_failures = 0;    ///< messages LCM failed to send (lcm_publish returned non-zero)
+  int64_t states_refused = 0;      ///< states beyond the limits or not finite (never a start)
+  int64_t foreign_heartbeats = 0;  ///< heartbeats on this daemon's channel published by another
 };
 
 /// The planner daemon's node: scene (robot, defaults, fixed obstacles) + LCM + worker thread.
@@ -80,6 +94,14 @@ class PlannerNode {
   static constexpr int kGoalQueueCapacity = 10000;
   static constexpr int kObstacleQueueCapacity = 2000;
   static constexpr int kStateQueueCapacity = 2000;
+  /// Heartbeats read back from the daemon's own status channel (to find a second daemon);
+  /// dropping some only delays finding it.
+  static constexpr int kHeartbeatQueueCapacity = 100;
+  /// Own heartbeats remembered to tell them from another daemon's (over an hour at 1 Hz).
+  static constexpr std::size_t kOwnHeartbeatMemory = 4096;
+  /// Log lines about rejected messages allowed per second and channel; the rest are counted
+  /// and summarised in one line.
+  static constexpr int kRejectLogLinesPerSecond = 10;
   /// A jump in goal ids larger than this is a new numbering, not a loss.
   static constexpr int64_t kMaxGoalIdGap = kGoalQueueCapacity;
 
@@ -104,9 +126,30 @@ class PlannerNode {
   void on_goal(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   void on_obstacles(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   void on_state(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
-  void reject(const std::string& reason);
-  /// Publishes a plan_t without trajectory that answers `goal_id` with a failure status.
-  void answer_with_failure(int8_t status, const std::string& reason, int64_t goal_id);
+  void on_iiwa_status(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  /// A heartbeat on this daemon's status channel: its own, or another daemon's (reported).
+  void on_heartbeat(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  /// Hands a decoded measured state to the intake (LCM thread); one beyond the robot's limits
+  /// is refused, and goals are answered INVALID_STATE until a usable state arrives.
+  void take_state(const std::string& channel, MeasuredState&& state);
+  /// Refuses the newest measured state as a start for `reason` (LCM thread).
+  void refuse_state(const std::string& channel, int64_t utime, std::string reason);
+  /// Refuses a message that came on `channel`: counted, its reason on the status channel and,
+  /// within the rate limit, in the log.
+  void reject(const std::string& channel, const std::string& reason);
+  /// Publishes `msg` on `channel`; a failure is logged as an error and counted in the heartbeat.
+  template <class Message>
+  void publish(const std::string& channel, const Message& msg);
+  /// Publishes encoded bytes of type `type`, checked as publish() does.
+  void publish_bytes(const char* type, const std::string& channel, const void* data, unsigned size);
+  /// Logs the summaries of rejections the rate limit left out.
+  void flush_reject_log();
+  /// Publishes a plan_t without trajectory that answers `goal_id` with a failure status; a
+  /// second answer to a goal (a replan's) is not counted as an answered goal again.
+  void answer_with_failure(int8_t status, const std::string& reason, int64_t goal_id,
+                           bool first_answer = true);
+  /// Why a goal must not be planned from `state` (older than max_state_age_s), or empty.
+  std::string stale_state_reason(const GoalRequest& goal, const MeasuredState& state) const;
   /// Answers the goals a newer one replaced and the ids that never arrived (worker thread).
   void answer_superseded(const Intake& taken);
   /// Hands what the handlers took off LCM to the worker, in one go (LCM thread).
@@ -115,7 +158,11 @@ class PlannerNode {
   bool apply_obstacles(const std::vector<ObstacleUpdate>& updates, bool replace_all);
   void plan_and_publish(const GoalRequest& goal, bool replan);
   void publish_status();
-  int64_t now_utime() const;
+  /// The wall clock (epoch, µs): the heartbeat's, and the plans' while no state has arrived.
+  static int64_t wall_utime();
+  /// The plans' clock: the latest measured state's utime, or the wall clock before any state
+  /// arrived. Caller holds mutex_.
+  messages::PlanTime clock_now_locked() const;
 
   planning::Scene scene_;
   PlannerNodeOptions options_;
@@ -140,6 +187,12 @@ class PlannerNode {
   int64_t last_goal_id_ = -1;
   int64_t last_plan_id_ = -1;
   std::string last_message_;
+  std::string last_publish_failure_;  // channel of the last failed publish
+  std::string state_refusal_;         // why the newest measured state cannot be a start, or empty
+  LogLimiter reject_log_{kRejectLogLinesPerSecond, 1.0};
+  OwnHeartbeats own_heartbeats_{kOwnHeartbeatMemory};
+  std::string foreign_daemon_;        // what the last foreign heartbeat said about its daemon
+  int64_t foreign_logged_utime_ = 0;  // wall clock of the last log line about it
   int64_t next_plan_id_ = 1;
 
   // Owned by the worker thread.

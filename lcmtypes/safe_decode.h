@@ -5,8 +5,8 @@
 // array to its count *before* checking that the bytes are there, so a 30-byte message with
 // num_joints = 2^31 - 1 asks for tens of gigabytes, a negative count or a zero string length
 // throws std::length_error, and decoding into a reused object keeps stale array contents when
-// a count is 0. safe_decode() first walks the wire format (mirroring the .lcm files, which
-// are never edited once released) and checks every count and string length against the bytes
+// a count is 0. safe_decode() first walks the wire format (mirroring the .lcm files, each
+// version of a type its own struct) and checks every count and string length against the bytes
 // that remain, then decodes into a fresh object and catches anything left.
 #include <cstdint>
 #include <cstring>
@@ -14,10 +14,15 @@
 #include <string>
 #include <utility>
 
+#include "drake/lcmt_iiwa_status.hpp"
+#include "drake/lcmt_robot_plan.hpp"
+#include "drake/lcmt_robot_state.hpp"
 #include "kinograph/goal_t.hpp"
+#include "kinograph/joint_command_t.hpp"
 #include "kinograph/obstacle_list_t.hpp"
 #include "kinograph/obstacle_t.hpp"
 #include "kinograph/plan_t.hpp"
+#include "kinograph/plan_v1_t.hpp"
 #include "kinograph/planner_status_t.hpp"
 #include "kinograph/robot_state_t.hpp"
 
@@ -59,6 +64,12 @@ class WireReader {
     v = static_cast<int32_t>(u);
     return true;
   }
+  bool read_i16(int16_t& v, const char* field) {
+    if (remaining() < 2) return fail(std::string(field) + ": truncated");
+    v = static_cast<int16_t>((data_[pos_] << 8) | data_[pos_ + 1]);
+    pos_ += 2;
+    return true;
+  }
   bool read_i64(int64_t& v, const char* field) {
     if (remaining() < 8) return fail(std::string(field) + ": truncated");
     uint64_t u = 0;
@@ -94,6 +105,17 @@ class WireReader {
   /// which bounds the count by what remains before anything is allocated.
   bool count(int32_t& n, int64_t min_elem_bytes, const char* field) {
     if (!read_i32(n, field)) return false;
+    return bounded(n, min_elem_bytes, field);
+  }
+  /// The same for an int16 count (Drake's lcmt_robot_state).
+  bool count16(int32_t& n, int64_t min_elem_bytes, const char* field) {
+    int16_t n16 = 0;
+    if (!read_i16(n16, field)) return false;
+    n = n16;
+    return bounded(n, min_elem_bytes, field);
+  }
+  /// Checks a count already read: not negative, and its elements fit in what remains.
+  bool bounded(int32_t n, int64_t min_elem_bytes, const char* field) {
     if (n < 0) return fail(std::string(field) + " = " + std::to_string(n) + " is negative");
     if (static_cast<int64_t>(n) * min_elem_bytes > remaining()) {
       return fail(std::string(field) + " = " + std::to_string(n) + " needs at least " +
@@ -157,14 +179,19 @@ inline bool check_fields(WireReader& r, const obstacle_list_t*) {
   return r.boolean("obstacle_list_t.replace_all");
 }
 
-inline bool check_fields(WireReader& r, const plan_t*) {
+// plan_t (version 2) and plan_v1_t differ only by the four clock fields after `method`.
+inline bool check_plan_fields(WireReader& r, bool has_clock) {
   int64_t i64 = 0;
   int32_t nj = 0, ns = 0, i32 = 0;
   if (!(r.read_i64(i64, "plan_t.utime") && r.read_i64(i64, "plan_t.plan_id") &&
         r.read_i64(i64, "plan_t.goal_id") && r.string("plan_t.robot") &&
         r.skip(1, 1, "plan_t.status") && r.string("plan_t.status_message") &&
-        r.string("plan_t.method") && r.count(nj, kMinStringBytes, "plan_t.num_joints")))
+        r.string("plan_t.method")))
     return false;
+  if (has_clock && !(r.skip(1, 1, "plan_t.clock") &&
+                     r.skip(3, 8, "plan_t.start_utime/state_utime/takeover_utime")))
+    return false;
+  if (!r.count(nj, kMinStringBytes, "plan_t.num_joints")) return false;
   for (int32_t i = 0; i < nj; ++i)
     if (!r.string("plan_t.joint_name")) return false;
   // t[num_steps] bounds num_steps even when num_joints is 0.
@@ -172,6 +199,56 @@ inline bool check_fields(WireReader& r, const plan_t*) {
          r.skip(4 * static_cast<int64_t>(ns) * nj, 8, "plan_t.q/qd/qdd/tau") &&
          r.skip(1, 8, "plan_t.solve_time_s") && r.read_i32(i32, "plan_t.iterations") &&
          r.skip(1 + 4, 8, "plan_t.cost/validation") && r.boolean("plan_t.valid");
+}
+inline bool check_fields(WireReader& r, const plan_t*) {
+  return check_plan_fields(r, /*has_clock=*/true);
+}
+inline bool check_fields(WireReader& r, const plan_v1_t*) {
+  return check_plan_fields(r, /*has_clock=*/false);
+}
+
+inline bool check_fields(WireReader& r, const joint_command_t*) {
+  int64_t i64 = 0;
+  int32_t n = 0;
+  if (!(r.read_i64(i64, "joint_command_t.utime") && r.string("joint_command_t.robot") &&
+        r.read_i64(i64, "joint_command_t.plan_id") &&
+        r.count(n, kMinStringBytes, "joint_command_t.num_joints")))
+    return false;
+  for (int32_t i = 0; i < n; ++i)
+    if (!r.string("joint_command_t.joint_name")) return false;
+  return r.skip(3 * static_cast<int64_t>(n), 8, "joint_command_t.position/velocity/torque");
+}
+
+inline bool check_fields(WireReader& r, const ::drake::lcmt_iiwa_status*) {
+  int64_t i64 = 0;
+  int32_t n = 0;
+  return r.read_i64(i64, "lcmt_iiwa_status.utime") &&
+         r.count(n, 7 * 8, "lcmt_iiwa_status.num_joints") &&
+         r.skip(7 * static_cast<int64_t>(n), 8, "lcmt_iiwa_status.joint_*");
+}
+
+// A robot state inside a plan carries no fingerprint of its own.
+inline bool check_fields(WireReader& r, const ::drake::lcmt_robot_state*) {
+  int64_t i64 = 0;
+  int32_t n = 0;
+  if (!(r.read_i64(i64, "lcmt_robot_state.utime") &&
+        r.count16(n, kMinStringBytes + 4, "lcmt_robot_state.num_joints")))
+    return false;
+  for (int32_t i = 0; i < n; ++i)
+    if (!r.string("lcmt_robot_state.joint_name")) return false;
+  return r.skip(n, 4, "lcmt_robot_state.joint_position");
+}
+constexpr int64_t kMinDrakeStateBytes = 8 + 2;
+
+inline bool check_fields(WireReader& r, const ::drake::lcmt_robot_plan*) {
+  int64_t i64 = 0;
+  int32_t n = 0;
+  if (!(r.read_i64(i64, "lcmt_robot_plan.utime") &&
+        r.count(n, kMinDrakeStateBytes, "lcmt_robot_plan.num_states")))
+    return false;
+  for (int32_t i = 0; i < n; ++i)
+    if (!check_fields(r, static_cast<const ::drake::lcmt_robot_state*>(nullptr))) return false;
+  return true;
 }
 
 inline bool check_fields(WireReader& r, const planner_status_t*) {
@@ -186,7 +263,7 @@ inline bool check_fields(WireReader& r, const planner_status_t*) {
 
 }  // namespace detail
 
-/// Decodes a received kinograph message into `out` (replacing it wholly) only if it is
+/// Decodes a received kinograph (or Drake) message into `out` (replacing it wholly) only if it is
 /// well formed: right fingerprint, every count and string length consistent with the bytes,
 /// strings NUL-terminated without inner NULs, booleans 0 or 1, no trailing bytes. On failure `out`
 /// is untouched and the status names the bad field. Range checks that need the robot (joint counts,

@@ -21,6 +21,8 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev liborocos-kdl-dev libceres-dev
   # third-party URDFs with real meshes for renderer tests
   dart-doc
+  # the Python client's tests (the client needs only python3 and liblcm1)
+  python3
   # network namespaces for LCM multicast tests
   iproute2 util-linux
 )

@@ -1,10 +1,12 @@
 // LCM verbs of the CLI: talk to a running kinographd.
 //   kinograph send-goal     --prefix IIWA (--q ... | --frame F --position ... --quaternion ...)
+//                           [--utime US]
 //   kinograph send-obstacle --prefix IIWA --id box --shape box --size ... --position ...
-//   kinograph send-state    --prefix IIWA --scene S --q ... [--qd ...]
+//   kinograph send-state    --prefix IIWA --scene S --q ... [--qd ...] [--utime US]
 //   kinograph send-raw      CHANNEL --text BYTES
 //   kinograph log-plans     LOG.lcmlog --channel IIWA_PLAN --scene S --out-dir DIR
 // send-goal and send-obstacle can wait for the answering plan (--wait) and write it (--out).
+// --utime stamps a message on the robot's clock (e.g. sim time) instead of the wall clock.
 #include <chrono>
 #include <filesystem>
 #include <iostream>
@@ -55,7 +57,11 @@ lcm::LCM& open_lcm(const std::string& url) {
   return *lcm;
 }
 
-std::string summarize(const plan_t& p) {
+namespace {
+
+// Both plan versions share these fields.
+template <typename PlanMessage>
+std::string summarize_plan(const PlanMessage& p) {
   static const char* kStatus[] = {"SUCCESS",   "FAILED",        "INVALID_GOAL", "INVALID_STATE",
                                   "CANCELLED", "NOT_CONVERGED", "SUPERSEDED"};
   std::ostringstream s;
@@ -70,6 +76,22 @@ std::string summarize(const plan_t& p) {
       << p.goal_error << ", valid " << (p.valid ? "yes" : "no");
   }
   return s.str();
+}
+
+}  // namespace
+
+std::string summarize(const plan_t& p) {
+  std::ostringstream s;
+  s << summarize_plan(p) << "\n  clock " << (p.clock == plan_t::CLOCK_ROBOT ? "robot" : "wall")
+    << ", published at " << p.utime << " us";
+  if (p.num_steps > 0) s << ", starts at " << p.start_utime << " us";
+  s << (p.state_utime >= 0 ? ", from the state at " + std::to_string(p.state_utime) + " us"
+                           : ", from the scene's start");
+  return s.str();
+}
+
+std::string summarize(const plan_v1_t& p) {
+  return summarize_plan(p) + "\n  (plan_t version 1: no clock; times are from the plan's start)";
 }
 
 namespace {
@@ -152,8 +174,11 @@ const bool kSendGoal = register_command([](CLI::App& root) {
   auto goal_id = std::make_shared<int64_t>(-1);
   auto duration = std::make_shared<double>(0);
   auto robot = std::make_shared<std::string>();
+  auto utime = std::make_shared<int64_t>(-1);
   c->add(sub, true);
   sub->add_option("--id", *goal_id, "goal id (default: current time in µs)");
+  sub->add_option("--utime", *utime,
+                  "goal time on the robot's clock (µs), e.g. sim time (default: the wall clock)");
   sub->add_option("--q", *q, "joint goal (rad), comma-separated; angles may use pi");
   sub->add_option("--frame", *frame, "end-effector frame for a pose goal");
   sub->add_option("--position", *position, "pose goal position x,y,z (m)");
@@ -164,8 +189,8 @@ const bool kSendGoal = register_command([](CLI::App& root) {
   sub->add_option("--robot", *robot, "robot name in the message (default: empty = any)");
   sub->callback([=] {
     goal_t msg;
-    msg.utime = now_utime();
-    msg.goal_id = *goal_id >= 0 ? *goal_id : msg.utime;
+    msg.utime = *utime >= 0 ? *utime : now_utime();
+    msg.goal_id = *goal_id >= 0 ? *goal_id : now_utime();
     msg.robot = *robot;
     msg.duration_s = *duration;
     std::fill(std::begin(msg.ee_position), std::end(msg.ee_position), 0.0);
@@ -278,7 +303,10 @@ const bool kSendState = register_command([](CLI::App& root) {
   auto scene = std::make_shared<std::string>();
   auto q = std::make_shared<std::string>();
   auto qd = std::make_shared<std::string>();
+  auto utime = std::make_shared<int64_t>(-1);
   c->add(sub, false);
+  sub->add_option("--utime", *utime,
+                  "measurement time on the robot's clock (µs) (default: the wall clock)");
   sub->add_option("--scene", *scene, "scene with the robot (for the joint names)")->required();
   sub->add_option("--q", *q, "joint positions, comma-separated")->required();
   sub->add_option("--qd", *qd, "joint velocities (default zeros)");
@@ -286,7 +314,7 @@ const bool kSendState = register_command([](CLI::App& root) {
     const auto s = planning::load_scene(*scene);
     const auto& model = *s.problem.model;
     robot_state_t msg;
-    msg.utime = now_utime();
+    msg.utime = *utime >= 0 ? *utime : now_utime();
     msg.robot = model.name;
     msg.num_joints = model.nq();
     for (const auto& b : model.bodies) msg.joint_name.push_back(b.joint_name);
@@ -336,17 +364,16 @@ const bool kLogPlans = register_command([](CLI::App& root) {
     if (!file.good()) throw CommandFailure("cannot read LCM log " + *log);
     // Every plan is checked against the scene's robot before any file is written, so a wrong
     // --scene writes nothing.
-    std::vector<plan_t> plans;
-    int rejected = 0;
-    while (const lcm::LogEvent* event = file.readNextEvent()) {
-      if (event->channel != *channel) continue;
-      plan_t msg;
-      if (!lcmtypes::safe_decode(event->data, event->datalen, msg).ok) {
-        ++rejected;
-        continue;
-      }
+    struct Found {
+      std::string path;
+      planning::Plan plan;
+    };
+    std::vector<Found> plans;
+    int rejected = 0, old = 0;
+    // Prints a decoded plan of either version and keeps it when it has a trajectory.
+    auto take = [&](const auto& msg) {
       std::cout << summarize(msg) << "\n";
-      if (msg.num_steps == 0) continue;
+      if (msg.num_steps == 0) return;
       if (msg.joint_name != joints) {
         throw CommandFailure("plan " + std::to_string(msg.plan_id) + " for goal " +
                              std::to_string(msg.goal_id) + " moves joints [" +
@@ -354,16 +381,32 @@ const bool kLogPlans = register_command([](CLI::App& root) {
                              " has [" + join_names(joints) +
                              "]; give the scene the daemon served (nothing written)");
       }
-      plans.push_back(std::move(msg));
+      plans.push_back({*out_dir + "/plan_" + std::to_string(msg.goal_id) + "_" +
+                           std::to_string(msg.plan_id) + ".json",
+                       messages::plan_from_message(msg)});
+    };
+    while (const lcm::LogEvent* event = file.readNextEvent()) {
+      if (event->channel != *channel) continue;
+      // The fingerprint says which version of plan_t a message is (lcmtypes/README.md).
+      plan_t msg;
+      plan_v1_t v1;
+      const auto current = lcmtypes::safe_decode(event->data, event->datalen, msg);
+      if (current.ok) {
+        take(msg);
+      } else if (lcmtypes::safe_decode(event->data, event->datalen, v1).ok) {
+        take(v1);
+        ++old;
+      } else {
+        std::cerr << "kinograph: " << *channel << " message at " << event->timestamp
+                  << " us is not a plan_t of version 2 or 1 (" << current.reason << "); skipped\n";
+        ++rejected;
+      }
     }
     std::filesystem::create_directories(*out_dir);
-    for (const plan_t& msg : plans) {
-      const std::string path = *out_dir + "/plan_" + std::to_string(msg.goal_id) + "_" +
-                               std::to_string(msg.plan_id) + ".json";
-      write_plan_json(messages::plan_from_message(msg), s, path);
-    }
+    for (const Found& f : plans) write_plan_json(f.plan, s, f.path);
     std::cout << plans.size() << " plans written to " << *out_dir;
-    if (rejected) std::cout << ", " << rejected << " malformed messages skipped";
+    if (old) std::cout << ", " << old << " of version 1 (no clock)";
+    if (rejected) std::cout << ", " << rejected << " messages that are not plans skipped";
     std::cout << "\n";
   });
 });

@@ -1,6 +1,6 @@
 // `kinograph render plan.json --frames 5 --style strip|ghost --out strip.png`: draws a plan
 // headlessly (OSMesa) as a frame strip or a ghost overlay; `--compare after.json` draws a plan
-// and its replan in one view (the replanning figure).
+// and its replan in one view (the replanning figure). A failed plan's picture is marked failed.
 #include <spdlog/spdlog.h>
 
 #include <chrono>
@@ -8,6 +8,7 @@
 #include <string>
 
 #include "kinograph/planning/io/plan_json.h"
+#include "render/failure_mark.h"
 #include "render/image.h"
 #include "render/plan_scene.h"
 #include "render/scene_camera.h"
@@ -54,8 +55,10 @@ void run_render(const RenderArgs& args) {
     options.floor = !args.no_floor;
     render::SceneRenderer renderer(render::RendererOptions{.samples = args.samples});
     render::RenderResult result;
+    std::optional<std::string> failure = render::failure_text(plan.plan);
     if (!args.compare.empty()) {
       const planning::PlanFile after_plan = planning::read_plan_file(args.compare);
+      if (!failure) failure = render::failure_text(after_plan.plan);
       render::RenderScene after = render::plan_scene(after_plan);
       after.end_effector_frame = args.ee_frame;
       after.camera = scene.camera;
@@ -69,6 +72,7 @@ void run_render(const RenderArgs& args) {
     } else {
       result = renderer.strip(scene, options);
     }
+    if (failure) render::mark_failed(result.image, *failure);
     render::write_png(result.image, args.out);
   } catch (const std::exception& e) {
     throw CommandFailure(e.what());

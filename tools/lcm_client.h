@@ -6,6 +6,7 @@
 #include <string>
 
 #include "kinograph/plan_t.hpp"
+#include "kinograph/plan_v1_t.hpp"
 
 namespace kinograph::tools {
 
@@ -27,7 +28,9 @@ class PlanWaiter {
 /// Opens LCM on `url` (empty = default); throws CommandFailure if it cannot.
 lcm::LCM& open_lcm(const std::string& url);
 
-/// One line per plan: status, method, time, iterations, validation figures.
+/// One line per plan: status, method, time, iterations, validation figures, and its clock.
 std::string summarize(const plan_t& plan);
+/// The same for a plan of version 1 (old logs), which has no clock.
+std::string summarize(const plan_v1_t& plan);
 
 }  // namespace kinograph::tools

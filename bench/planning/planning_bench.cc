@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/common/bench_flags.h"
 #include "bench/common/bench_stats.h"
 #include "bench/common/iiwa_goals.h"
 #include "bench/common/timed_plan.h"
@@ -28,8 +29,6 @@ namespace {
 using nlohmann::json;
 using planning::Plan;
 using planning::Problem;
-
-const std::string kScenes = std::string(KINOGRAPH_SOURCE_DIR) + "/robots/scenes/";
 
 // The paper's "total torque" of a run (N·m): Σ_k Σ_j |τ_kj| over every state and joint.
 double total_torque(const Plan& plan) { return plan.tau.cwiseAbs().sum(); }
@@ -57,7 +56,7 @@ json summary(const std::vector<Run>& runs) {
           {"time_s_max", max_of(ok_times)},
           {"time_s_median_all", median(all_times)},
           {"iterations_median", median(iterations)},
-          {"valid_all", valid},           // per run, in run order
+          {"valid_all", valid},            // per run, in run order
           {"objective_all", objectives}};  // per run: the plan's soft cost
 }
 
@@ -77,18 +76,12 @@ json failures_of(const std::vector<Run>& runs) {
 int run(int argc, char** argv) {
   int goals = 50, acrobot_repeats = 5;
   std::string json_path;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--goals" && i + 1 < argc) {
-      goals = std::stoi(argv[++i]);
-    } else if (a == "--acrobot-repeats" && i + 1 < argc) {
-      acrobot_repeats = std::stoi(argv[++i]);
-    } else if (a == "--json" && i + 1 < argc) {
-      json_path = argv[++i];
-    } else {
-      std::cerr << "usage: planning_bench [--goals N] [--acrobot-repeats N] [--json FILE]\n";
-      return 1;
-    }
+  if (!Flags("planning_bench")
+           .value("--goals", &goals)
+           .value("--acrobot-repeats", &acrobot_repeats)
+           .value("--json", &json_path)
+           .parse(argc, argv)) {
+    return 1;
   }
   spdlog::set_level(spdlog::level::warn);
   const planning::BatchPlanner planner;

@@ -19,12 +19,13 @@
 #include <string>
 #include <vector>
 
+#include "bench/common/bench_flags.h"
 #include "bench/common/bench_stats.h"
 #include "bench/common/iiwa_goals.h"
 #include "kinograph/planning/batch/batch_planner.h"
 #include "kinograph/planning/goal_sampler.h"
-#include "kinograph/planning/replanner.h"
 #include "kinograph/planning/io/scene.h"
+#include "kinograph/planning/replanner.h"
 
 namespace kinograph::bench {
 namespace {
@@ -33,8 +34,6 @@ using nlohmann::json;
 using planning::Plan;
 using planning::Problem;
 using Clock = std::chrono::steady_clock;
-
-const std::string kScenes = std::string(KINOGRAPH_SOURCE_DIR) + "/robots/scenes/";
 
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
@@ -138,42 +137,24 @@ int run(int argc, char** argv) {
   planning::ReplannerOptions ro;
   ro.retry_from_scratch = false;
   planning::IncrementalPlannerOptions& io = ro.incremental;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--problems" && i + 1 < argc) {
-      problems = std::stoi(argv[++i]);
-    } else if (a == "--obstacle-problems" && i + 1 < argc) {
-      obstacle_problems = std::stoi(argv[++i]);
-    } else if (a == "--radius" && i + 1 < argc) {
-      radius = std::stod(argv[++i]);
-    } else if (a == "--shift" && i + 1 < argc) {
-      shift = std::stod(argv[++i]);
-    } else if (a == "--json" && i + 1 < argc) {
-      json_path = argv[++i];
-    } else if (a == "--polish-objective") {
-      io.stop_at_first_valid = false;
-    } else if (a == "--no-linearize-at-evaluation") {
-      io.isam2.linearize_at_evaluation = false;
-    } else if (a == "--lambda-initial" && i + 1 < argc) {
-      io.isam2.lambda_initial = std::stod(argv[++i]);
-    } else if (a == "--lambda-min" && i + 1 < argc) {
-      io.isam2.lambda_min = std::stod(argv[++i]);
-    } else if (a == "--lambda-decrease" && i + 1 < argc) {
-      io.isam2.lambda_decrease = std::stod(argv[++i]);
-    } else if (a == "--limit-epsilon" && i + 1 < argc) {
-      limit_epsilon = std::stod(argv[++i]);
-    } else if (a == "--only" && i + 1 < argc) {
-      only = std::stoi(argv[++i]);
-    } else if (a == "--log-level" && i + 1 < argc) {
-      log_level = spdlog::level::from_str(argv[++i]);
-    } else {
-      std::cerr << "usage: replanning_bench [--problems 50] [--obstacle-problems N] "
-                   "[--radius 0.2] [--shift 0.05] [--json FILE] "
-                   "[--log-level warn|info|debug|trace] [--polish-objective] "
-                   "[--no-linearize-at-evaluation] [--lambda-initial 1e-2] "
-                   "[--lambda-decrease 100] [--lambda-min 1e-7] [--limit-epsilon X] [--only I]\n";
-      return 1;
-    }
+  if (!Flags("replanning_bench")
+           .value("--problems", &problems)
+           .value("--obstacle-problems", &obstacle_problems)
+           .value("--radius", &radius)
+           .value("--shift", &shift)
+           .value("--json", &json_path)
+           .value("--log-level", "warn|info|debug|trace",
+                  [&](const std::string& v) { log_level = spdlog::level::from_str(v); })
+           .toggle("--polish-objective", [&] { io.stop_at_first_valid = false; })
+           .toggle("--no-linearize-at-evaluation",
+                   [&] { io.isam2.linearize_at_evaluation = false; })
+           .value("--lambda-initial", &io.isam2.lambda_initial)
+           .value("--lambda-decrease", &io.isam2.lambda_decrease)
+           .value("--lambda-min", &io.isam2.lambda_min)
+           .value("--limit-epsilon", &limit_epsilon)
+           .value("--only", &only)
+           .parse(argc, argv)) {
+    return 1;
   }
   if (obstacle_problems < 0) obstacle_problems = problems;
   spdlog::set_level(log_level);

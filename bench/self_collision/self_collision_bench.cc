@@ -14,7 +14,9 @@
 #include <string>
 #include <vector>
 
+#include "bench/common/bench_flags.h"
 #include "bench/common/bench_stats.h"
+#include "bench/common/clearance_walk.h"
 #include "bench/common/iiwa_goals.h"
 #include "bench/common/timed_plan.h"
 #include "kinograph/collision/collision_world.h"
@@ -31,46 +33,8 @@ using nlohmann::json;
 using planning::Plan;
 using planning::Problem;
 
-const std::string kScenes = std::string(KINOGRAPH_SOURCE_DIR) + "/robots/scenes/";
 // Points per interval of the clearance walk (the validator samples 10 and walks adaptively).
 constexpr int kWalkSamples = 40;
-
-struct Clearance {
-  double self = std::numeric_limits<double>::infinity();
-  double floor = std::numeric_limits<double>::infinity();
-};
-
-// Self and floor clearance of a plan on the cubic Hermite interpolant of its knots, every pair
-// to the end (no culling), kWalkSamples points per interval: independent of the planner's
-// factors and of the validator's adaptive walk.
-Clearance walk(const Problem& problem, const Plan& plan) {
-  const dynamics::Model& model = *problem.model;
-  collision::CollisionWorldOptions self_only;
-  self_only.self_collision = true;
-  self_only.cull = false;
-  self_only.self_collision_excluded = problem.self_and_floor.allowed_pairs;
-  collision::CollisionWorld self(model, self_only);
-  collision::CollisionWorldOptions floor_only;
-  floor_only.cull = false;
-  collision::CollisionWorld floor(model, floor_only);
-  floor.add_obstacle(planning::floor_obstacle(problem.self_and_floor.floor.value_or(0.0)));
-  dynamics::Data data(model);
-  Clearance c;
-  const double dt = problem.dt();
-  for (int k = 0; k < problem.steps; ++k) {
-    for (int i = 0; i <= kWalkSamples; ++i) {
-      const double s = static_cast<double>(i) / kWalkSamples, s2 = s * s, s3 = s2 * s;
-      const Eigen::VectorXd q =
-          ((2 * s3 - 3 * s2 + 1) * plan.q.row(k) + (s3 - 2 * s2 + s) * dt * plan.qd.row(k) +
-           (-2 * s3 + 3 * s2) * plan.q.row(k + 1) + (s3 - s2) * dt * plan.qd.row(k + 1))
-              .transpose();
-      dynamics::forward_kinematics(model, data, q);
-      c.self = std::min(c.self, self.closest(data).distance);
-      c.floor = std::min(c.floor, floor.closest(data).distance);
-    }
-  }
-  return c;
-}
 
 // A horizon the move can make: twice the time the slowest joint needs at its velocity limit
 // (a smooth rest-to-rest profile peaks at 1.5× its mean speed), at least the scene's 3 s;
@@ -105,32 +69,14 @@ json times(const std::vector<Run>& runs) {
           {"time_s_max", max_of(ok)},    {"time_s_median_all", median(all)}};
 }
 
-// A JSON number, NaN for null (NaN is written as null).
-double num(const json& j) { return j.is_number() ? j.get<double>() : std::nan(""); }
-
-// Self and floor clearance of one configuration, as walk() measures them.
-Clearance at(const Problem& problem, const Eigen::VectorXd& q) {
-  Plan still;
-  still.q = q.transpose().replicate(2, 1);
-  still.qd = Eigen::MatrixXd::Zero(2, q.size());
-  Problem one = problem;
-  one.steps = 1;
-  return walk(one, still);
-}
-
 int run(int argc, char** argv) {
   int count = 50;
   std::string json_path;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--count" && i + 1 < argc) {
-      count = std::stoi(argv[++i]);
-    } else if (a == "--json" && i + 1 < argc) {
-      json_path = argv[++i];
-    } else {
-      std::cerr << "usage: self_collision_bench [--count N] [--json FILE]\n";
-      return 1;
-    }
+  if (!Flags("self_collision_bench")
+           .value("--count", &count)
+           .value("--json", &json_path)
+           .parse(argc, argv)) {
+    return 1;
   }
   spdlog::set_level(spdlog::level::warn);
   const planning::BatchPlanner planner;
@@ -164,7 +110,7 @@ int run(int argc, char** argv) {
                 {"status", to_string(r.plan.stats.status)},
                 {"time_s", r.wall_s},
                 {"success_without", blind.plan.success()}};
-      const Clearance cs = at(p, p.start_q), cg = at(p, p.goal.q);
+      const Clearance cs = clearance_at(p, p.start_q), cg = clearance_at(p, p.goal.q);
       c["start_q"] = std::vector<double>(p.start_q.data(), p.start_q.data() + p.start_q.size());
       c["goal_q"] = std::vector<double>(p.goal.q.data(), p.goal.q.data() + p.goal.q.size());
       c["start_self_m"] = cs.self;
@@ -174,7 +120,7 @@ int run(int argc, char** argv) {
       if (r.plan.success()) {
         ++ok;
         ok_times.push_back(r.wall_s);
-        const Clearance cl = walk(p, r.plan);
+        const Clearance cl = clearance_walk(p, r.plan, kWalkSamples);
         worst_self = std::min(worst_self, cl.self);
         worst_floor = std::min(worst_floor, cl.floor);
         if (cl.self >= 0 && cl.floor >= 0) ++clear;
@@ -219,10 +165,10 @@ int run(int argc, char** argv) {
     json failed = json::array();
     for (std::size_t i = 0; i < with.size(); ++i) {
       if (with[i].plan.success()) {
-        const Clearance c = walk(scene.problem, with[i].plan);
+        const Clearance c = clearance_walk(scene.problem, with[i].plan, kWalkSamples);
         if (c.self >= 0 && c.floor >= 0) ++with_clear;
       } else {
-        const Clearance g = at(scene.problem, with[i].plan.q.bottomRows(1).transpose());
+        const Clearance g = clearance_at(scene.problem, with[i].plan.q.bottomRows(1).transpose());
         const Eigen::VectorXd qg = with[i].plan.q.bottomRows(1).transpose();
         failed.push_back({{"goal", i},
                           {"goal_q", std::vector<double>(qg.data(), qg.data() + qg.size())},
@@ -233,7 +179,7 @@ int run(int argc, char** argv) {
                           {"without_success", without[i].plan.success()}});
       }
       if (without[i].plan.success()) {
-        const Clearance c = walk(scene.problem, without[i].plan);
+        const Clearance c = clearance_walk(scene.problem, without[i].plan, kWalkSamples);
         if (c.self < 0 || c.floor < 0) ++without_unclear;
       }
     }
@@ -270,25 +216,28 @@ int run(int argc, char** argv) {
                "|---|---|---|---|---|---|---|---|\n";
   std::cout << "| " << r["cases"] << " | " << r["successes"] << " | "
             << r["successes_without_self_and_floor"] << " | " << r["successes_clear"] << " | "
-            << cell(num(r["min_self_clearance_m"]), 1e3, 1) << " | "
-            << cell(num(r["min_floor_clearance_m"]), 1e3, 1) << " | "
-            << cell(num(r["time_s_median"]), 1e3) << " | " << cell(num(r["horizon_s_median"]), 1, 1)
-            << " |\n\n";
+            << cell(json_number(r["min_self_clearance_m"]), 1e3, 1) << " | "
+            << cell(json_number(r["min_floor_clearance_m"]), 1e3, 1) << " | "
+            << cell(json_number(r["time_s_median"]), 1e3) << " | "
+            << cell(json_number(r["horizon_s_median"]), 1, 1) << " |\n\n";
   std::cout << "| problem | checks | success | median time (ms) | mean (ms) | max (ms) | median "
                "all runs (ms) | both valid: median (ms), ratio |\n"
                "|---|---|---|---|---|---|---|---|\n";
   for (const char* key : {"iiwa_task1", "iiwa_task2"}) {
     for (const char* mode : {"with", "without"}) {
       const json& s = result[key][mode];
-      std::cout << "| " << key << " | " << mode << " | " << s["successes"] << "/" << s["runs"]
-                << " | " << cell(num(s["time_s_median"]), 1e3) << " | "
-                << cell(num(s["time_s_mean"]), 1e3) << " | " << cell(num(s["time_s_max"]), 1e3)
-                << " | " << cell(num(s["time_s_median_all"]), 1e3) << " | "
-                << cell(num(result[key][std::string("both_valid_") + mode + "_time_s_median"]), 1e3)
-                << (std::string(mode) == "with"
-                        ? ", " + cell(num(result[key]["both_valid_time_ratio_median"]), 1, 2)
-                        : std::string())
-                << " |\n";
+      std::cout
+          << "| " << key << " | " << mode << " | " << s["successes"] << "/" << s["runs"] << " | "
+          << cell(json_number(s["time_s_median"]), 1e3) << " | "
+          << cell(json_number(s["time_s_mean"]), 1e3) << " | "
+          << cell(json_number(s["time_s_max"]), 1e3) << " | "
+          << cell(json_number(s["time_s_median_all"]), 1e3) << " | "
+          << cell(json_number(result[key][std::string("both_valid_") + mode + "_time_s_median"]),
+                  1e3)
+          << (std::string(mode) == "with"
+                  ? ", " + cell(json_number(result[key]["both_valid_time_ratio_median"]), 1, 2)
+                  : std::string())
+          << " |\n";
     }
   }
   return 0;

@@ -152,46 +152,119 @@ Check obstacles_from_message(const obstacle_list_t& msg, std::vector<ObstacleUpd
   return {};
 }
 
+namespace {
+
+// Model index of each entry of a message's joint_name list, which may be in any order but must
+// name every joint of the model once.
+Check joint_indices(const std::vector<std::string>& names, const dynamics::Model& model,
+                    const std::string& type, std::vector<int>& out) {
+  const int n = model.nq();
+  std::unordered_map<std::string, int> index;
+  for (int j = 0; j < n; ++j) index[model.bodies[j].joint_name] = j;
+  std::vector<bool> seen(n, false);
+  std::vector<int> indices(names.size());
+  for (size_t i = 0; i < names.size(); ++i) {
+    auto it = index.find(names[i]);
+    if (it == index.end()) {
+      return Check::fail(type + ".joint_name[" + std::to_string(i) + "] \"" + names[i] +
+                         "\" is not a joint of " + model.name);
+    }
+    if (seen[it->second]) {
+      return Check::fail(type + ".joint_name \"" + names[i] + "\" appears twice");
+    }
+    seen[it->second] = true;
+    indices[i] = it->second;
+  }
+  out = std::move(indices);
+  return {};
+}
+
+Check joint_count(int32_t count, const dynamics::Model& model, const std::string& type) {
+  if (count == model.nq()) return {};
+  return Check::fail(type + ".num_joints is " + std::to_string(count) + ", robot " + model.name +
+                     " has " + std::to_string(model.nq()) + " joints");
+}
+
+}  // namespace
+
 Check state_from_message(const robot_state_t& msg, const dynamics::Model& model,
                          const RobotIdentity& identity, MeasuredState& out) {
   if (Check c = robot_field(msg.robot, identity, "robot_state_t"); !c.ok) return c;
-  const int n = model.nq();
-  if (msg.num_joints != n) {
-    return Check::fail("robot_state_t.num_joints is " + std::to_string(msg.num_joints) +
-                       ", robot " + model.name + " has " + std::to_string(n) + " joints");
-  }
+  if (Check c = joint_count(msg.num_joints, model, "robot_state_t"); !c.ok) return c;
   if (!all_finite(msg.position.begin(), msg.position.end()) ||
       !all_finite(msg.velocity.begin(), msg.velocity.end())) {
     return Check::fail("robot_state_t.position or velocity is not finite");
   }
-  std::unordered_map<std::string, int> index;
-  for (int j = 0; j < n; ++j) index[model.bodies[j].joint_name] = j;
+  std::vector<int> index;
+  if (Check c = joint_indices(msg.joint_name, model, "robot_state_t", index); !c.ok) return c;
   MeasuredState state;
   state.utime = msg.utime;
-  state.q.setZero(n);
-  state.qd.setZero(n);
-  std::vector<bool> seen(n, false);
-  for (int i = 0; i < n; ++i) {
-    auto it = index.find(msg.joint_name[i]);
-    if (it == index.end()) {
-      return Check::fail("robot_state_t.joint_name[" + std::to_string(i) + "] \"" +
-                         msg.joint_name[i] + "\" is not a joint of " + model.name);
-    }
-    if (seen[it->second]) {
-      return Check::fail("robot_state_t.joint_name \"" + msg.joint_name[i] + "\" appears twice");
-    }
-    seen[it->second] = true;
-    state.q[it->second] = msg.position[i];
-    state.qd[it->second] = msg.velocity[i];
+  state.q.setZero(model.nq());
+  state.qd.setZero(model.nq());
+  for (size_t i = 0; i < index.size(); ++i) {
+    state.q[index[i]] = msg.position[i];
+    state.qd[index[i]] = msg.velocity[i];
   }
   out = std::move(state);
   return {};
 }
 
+Check command_from_message(const joint_command_t& msg, const dynamics::Model& model,
+                           const RobotIdentity& identity, CommandSetpoint& out) {
+  if (Check c = robot_field(msg.robot, identity, "joint_command_t"); !c.ok) return c;
+  if (Check c = joint_count(msg.num_joints, model, "joint_command_t"); !c.ok) return c;
+  if (!all_finite(msg.position.begin(), msg.position.end()) ||
+      !all_finite(msg.velocity.begin(), msg.velocity.end()) ||
+      !all_finite(msg.torque.begin(), msg.torque.end())) {
+    return Check::fail("joint_command_t.position, velocity or torque is not finite");
+  }
+  std::vector<int> index;
+  if (Check c = joint_indices(msg.joint_name, model, "joint_command_t", index); !c.ok) return c;
+  CommandSetpoint setpoint;
+  setpoint.utime = msg.utime;
+  setpoint.plan_id = msg.plan_id;
+  setpoint.q.setZero(model.nq());
+  setpoint.qd.setZero(model.nq());
+  setpoint.tau.setZero(model.nq());
+  for (size_t i = 0; i < index.size(); ++i) {
+    setpoint.q[index[i]] = msg.position[i];
+    setpoint.qd[index[i]] = msg.velocity[i];
+    setpoint.tau[index[i]] = msg.torque[i];
+  }
+  out = std::move(setpoint);
+  return {};
+}
+
+joint_command_t command_to_message(const CommandSetpoint& setpoint, const dynamics::Model& model) {
+  joint_command_t msg;
+  msg.utime = setpoint.utime;
+  msg.robot = model.name;
+  msg.plan_id = setpoint.plan_id;
+  msg.num_joints = model.nq();
+  for (const auto& body : model.bodies) msg.joint_name.push_back(body.joint_name);
+  msg.position.assign(setpoint.q.data(), setpoint.q.data() + setpoint.q.size());
+  msg.velocity.assign(setpoint.qd.data(), setpoint.qd.data() + setpoint.qd.size());
+  msg.torque.assign(setpoint.tau.data(), setpoint.tau.data() + setpoint.tau.size());
+  return msg;
+}
+
+namespace {
+
+void set_time(plan_t& msg, const PlanTime& time, bool has_trajectory) {
+  msg.utime = time.utime;
+  msg.clock = time.clock;
+  msg.start_utime = has_trajectory ? time.start_utime : -1;
+  msg.state_utime = time.state_utime;
+  msg.takeover_utime = has_trajectory ? time.takeover_utime : -1;
+}
+
+}  // namespace
+
 plan_t plan_to_message(const planning::Plan& plan, const dynamics::Model& model,
-                       const std::string& robot, int64_t plan_id, int64_t goal_id, int64_t utime) {
+                       const std::string& robot, int64_t plan_id, int64_t goal_id,
+                       const PlanTime& time) {
   plan_t msg;
-  msg.utime = utime;
+  set_time(msg, time, plan.q.rows() > 0);
   msg.plan_id = plan_id;
   msg.goal_id = goal_id;
   msg.robot = robot;
@@ -241,9 +314,9 @@ plan_t plan_to_message(const planning::Plan& plan, const dynamics::Model& model,
 }
 
 plan_t failure_message(int8_t status, const std::string& reason, const std::string& robot,
-                       int64_t plan_id, int64_t goal_id, int64_t utime) {
+                       int64_t plan_id, int64_t goal_id, const PlanTime& time) {
   plan_t msg;
-  msg.utime = utime;
+  set_time(msg, time, /*has_trajectory=*/false);
   msg.plan_id = plan_id;
   msg.goal_id = goal_id;
   msg.robot = robot;
@@ -263,7 +336,11 @@ plan_t failure_message(int8_t status, const std::string& reason, const std::stri
   return msg;
 }
 
-planning::Plan plan_from_message(const plan_t& msg) {
+namespace {
+
+// Both versions of plan_t carry the trajectory and the figures in the same fields.
+template <typename PlanMessage>
+planning::Plan plan_from(const PlanMessage& msg) {
   planning::Plan plan;
   const int steps = msg.num_steps, n = msg.num_joints;
   plan.t.assign(msg.t.begin(), msg.t.end());
@@ -279,11 +356,12 @@ planning::Plan plan_from_message(const plan_t& msg) {
   plan.qdd = matrix(msg.qdd);
   plan.tau = matrix(msg.tau);
   plan.stats.method = msg.method;
-  plan.stats.status = msg.status == plan_t::SUCCESS         ? planning::PlanStatus::kConverged
-                      : msg.status == plan_t::INVALID_GOAL  ? planning::PlanStatus::kInvalidProblem
-                      : msg.status == plan_t::NOT_CONVERGED ? planning::PlanStatus::kInfeasible
-                                                            : planning::PlanStatus::kFailed;
-  if (msg.status != plan_t::SUCCESS) plan.stats.reason = msg.status_message;
+  plan.stats.status = msg.status == PlanMessage::SUCCESS ? planning::PlanStatus::kConverged
+                      : msg.status == PlanMessage::INVALID_GOAL
+                          ? planning::PlanStatus::kInvalidProblem
+                      : msg.status == PlanMessage::NOT_CONVERGED ? planning::PlanStatus::kInfeasible
+                                                                 : planning::PlanStatus::kFailed;
+  if (msg.status != PlanMessage::SUCCESS) plan.stats.reason = msg.status_message;
   plan.stats.solve_time_s = msg.solve_time_s;
   plan.stats.iterations = msg.iterations;
   plan.stats.cost = msg.cost;
@@ -293,5 +371,10 @@ planning::Plan plan_from_message(const plan_t& msg) {
   plan.validation.goal_error = msg.goal_error;
   return plan;
 }
+
+}  // namespace
+
+planning::Plan plan_from_message(const plan_t& msg) { return plan_from(msg); }
+planning::Plan plan_from_message(const plan_v1_t& msg) { return plan_from(msg); }
 
 }  // namespace kinograph::messages

@@ -11,8 +11,10 @@
 #include "kinograph/collision/shape.h"
 #include "kinograph/dynamics/model.h"
 #include "kinograph/goal_t.hpp"
+#include "kinograph/joint_command_t.hpp"
 #include "kinograph/obstacle_list_t.hpp"
 #include "kinograph/plan_t.hpp"
+#include "kinograph/plan_v1_t.hpp"
 #include "kinograph/planning/plan.h"
 #include "kinograph/planning/problem.h"
 #include "kinograph/robot_state_t.hpp"
@@ -56,6 +58,13 @@ struct MeasuredState {
   Eigen::VectorXd q, qd;
 };
 
+/// A joint setpoint from a joint_command_t, in the model's joint order.
+struct CommandSetpoint {
+  int64_t utime = 0;
+  int64_t plan_id = -1;
+  Eigen::VectorXd q, qd, tau;
+};
+
 /// Checks a goal_t against the model and converts it. Limits and reachability are left to the
 /// planner's own problem check, which answers with INVALID_GOAL.
 Check goal_from_message(const goal_t& msg, const dynamics::Model& model,
@@ -73,15 +82,36 @@ Check obstacles_from_message(const obstacle_list_t& msg, std::vector<ObstacleUpd
 Check state_from_message(const robot_state_t& msg, const dynamics::Model& model,
                          const RobotIdentity& identity, MeasuredState& out);
 
-/// The plan_t answering goal `goal_id`: status SUCCESS only for a plan that validated.
+/// Checks a joint_command_t (joint names may come in any order) and converts it to model order.
+Check command_from_message(const joint_command_t& msg, const dynamics::Model& model,
+                           const RobotIdentity& identity, CommandSetpoint& out);
+
+/// The joint_command_t of a setpoint in the model's joint order.
+joint_command_t command_to_message(const CommandSetpoint& setpoint, const dynamics::Model& model);
+
+/// Where a plan sits in time (plan_t's clock fields, lcmtypes/README.md "Time"): the clock and,
+/// on it, the publication time, knot 0's time, the measured state knot 0 is and the take-over.
+struct PlanTime {
+  int8_t clock = plan_t::CLOCK_WALL;
+  int64_t utime = 0;            ///< publication (µs)
+  int64_t start_utime = -1;     ///< knot 0 (µs); -1 without a trajectory
+  int64_t state_utime = -1;     ///< the robot_state_t knot 0 starts from; -1 = the scene's start
+  int64_t takeover_utime = -1;  ///< when the plan replaces the one before it (µs)
+};
+
+/// The plan_t answering goal `goal_id`: status SUCCESS only for a plan that validated. A plan
+/// without trajectory gets start_utime = takeover_utime = -1 whatever `time` says.
 plan_t plan_to_message(const planning::Plan& plan, const dynamics::Model& model,
-                       const std::string& robot, int64_t plan_id, int64_t goal_id, int64_t utime);
+                       const std::string& robot, int64_t plan_id, int64_t goal_id,
+                       const PlanTime& time);
 
 /// A plan_t with no trajectory that answers a goal with a failure status and reason.
 plan_t failure_message(int8_t status, const std::string& reason, const std::string& robot,
-                       int64_t plan_id, int64_t goal_id, int64_t utime);
+                       int64_t plan_id, int64_t goal_id, const PlanTime& time);
 
 /// The planner's view of a plan_t (trajectory only; validation figures as sent).
 planning::Plan plan_from_message(const plan_t& msg);
+/// The same for a plan of version 1 (old logs), which has no clock fields.
+planning::Plan plan_from_message(const plan_v1_t& msg);
 
 }  // namespace kinograph::messages

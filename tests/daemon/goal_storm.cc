@@ -101,6 +101,14 @@ class Answers {
     });
   }
 
+  // Waits until a heartbeat's message contains `text`, or until the timeout.
+  bool wait_status_text(const std::string& text, double timeout_s) {
+    std::unique_lock lock(mutex_);
+    return cv_.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] {
+      return status_ && status_->message.find(text) != std::string::npos;
+    });
+  }
+
   std::mutex mutex_;
   std::condition_variable cv_;
   std::map<int64_t, kinograph::plan_t> first_answer_, last_answer_;
@@ -131,7 +139,7 @@ double percentile(std::vector<double> v, double p) {
 
 int main(int argc, char** argv) {
   CLI::App app{"goal_storm: floods a kinographd with goals and checks every one is answered"};
-  std::string url, prefix = "RR", q_text = "0.8,-0.4", json_path;
+  std::string url, prefix = "RR", q_text = "0.8,-0.4", json_path, heartbeat_text;
   int64_t goals = 40, first_id = 1;
   double rate = 0, obstacle_rate = 0, answer_timeout = 60;
   app.add_option("--url", url, "LCM URL")->required();
@@ -143,6 +151,8 @@ int main(int argc, char** argv) {
   app.add_option("--first-id", first_id, "id of the first goal (then consecutive)");
   app.add_option("--answer-timeout", answer_timeout, "s to wait for answers after the last goal");
   app.add_option("--json", json_path, "write the figures as JSON here");
+  app.add_option("--heartbeat-text", heartbeat_text,
+                 "also wait (30 s at most) for a heartbeat whose message contains this");
   CLI11_PARSE(app, argc, argv);
   const std::vector<double> q0 = parse_list(q_text);
 
@@ -209,6 +219,7 @@ int main(int argc, char** argv) {
 
   const int64_t last_id = first_id + goals - 1;
   const bool complete = answers.wait_all(first_id, last_id, answer_timeout);
+  const bool text_seen = heartbeat_text.empty() || answers.wait_status_text(heartbeat_text, 30);
   stop = true;
   receiver.join();
 
@@ -236,6 +247,7 @@ int main(int argc, char** argv) {
                        " goals planned after they were answered superseded or refused");
   }
   const auto& st = answers.status_;
+  if (!text_seen) problems.push_back("no heartbeat said \"" + heartbeat_text + "\"");
   if (!st) {
     problems.push_back("no heartbeat received");
   } else if (st->num_goals_received + st->num_goals_dropped != st->num_goals_answered) {
@@ -262,6 +274,7 @@ int main(int argc, char** argv) {
   }
   json << "}";
   std::cout << json.str() << std::endl;
+  if (st) std::cout << "last heartbeat message: " << st->message << std::endl;
   if (!json_path.empty()) std::ofstream(json_path) << json.str() << "\n";
   for (const auto& p : problems) std::cerr << "goal_storm: " << p << "\n";
   return problems.empty() ? 0 : 1;

@@ -81,6 +81,12 @@ class Listener {
     });
     return found;
   }
+  // Waits until `count` heartbeats have arrived.
+  bool wait_statuses(size_t count, double timeout_s = 30) {
+    std::unique_lock lock(mutex_);
+    return cv_.wait_for(lock, std::chrono::duration<double>(timeout_s),
+                        [&] { return statuses_.size() >= count; });
+  }
   // Waits until some status message mentions `text`.
   bool wait_status_containing(const std::string& text, double timeout_s = 10) {
     std::unique_lock lock(mutex_);
@@ -128,8 +134,9 @@ class NodeFixture : public ::testing::Test {
     stop_ = true;
     if (thread_.joinable()) thread_.join();
   }
-  void send_goal(int64_t id, std::vector<double> q) {
+  void send_goal(int64_t id, std::vector<double> q, int64_t utime = 0) {
     goal_t g{};
+    g.utime = utime;
     g.goal_id = id;
     g.kind = goal_t::KIND_JOINT_CONFIGURATION;
     g.num_joints = static_cast<int32_t>(q.size());
@@ -154,6 +161,18 @@ class NodeFixture : public ::testing::Test {
     lcm_.publish("RR_OBSTACLES", &list);
   }
 
+  // A measured state of the RR arm at `utime` on the robot's clock.
+  void send_state(int64_t utime, std::vector<double> q, std::vector<double> qd = {0, 0}) {
+    robot_state_t state{};
+    state.utime = utime;
+    state.robot = "rr";
+    state.num_joints = 2;
+    state.joint_name = {"joint1", "joint2"};
+    state.position = std::move(q);
+    state.velocity = std::move(qd);
+    lcm_.publish("RR_STATE", &state);
+  }
+
   lcm::LCM lcm_{"memq://"};
   bool defer_start_ = false;  // set by fixtures that create and run the node themselves
   std::atomic<bool> stop_{false};
@@ -174,6 +193,167 @@ TEST_F(NodeFixture, AnswersAGoalWithAValidPlanThatEndsThere) {
   EXPECT_NEAR(p.q.back()[1], -0.5, 1e-3);
   EXPECT_NEAR(p.q.front()[0], -0.8, 1e-6);
   EXPECT_TRUE(p.valid);
+}
+
+// Before any state the plan is on the daemon's wall clock and starts when it is published.
+TEST_F(NodeFixture, WithoutStatesAPlanIsOnTheWallClock) {
+  send_goal(15, {0.9, -0.5});
+  const auto plans = listener_->wait_plans(1);
+  ASSERT_EQ(plans.size(), 1u);
+  const plan_t& p = plans[0];
+  ASSERT_EQ(p.status, plan_t::SUCCESS) << p.status_message;
+  EXPECT_EQ(p.clock, plan_t::CLOCK_WALL);
+  EXPECT_EQ(p.state_utime, -1);
+  EXPECT_EQ(p.start_utime, p.utime);
+  EXPECT_EQ(p.takeover_utime, p.start_utime);
+  EXPECT_GT(p.utime, 1'600'000'000'000'000);  // an epoch time, not a sim time
+}
+
+// Sim time: a state at 5 s and a goal at 5.1 s on the robot's clock give a plan stamped on
+// that clock, knot 0 at the state's time, whatever the wall clock says.
+TEST_F(NodeFixture, WithStatesAPlanIsOnTheRobotClock) {
+  send_state(5'000'000, {-0.8, 0.4});
+  send_goal(16, {0.9, -0.5}, 5'100'000);
+  const auto plans = listener_->wait_plans(1);
+  ASSERT_EQ(plans.size(), 1u);
+  const plan_t& p = plans[0];
+  ASSERT_EQ(p.status, plan_t::SUCCESS) << p.status_message;
+  EXPECT_EQ(p.clock, plan_t::CLOCK_ROBOT);
+  EXPECT_EQ(p.state_utime, 5'000'000);
+  EXPECT_EQ(p.start_utime, 5'000'000);
+  EXPECT_EQ(p.takeover_utime, 5'000'000);
+  EXPECT_EQ(p.utime, 5'000'000);  // the robot's clock as the daemon last saw it
+  EXPECT_EQ(p.t[0], 0.0);
+}
+
+// A goal issued longer after the latest state than the bound (0.5 s by default) is refused,
+// with a reason that says how old the state was; the next fresh state lets it plan again.
+TEST_F(NodeFixture, AStaleStateRefusesTheGoalWithItsAge) {
+  send_state(5'000'000, {-0.8, 0.4});
+  send_goal(17, {0.9, -0.5}, 5'600'000);
+  auto plans = listener_->wait_plans(1);
+  ASSERT_EQ(plans.size(), 1u);
+  EXPECT_EQ(plans[0].goal_id, 17);
+  EXPECT_EQ(plans[0].status, plan_t::INVALID_STATE);
+  EXPECT_EQ(plans[0].state_utime, 5'000'000);
+  EXPECT_EQ(plans[0].clock, plan_t::CLOCK_ROBOT);
+  EXPECT_NE(plans[0].status_message.find("0.600000 s older than goal 17"), std::string::npos)
+      << plans[0].status_message;
+  send_state(5'500'000, {-0.8, 0.4});
+  send_goal(18, {0.9, -0.5}, 5'600'000);
+  plans = listener_->wait_plans(2);
+  ASSERT_EQ(plans.size(), 2u);
+  EXPECT_EQ(plans[1].status, plan_t::SUCCESS) << plans[1].status_message;
+  EXPECT_EQ(plans[1].start_utime, 5'500'000);
+  EXPECT_EQ(node_->counters().goals_answered, 2);
+}
+
+// A state beyond the robot's limits is never a start: the goal after it is answered
+// INVALID_STATE naming the joint and the amount, and the next usable state plans again.
+TEST_F(NodeFixture, AStateBeyondTheLimitsIsNeverAStart) {
+  send_state(5'000'000, {-0.8, 0.4});
+  // (q, q̇) of the state sent before each goal, and what the goal's answer must say.
+  struct Case {
+    std::vector<double> q, qd;
+    int8_t status;
+    std::string says;
+  };
+  const std::vector<Case> cases = {
+      {{-0.8, 3.5},
+       {0, 0},
+       plan_t::INVALID_STATE,  // joint2 is limited to [-pi, pi]
+       "joint joint2: measured position 3.5 is 0.358407 beyond"},
+      {{-0.8, 0.4},
+       {4.0, 0},
+       plan_t::INVALID_STATE,  // joint1's velocity limit is 3 rad/s
+       "joint joint1: measured velocity 4 is 1 above"},
+      {{-0.7, 0.4}, {0, 0}, plan_t::SUCCESS, ""},
+  };
+  for (size_t i = 0; i < cases.size(); ++i) {
+    const int64_t utime = 5'050'000 + 100'000 * static_cast<int64_t>(i);
+    send_state(utime, cases[i].q, cases[i].qd);
+    send_goal(21 + static_cast<int64_t>(i), {0.9, -0.5}, utime + 50'000);
+    const auto plans = listener_->wait_plans(i + 1);
+    ASSERT_EQ(plans.size(), i + 1);
+    EXPECT_EQ(plans[i].status, cases[i].status) << plans[i].status_message;
+    EXPECT_NE(plans[i].status_message.find(cases[i].says), std::string::npos)
+        << plans[i].status_message;
+    if (cases[i].status == plan_t::SUCCESS) {
+      EXPECT_EQ(plans[i].start_utime, utime);
+    }
+  }
+  EXPECT_EQ(node_->counters().states_refused, 2);
+}
+
+// NaN in a measured state (a sensor fault) is answered INVALID_STATE too, with the joint, and
+// the older usable state is not planned from in its place.
+TEST_F(NodeFixture, ANonFiniteStateIsNeverAStart) {
+  send_state(5'000'000, {-0.8, 0.4});
+  send_state(5'050'000, {std::nan(""), 0.4});
+  send_goal(24, {0.9, -0.5}, 5'100'000);
+  const auto plans = listener_->wait_plans(1);
+  ASSERT_EQ(plans.size(), 1u);
+  EXPECT_EQ(plans[0].status, plan_t::INVALID_STATE);
+  EXPECT_NE(plans[0].status_message.find("joint joint1: position nan"), std::string::npos)
+      << plans[0].status_message;
+}
+
+// A 60 kB robot name is refused, and neither the answer nor the status echoes it in full.
+TEST_F(NodeFixture, AnOverlongNameIsRefusedAndNotEchoed) {
+  goal_t g{};
+  g.goal_id = 25;
+  g.robot = std::string(60000, 'x');
+  g.kind = goal_t::KIND_JOINT_CONFIGURATION;
+  g.num_joints = 2;
+  g.joint_position = {0.9, -0.5};
+  g.ee_quaternion[0] = 1;
+  lcm_.publish("RR_GOAL", &g);
+  const auto plans = listener_->wait_plans(1);
+  ASSERT_EQ(plans.size(), 1u);
+  EXPECT_EQ(plans[0].status, plan_t::INVALID_GOAL);
+  EXPECT_NE(plans[0].status_message.find("goal_t.robot is 60000 bytes long"), std::string::npos)
+      << plans[0].status_message;
+  EXPECT_LT(plans[0].status_message.size(), 300u);
+  ASSERT_TRUE(listener_->wait_status_containing("goal_t.robot is 60000 bytes long"));
+  const auto status = listener_->wait_status_answered(1);
+  ASSERT_TRUE(status);
+  EXPECT_LT(status->message.size(), 300u);
+}
+
+// A node hears its own heartbeats and takes them as its own; a heartbeat on its status channel
+// that it did not publish (here the test's, standing in for a second daemon on prefix RR; two
+// real daemons: tests/daemon/second_daemon_test.sh) is reported in its heartbeat.
+TEST_F(NodeFixture, AHeartbeatOfASecondDaemonIsReported) {
+  ASSERT_TRUE(listener_->wait_statuses(5));  // the node's own heartbeats, read back by it too
+  EXPECT_EQ(node_->counters().foreign_heartbeats, 0);
+  planner_status_t other{};
+  other.utime = std::chrono::duration_cast<std::chrono::microseconds>(
+                    std::chrono::system_clock::now().time_since_epoch())
+                    .count();
+  other.robot = "rr";
+  other.last_plan_id = 7;
+  lcm_.publish("RR_PLANNER_STATUS", &other);
+  EXPECT_TRUE(listener_->wait_status_containing(
+      "another planner daemon publishes on RR_PLANNER_STATUS (robot \"rr\", its last plan id 7)"));
+  EXPECT_EQ(node_->counters().foreign_heartbeats, 1);
+}
+
+class StateAgeFixture : public NodeFixture {
+ protected:
+  StateAgeFixture() { defer_start_ = true; }
+};
+
+// --max-state-age: the same 0.6 s old state is accepted under a 1 s bound.
+TEST_F(StateAgeFixture, TheStateAgeBoundIsTheOptionsOne) {
+  PlannerNodeOptions options;
+  options.max_state_age_s = 1.0;
+  start(default_scene(), options);
+  send_state(5'000'000, {-0.8, 0.4});
+  send_goal(19, {0.9, -0.5}, 5'600'000);
+  const auto plans = listener_->wait_plans(1);
+  ASSERT_EQ(plans.size(), 1u);
+  EXPECT_EQ(plans[0].status, plan_t::SUCCESS) << plans[0].status_message;
+  EXPECT_EQ(plans[0].start_utime, 5'000'000);
 }
 
 TEST_F(NodeFixture, MalformedBytesGetAStatusAndTheNodeKeepsServing) {

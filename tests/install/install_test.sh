@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The installed package as a user gets it. Installs the build into a temporary prefix, builds
 # examples/ against it with find_package(kinograph 0.1) and runs it; then, with the prefix
-# moved, the installed CLI plans, validates and renders a shipped scene from another working
-# directory with the build and source trees gone: empty directories are mounted over them in a
+# moved, the installed CLI plans, validates and renders a shipped scene (and the installed
+# Python client publishes a goal) from another working directory with the build and source trees gone: empty directories are mounted over them in a
 # private mount namespace.
 # That needs root; without it the last step is skipped (exit 77) and says so.
 # Usage: install_test.sh BUILD_DIR SOURCE_DIR
@@ -19,6 +19,7 @@ for f in bin/kinograph bin/kinographd bin/kinograph-spy include/kinograph/kinogr
          include/kinograph/kinograph/planning/io/scene.h include/kinograph/render/image.h \
          lib/cmake/kinograph/kinographConfig.cmake lib/cmake/kinograph/kinographConfigVersion.cmake \
          share/kinograph/robots/scenes/rr_reach.yaml share/kinograph/lcmtypes/goal_t.lcm \
+         share/kinograph/python/kinograph/plan_t.py share/kinograph/python/kinograph_client/client.py \
          share/doc/kinograph/LICENSE; do
   [ -e "$PREFIX/$f" ] || { echo "FAIL: $f was not installed"; exit 1; }
 done
@@ -79,6 +80,9 @@ env -u KINOGRAPH_DATA_DIR "$PREFIX/bin/kinograph" render plan.json --frames 3 --
 [ -s strip.png ]
 grep -q '"urdf": "robots/rr/rr.urdf"' plan.json
 grep -q '"scene": "robots/scenes/rr_reach.yaml"' plan.json
+# The installed Python types and client: a goal encoded and published (in-process memq).
+PYTHONDONTWRITEBYTECODE=1 PYTHONPATH="$PREFIX/share/kinograph/python" python3 -c \
+  "from kinograph_client import PlannerClient, joint_goal; PlannerClient('RR', 'memq://').send(joint_goal([0.1, 0.2]))"
 CLI
 if [ "$(id -u)" -ne 0 ] || ! unshare -m true 2>/dev/null; then
   echo "SKIP: hiding the source and build trees needs root (a private mount namespace)"

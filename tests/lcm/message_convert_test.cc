@@ -227,7 +227,7 @@ TEST(PlanMessage, RoundTripsTrajectoryAndMapsStatus) {
   plan.tau = Eigen::MatrixXd::Random(3, 2);
   plan.validation.valid = true;
   plan.stats.method = "batch-L";
-  plan_t msg = plan_to_message(plan, rr(), "rr", 3, 7, 0);
+  plan_t msg = plan_to_message(plan, rr(), "rr", 3, 7, {});
   EXPECT_EQ(msg.status, plan_t::SUCCESS);
   EXPECT_EQ(msg.num_steps, 3);
   EXPECT_EQ(msg.joint_name.size(), 2u);
@@ -238,12 +238,12 @@ TEST(PlanMessage, RoundTripsTrajectoryAndMapsStatus) {
 
   plan.validation.valid = false;
   plan.validation.failures = {"collision at step 4"};
-  msg = plan_to_message(plan, rr(), "rr", 4, 7, 0);
+  msg = plan_to_message(plan, rr(), "rr", 4, 7, {});
   EXPECT_EQ(msg.status, plan_t::NOT_CONVERGED);
   EXPECT_NE(msg.status_message.find("collision at step 4"), std::string::npos);
 
   plan.stats.status = planning::PlanStatus::kInvalidProblem;
-  EXPECT_EQ(plan_to_message(plan, rr(), "rr", 5, 7, 0).status, plan_t::INVALID_GOAL);
+  EXPECT_EQ(plan_to_message(plan, rr(), "rr", 5, 7, {}).status, plan_t::INVALID_GOAL);
 }
 
 }  // namespace

@@ -106,6 +106,10 @@ TEST(LcmTypes, PlanRoundTrip) {
   EXPECT_EQ(out.tau, m.tau);
   EXPECT_EQ(out.min_clearance, m.min_clearance);
   EXPECT_TRUE(out.valid);
+  EXPECT_EQ(out.clock, plan_t::CLOCK_ROBOT);
+  EXPECT_EQ(out.start_utime, 5'000'000);
+  EXPECT_EQ(out.state_utime, 5'000'000);
+  EXPECT_EQ(out.takeover_utime, 5'000'000);
 }
 
 // A failed plan carries no trajectory; the counts make that explicit and decode agrees.
@@ -145,9 +149,11 @@ TEST(LcmTypes, TruncatedBuffersAreRejected) {
 
 // The fingerprint at the head of each message keeps one type from being read as another.
 TEST(LcmTypes, FingerprintsDifferAndMismatchIsRejected) {
-  const std::vector<int64_t> hashes = {robot_state_t::getHash(), goal_t::getHash(),
-                                       obstacle_t::getHash(),    obstacle_list_t::getHash(),
-                                       plan_t::getHash(),        planner_status_t::getHash()};
+  const std::vector<int64_t> hashes = {
+      robot_state_t::getHash(),    goal_t::getHash(),
+      obstacle_t::getHash(),       obstacle_list_t::getHash(),
+      plan_t::getHash(),           kinograph::plan_v1_t::getHash(),
+      planner_status_t::getHash(), kinograph::joint_command_t::getHash()};
   for (size_t i = 0; i < hashes.size(); ++i)
     for (size_t j = i + 1; j < hashes.size(); ++j) EXPECT_NE(hashes[i], hashes[j]);
 

@@ -58,7 +58,12 @@ TEST(SafeDecode, AcceptsWellFormedMessagesOfEveryType) {
   expect_accepts(make_obstacle_list());
   expect_accepts(make_plan(6));
   expect_accepts(make_plan(0));
+  expect_accepts(make_plan_v1(6));
   expect_accepts(make_planner_status());
+  expect_accepts(make_joint_command());
+  expect_accepts(make_iiwa_status());
+  expect_accepts(make_robot_plan(5));
+  expect_accepts(make_robot_plan(0));
 }
 
 template <typename Msg>
@@ -78,7 +83,36 @@ TEST(SafeDecode, RejectsEveryTruncation) {
   expect_prefixes_rejected(make_goal());
   expect_prefixes_rejected(make_obstacle_list());
   expect_prefixes_rejected(make_plan(3));
+  expect_prefixes_rejected(make_plan_v1(3));
   expect_prefixes_rejected(make_planner_status());
+  expect_prefixes_rejected(make_joint_command());
+  expect_prefixes_rejected(make_iiwa_status());
+  expect_prefixes_rejected(make_robot_plan(3));
+}
+
+// The two versions of plan_t have their own fingerprints: neither decodes as the other.
+TEST(SafeDecode, TellsThePlanVersionsApart) {
+  plan_t v2;
+  kinograph::plan_v1_t v1;
+  const DecodeStatus as_v2 = decode_bytes(encode(make_plan_v1(2)), v2);
+  EXPECT_FALSE(as_v2.ok);
+  EXPECT_NE(as_v2.reason.find("fingerprint"), std::string::npos) << as_v2.reason;
+  EXPECT_FALSE(decode_bytes(encode(make_plan(2)), v1).ok);
+  EXPECT_TRUE(decode_bytes(encode(make_plan_v1(2)), v1).ok);
+}
+
+// Drake's lcmt_robot_state counts joints in an int16: a negative count is refused by name.
+TEST(SafeDecode, RejectsANegativeDrakeJointCount) {
+  std::vector<uint8_t> bytes = encode(make_robot_plan(1));
+  // fingerprint, plan utime, num_states, then the first knot's utime and its int16 count.
+  const size_t offset = 8 + 8 + 4 + 8;
+  bytes[offset] = 0xff;
+  bytes[offset + 1] = 0xfe;
+  drake::lcmt_robot_plan out;
+  const DecodeStatus status = decode_bytes(bytes, out);
+  EXPECT_FALSE(status.ok);
+  EXPECT_NE(status.reason.find("lcmt_robot_state.num_joints = -2"), std::string::npos)
+      << status.reason;
 }
 
 // lcm-gen's decode would resize to these counts before looking at the bytes (or throw).

@@ -5,19 +5,25 @@
 #include <string>
 #include <vector>
 
+#include "drake/lcmt_iiwa_status.hpp"
+#include "drake/lcmt_robot_plan.hpp"
 #include "kinograph/goal_t.hpp"
+#include "kinograph/joint_command_t.hpp"
 #include "kinograph/obstacle_list_t.hpp"
 #include "kinograph/obstacle_t.hpp"
 #include "kinograph/plan_t.hpp"
+#include "kinograph/plan_v1_t.hpp"
 #include "kinograph/planner_status_t.hpp"
 #include "kinograph/robot_state_t.hpp"
 
 namespace kinograph::lcmtypes::testing {
 
 using kinograph::goal_t;
+using kinograph::joint_command_t;
 using kinograph::obstacle_list_t;
 using kinograph::obstacle_t;
 using kinograph::plan_t;
+using kinograph::plan_v1_t;
 using kinograph::planner_status_t;
 using kinograph::robot_state_t;
 
@@ -90,14 +96,16 @@ inline obstacle_list_t make_obstacle_list() {
   return m;
 }
 
-inline plan_t make_plan(int num_steps) {
+// Either version of plan_t (version 2 adds the clock fields, filled by make_plan).
+template <typename PlanMessage>
+inline PlanMessage make_plan_of_version(int num_steps) {
   const int n = 7;
-  plan_t m;
+  PlanMessage m;
   m.utime = 123;
   m.plan_id = 5;
   m.goal_id = 9'000'000'001;
   m.robot = "iiwa14";
-  m.status = plan_t::SUCCESS;
+  m.status = PlanMessage::SUCCESS;
   m.status_message = "";
   m.method = "incremental";
   m.num_joints = n;
@@ -118,6 +126,57 @@ inline plan_t make_plan(int num_steps) {
   m.min_clearance = 0.031;
   m.goal_error = 1e-4;
   m.valid = true;
+  return m;
+}
+
+inline plan_t make_plan(int num_steps) {
+  plan_t m = make_plan_of_version<plan_t>(num_steps);
+  m.clock = plan_t::CLOCK_ROBOT;
+  m.start_utime = 5'000'000;
+  m.state_utime = 5'000'000;
+  m.takeover_utime = 5'000'000;
+  return m;
+}
+
+inline plan_v1_t make_plan_v1(int num_steps) { return make_plan_of_version<plan_v1_t>(num_steps); }
+
+inline joint_command_t make_joint_command() {
+  joint_command_t m;
+  m.utime = 5'005'000;
+  m.robot = "iiwa14";
+  m.plan_id = 12;
+  m.num_joints = 7;
+  m.joint_name = joint_names(7);
+  m.position = random_vector(7);
+  m.velocity = random_vector(7);
+  m.torque = random_vector(7);
+  return m;
+}
+
+inline drake::lcmt_iiwa_status make_iiwa_status() {
+  drake::lcmt_iiwa_status m;
+  m.utime = 5'000'000;
+  m.num_joints = 7;
+  for (auto* v : {&m.joint_position_measured, &m.joint_velocity_estimated,
+                  &m.joint_position_commanded, &m.joint_position_ipo, &m.joint_torque_measured,
+                  &m.joint_torque_commanded, &m.joint_torque_external}) {
+    *v = random_vector(7);
+  }
+  return m;
+}
+
+inline drake::lcmt_robot_plan make_robot_plan(int num_states) {
+  drake::lcmt_robot_plan m;
+  m.utime = 5'000'000;
+  m.num_states = num_states;
+  for (int k = 0; k < num_states; ++k) {
+    drake::lcmt_robot_state s;
+    s.utime = 100'000 * k;
+    s.num_joints = 7;
+    s.joint_name = joint_names(7);
+    for (double x : random_vector(7)) s.joint_position.push_back(static_cast<float>(x));
+    m.plan.push_back(std::move(s));
+  }
   return m;
 }
 

@@ -824,6 +824,7 @@ TEST(BatchPlannerOptions, MaxRestarts) {
 TEST(BatchPlannerOptions, DetourCandidatesBoundTheRestarts) {
   BatchPlannerOptions o;
   o.validation.final_velocity = -1;
+  o.path_search.max_samples = 0;  // the detours only
   o.detour.candidates = 1;
   EXPECT_EQ(BatchPlanner(o).plan(testing::rr_reach()).stats.attempts, 2);
 }

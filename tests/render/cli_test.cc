@@ -95,6 +95,41 @@ TEST_F(Cli, PlotOverlaysTwoPlans) {
   EXPECT_EQ(read_png(out).width, 800);
 }
 
+TEST_F(Cli, FailedPlanIsDrawnMarkedFailed) {
+  // Red edge pixels along the picture's left and bottom edges.
+  const auto red_edge = [](const Image& image) {
+    int red = 0;
+    for (int y = 0; y < image.height; ++y) {
+      const std::uint8_t* p = image.at(0, y);
+      red += p[0] > 180 && p[1] < 60 && p[2] < 60;
+    }
+    for (int x = 0; x < image.width; ++x) {
+      const std::uint8_t* p = image.at(x, image.height - 1);
+      red += p[0] > 180 && p[1] < 60 && p[2] < 60;
+    }
+    return red;
+  };
+  const std::string valid_out = (dir_ / "valid.png").string();
+  CliRun r = run("render " + plan_ + " --frames 3 --width 600 --height 200 --out " + valid_out);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(red_edge(read_png(valid_out)), 0);
+
+  nlohmann::json failed = test::iiwa_test_plan(10);
+  failed["validation"] = {{"valid", false}, {"failures", {"goal error 0.2 exceeds 0.01"}}};
+  const std::string failed_plan = (dir_ / "failed.json").string();
+  test::write_json(failed, failed_plan);
+  const std::string failed_out = (dir_ / "failed.png").string();
+  r = run("render " + failed_plan + " --frames 3 --width 600 --height 200 --out " + failed_out);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(red_edge(read_png(failed_out)), 600 + 200);
+  // Compared with a valid plan, a failed one marks the picture too.
+  const std::string compare_out = (dir_ / "compare_failed.png").string();
+  r = run("render " + plan_ + " --compare " + failed_plan +
+          " --frames 3 --width 400 --height 300 --out " + compare_out);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(red_edge(read_png(compare_out)), 400 + 300);
+}
+
 TEST_F(Cli, BadInputFailsWithAMessage) {
   CliRun r = run("render " + (dir_ / "nope.json").string() + " --out " + (dir_ / "x.png").string());
   EXPECT_NE(r.status, 0);

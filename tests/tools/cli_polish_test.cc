@@ -130,7 +130,8 @@ TEST_F(CliContract, LogPlansRefusesAnotherRobotsSceneAndWritesNothing) {
   // A log with one rr plan on RR_PLAN, written with LCM's own log writer.
   const planning::Scene rr = planning::load_scene(repo("robots/scenes/rr_reach.yaml"));
   const planning::Plan plan = planning::read_plan(plan_, *rr.problem.model);
-  const plan_t msg = messages::plan_to_message(plan, *rr.problem.model, "rr", 7, 3, 1000);
+  const plan_t msg = messages::plan_to_message(plan, *rr.problem.model, "rr", 7, 3,
+                                               {plan_t::CLOCK_WALL, 1000, 1000, -1, 1000});
   const std::string log = (dir_ / "rr.lcmlog").string();
   {
     lcm::LogFile file(log, "w");

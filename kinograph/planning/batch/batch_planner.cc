@@ -2,8 +2,10 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 #include "kinograph/planning/formulation/initialization.h"
@@ -31,12 +33,29 @@ Plan solved_plan(const Problem& problem, const PlanningGraph& pg, const OuterLoo
 OuterLoopOptions outer_loop_options(const BatchPlannerOptions& options) {
   OuterLoopOptions loop = options.outer_loop;
   if (options.formulation == Formulation::kDynamicFactorGraph) {
-    loop.constraint_tolerance = std::min(loop.constraint_tolerance, options.dfg_constraint_tolerance);
+    loop.constraint_tolerance =
+        std::min(loop.constraint_tolerance, options.dfg_constraint_tolerance);
     loop.inner_tolerance_final =
         std::min(loop.inner_tolerance_final, options.dfg_inner_tolerance_final);
   }
   return loop;
 }
+
+namespace {
+
+// The initial trajectory along a collision-free path, when one is found that fits the steps.
+std::optional<Trajectory> searched_path(const Problem& problem, const Eigen::VectorXd& q_goal,
+                                        const PathSearchOptions& options) {
+  if (std::any_of(problem.obstacles.begin(), problem.obstacles.end(),
+                  [](const collision::Obstacle& o) { return o.is_moving(); })) {
+    return std::nullopt;  // the search sees obstacles at rest only
+  }
+  const std::optional<std::vector<Eigen::VectorXd>> path = search_path(problem, q_goal, options);
+  if (!path || 2 * (path->size() - 1) > static_cast<size_t>(problem.steps)) return std::nullopt;
+  return path_trajectory(problem, *path);
+}
+
+}  // namespace
 
 BatchPlanner::BatchPlanner(BatchPlannerOptions options) : options_(std::move(options)) {}
 
@@ -71,35 +90,45 @@ Plan BatchPlanner::plan(const Problem& problem, const Plan* warm, BatchSolution*
     return p;
   }
   // Initializations in the order tried: the straight line (or the warm start), then detours
-  // around the obstacles (best clearance first). A straight line that runs through an obstacle
-  // usually leads into a poor local minimum (e.g. straddling a thin tabletop), so when it collides
-  // and the best detour does not, the detour goes first.
-  std::vector<Trajectory> inits{init};
+  // around the obstacles (best clearance first) and a searched collision-free path. A straight
+  // line that runs through an obstacle usually leads into a poor local minimum (e.g. straddling a
+  // thin tabletop), so when it collides the best detour goes first if its path is clear, then the
+  // searched path (made only when its turn comes: the search costs more than ranking detours).
+  std::vector<std::optional<Trajectory>> inits{init};
   const bool may_detour =
       warm == nullptr && options_.max_restarts > 0 && !problem.obstacles.empty();
+  const bool may_search = may_detour && options_.path_search.max_samples > 0;
   bool detours_added = false;
-  auto add_detours = [&](bool detour_goes_first) {  // ranking costs queries: only when needed
-    if (detours_added || !may_detour) return;
+  // Adds the restarts; `tried` initializations are done. Returns whether the best detour went
+  // first.
+  auto add_restarts = [&](bool detour_goes_first, size_t tried) {
+    if (detours_added || !may_detour) return false;
     detours_added = true;
     const std::vector<Detour> vias = detour_candidates(problem, q_goal, options_.detour);
     const size_t first = inits.size();
-    for (int r = 0; r < options_.max_restarts && r < static_cast<int>(vias.size()); ++r) {
+    const int detours = options_.max_restarts - (may_search ? 1 : 0);
+    for (int r = 0; r < detours && r < static_cast<int>(vias.size()); ++r) {
       inits.push_back(via_point(problem, vias[r].via, q_goal));
     }
-    if (detour_goes_first && inits.size() > first && vias[0].clearance >= 0) {
-      std::swap(inits[0], inits[first]);
-    }
+    const bool swapped = detour_goes_first && inits.size() > first && vias[0].clearance >= 0;
+    if (swapped) std::swap(inits[0], inits[first]);
+    if (may_search) inits.insert(inits.begin() + tried + (swapped ? 1 : 0), std::nullopt);
+    return swapped;
   };
   if (may_detour && options_.detour_first &&
       segment_clearance(problem, problem.start_q, q_goal, 2 * options_.detour.samples) < 0) {
-    add_detours(true);
+    add_restarts(true, 0);
   }
   Plan best;
   SolveStats total;
   BatchSolution attempt;
+  int made = 0;
   for (size_t a = 0; a < inits.size(); ++a) {
-    Plan p = solve(problem, inits[a], method, solution != nullptr ? &attempt : nullptr);
-    if (a == 0) {
+    if (!inits[a]) inits[a] = searched_path(problem, q_goal, options_.path_search);
+    if (!inits[a]) continue;  // no path found: on to the next initialization
+    Plan p = solve(problem, *inits[a], method, solution != nullptr ? &attempt : nullptr);
+    const bool first = made++ == 0;
+    if (first) {
       total = p.stats;
     } else {
       total.iterations += p.stats.iterations;
@@ -107,16 +136,15 @@ Plan BatchPlanner::plan(const Problem& problem, const Plan* warm, BatchSolution*
       total.linear_solves += p.stats.linear_solves;
       ++total.attempts;
     }
-    spdlog::debug("plan {}: attempt {}: {}", problem.name, a + 1,
+    spdlog::debug("plan {}: attempt {}: {}", problem.name, made,
                   p.success() ? std::string("valid") : to_string(p.stats.status));
-    const bool first = a == 0;
     if (first || p.success() ||
         p.stats.max_constraint_violation < best.stats.max_constraint_violation) {
       best = std::move(p);
       if (solution != nullptr) *solution = std::move(attempt);
     }
     if (best.success() || best.stats.status == PlanStatus::kInvalidProblem) break;
-    add_detours(false);
+    add_restarts(false, a + 1);
   }
   const SolveStats own = best.stats;
   best.stats = total;

@@ -1,6 +1,7 @@
 #pragma once
 // DFGP batch planning: the problem's factor graph solved by Levenberg–Marquardt inside an
 // augmented-Lagrangian outer loop, then validated independently.
+#include "kinograph/planning/batch/path_search.h"
 #include "kinograph/planning/formulation/dfg_builder.h"
 #include "kinograph/planning/formulation/initialization.h"
 #include "kinograph/planning/formulation/planning_graph.h"
@@ -44,7 +45,8 @@ struct BatchPlannerOptions {
   OuterLoopOptions outer_loop;
   ValidationThresholds validation;
   /// When the straight-line (L) plan of a problem with obstacles does not validate, up to this
-  /// many more attempts start from detours (via_point() through detour_candidates()); the plan
+  /// many more attempts start from detours (via_point() through detour_candidates()) and, with
+  /// path_search on, one from a searched path (skipped when none is found); the plan
   /// returned is the first that validates (else the one with the smallest constraint violation),
   /// and its stats count every attempt; each attempt has its own iteration limits. 0 = never.
   int max_restarts = 4;
@@ -52,6 +54,10 @@ struct BatchPlannerOptions {
   /// does not (the straight line is then the first restart).
   bool detour_first = true;
   DetourOptions detour;
+  /// One restart starts from a collision-free path (search_path, timed by path_trajectory): when
+  /// the straight line collides, first (second after the best detour when that detour's path is
+  /// clear); else right after a failed first attempt. max_samples = 0 switches it off.
+  PathSearchOptions path_search;
 };
 
 /// Where the solve of a plan ended: its graph, values and the constraint state (final

@@ -118,30 +118,78 @@ Trajectory warm_start(const Problem& problem, const Plan& previous) {
   return tr;
 }
 
-Trajectory via_point(const Problem& problem, const Eigen::VectorXd& q_via,
-                     const Eigen::VectorXd& q_goal) {
-  const int N = problem.steps;
-  const int n = problem.model->nq();
-  if (N < 2) return straight_line(problem, q_goal);
-  const int half = N / 2;
-  Problem first = problem;
-  first.steps = half;
-  first.horizon = problem.dt() * half;
-  const Trajectory a = straight_line(first, q_via);
-  Problem second = problem;
-  second.steps = N - half;
-  second.horizon = problem.dt() * (N - half);
-  second.start_q = q_via;
-  second.start_qd = Eigen::VectorXd::Zero(n);
-  const Trajectory b = straight_line(second, q_goal);
+Trajectory segment_trajectory(const Problem& problem, const std::vector<Eigen::VectorXd>& waypoints,
+                              const std::vector<int>& steps) {
+  const int n = problem.model->nq(), N = problem.steps;
+  int total = 0;
+  for (int s : steps) {
+    if (s < 1) throw std::invalid_argument("segment_trajectory: a segment without steps");
+    total += s;
+  }
+  if (waypoints.size() < 2 || steps.size() + 1 != waypoints.size() || total != N) {
+    throw std::invalid_argument("segment_trajectory: waypoints and steps do not match");
+  }
   Trajectory tr;
   tr.q.resize(N + 1, n);
   tr.qd.resize(N + 1, n);
   tr.qdd.resize(N + 1, n);
-  tr.q << a.q, b.q.bottomRows(N - half);
-  tr.qd << a.qd, b.qd.bottomRows(N - half);
-  tr.qdd << a.qdd, b.qdd.bottomRows(N - half);
+  int k = 0;
+  for (size_t i = 0; i < steps.size(); ++i) {
+    Problem part = problem;
+    part.steps = steps[i];
+    part.horizon = problem.dt() * steps[i];
+    part.start_q = waypoints[i];
+    if (i > 0) part.start_qd = Eigen::VectorXd::Zero(n);
+    const Trajectory t = straight_line(part, waypoints[i + 1]);
+    const int skip = i == 0 ? 0 : 1;  // the segment's first state is the previous one's last
+    tr.q.middleRows(k, steps[i] + 1 - skip) = t.q.bottomRows(steps[i] + 1 - skip);
+    tr.qd.middleRows(k, steps[i] + 1 - skip) = t.qd.bottomRows(steps[i] + 1 - skip);
+    tr.qdd.middleRows(k, steps[i] + 1 - skip) = t.qdd.bottomRows(steps[i] + 1 - skip);
+    k += steps[i] + 1 - skip;
+  }
   return tr;
+}
+
+Trajectory path_trajectory(const Problem& problem, const std::vector<Eigen::VectorXd>& waypoints) {
+  const int segments = static_cast<int>(waypoints.size()) - 1;
+  if (segments < 1 || 2 * segments > problem.steps) {
+    throw std::invalid_argument("path_trajectory: " + std::to_string(segments) +
+                                " segments do not fit " + std::to_string(problem.steps) + " steps");
+  }
+  const dynamics::Model& model = *problem.model;
+  std::vector<double> need(segments, 0.0);
+  double sum = 0;
+  for (int i = 0; i < segments; ++i) {
+    for (int j = 0; j < model.nq(); ++j) {
+      const double v = model.bodies[j].limits.velocity;
+      const double d = std::abs(waypoints[i + 1][j] - waypoints[i][j]);
+      need[i] = std::max(need[i], std::isfinite(v) && v > 0 ? d / v : d);
+    }
+    need[i] += 1e-9;  // a segment that does not move still gets its share of the minimum
+    sum += need[i];
+  }
+  // Two steps each, the rest by largest remainder of the proportional share.
+  std::vector<int> steps(segments, 2);
+  const int spare = problem.steps - 2 * segments;
+  std::vector<std::pair<double, int>> remainder;
+  int given = 0;
+  for (int i = 0; i < segments; ++i) {
+    const double share = spare * need[i] / sum;
+    steps[i] += static_cast<int>(std::floor(share));
+    given += static_cast<int>(std::floor(share));
+    remainder.push_back({share - std::floor(share), i});
+  }
+  std::stable_sort(remainder.begin(), remainder.end(),
+                   [](const auto& x, const auto& y) { return x.first > y.first; });
+  for (int r = 0; r < spare - given; ++r) ++steps[remainder[r].second];
+  return segment_trajectory(problem, waypoints, steps);
+}
+
+Trajectory via_point(const Problem& problem, const Eigen::VectorXd& q_via,
+                     const Eigen::VectorXd& q_goal) {
+  const int N = problem.steps;
+  if (N < 2) return straight_line(problem, q_goal);
+  return segment_trajectory(problem, {problem.start_q, q_via, q_goal}, {N / 2, N - N / 2});
 }
 
 namespace {

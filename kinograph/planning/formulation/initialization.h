@@ -31,6 +31,18 @@ Trajectory straight_line(const Problem& problem, const Eigen::VectorXd& q_goal);
 Trajectory via_point(const Problem& problem, const Eigen::VectorXd& q_via,
                      const Eigen::VectorXd& q_goal);
 
+/// Smooth straight lines through `waypoints` (the start first, q_goal last), each along the
+/// quintic time law of straight_line and at rest at every inner waypoint, with `steps[i]`
+/// intervals for segment i (the steps sum to the problem's). Throws std::invalid_argument when
+/// the sizes do not match or a segment has no step.
+Trajectory segment_trajectory(const Problem& problem, const std::vector<Eigen::VectorXd>& waypoints,
+                              const std::vector<int>& steps);
+
+/// segment_trajectory through a path, its steps shared in proportion to the time each segment
+/// needs at the velocity limits (at least 2 each). Throws std::invalid_argument for fewer than two
+/// waypoints or more segments than half the steps.
+Trajectory path_trajectory(const Problem& problem, const std::vector<Eigen::VectorXd>& waypoints);
+
 /// Options of detour_candidates.
 struct DetourOptions {
   int candidates = 24;  ///< random via points drawn (seeded, so plans are repeatable)

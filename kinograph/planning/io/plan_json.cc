@@ -379,6 +379,7 @@ std::string summarize(const Plan& plan) {
 json plan_to_json(const Plan& plan, const Scene& scene) {
   const Problem& problem = scene.problem;
   json j;
+  j["format_version"] = kPlanFormatVersion;
   j["name"] = problem.name;
   j["robot"]["urdf"] = data_relative_path(scene.urdf_path);
   if (scene.payload) {
@@ -467,8 +468,23 @@ void write_plan(const Plan& plan, const Scene& scene, const std::string& path) {
   if (!out) throw PlanFileError("error while writing plan file '" + path + "'");
 }
 
-Plan plan_from_json(const json& j, const dynamics::Model& model, const std::string& source) {
+int plan_format_version(const json& j, const std::string& source) {
   if (!j.is_object()) fail(source, "", "the top level must be a JSON object");
+  if (!j.contains("format_version")) return 0;
+  const json& v = j["format_version"];
+  if (!v.is_number_integer() || v.get<long long>() < 1) {
+    fail(source, "format_version", "must be an integer >= 1, is " + v.dump());
+  }
+  if (v.get<long long>() > kPlanFormatVersion) {
+    fail(source, "format_version",
+         "is " + v.dump() + ", newer than this kinograph reads (versions up to " +
+             std::to_string(kPlanFormatVersion) + "); read it with a newer kinograph");
+  }
+  return v.get<int>();
+}
+
+Plan plan_from_json(const json& j, const dynamics::Model& model, const std::string& source) {
+  plan_format_version(j, source);
   const int n = model.nq();
   std::vector<int> column(n);
   std::size_t width = n;
@@ -514,7 +530,7 @@ Plan read_plan(const std::string& path, const dynamics::Model& model) {
 }
 
 PlanFileInfo plan_info_from_json(const json& j, const std::string& source) {
-  if (!j.is_object()) fail(source, "", "the top level must be a JSON object");
+  plan_format_version(j, source);
   PlanFileInfo info;
   info.source = source;
   if (j.contains("name") && j["name"].is_string()) info.name = j["name"].get<std::string>();

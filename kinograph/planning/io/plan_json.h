@@ -1,20 +1,6 @@
 #pragma once
 // Plan files (JSON): a plan with the robot and obstacles it was planned for, read by the
-// renderer (whole, through read_plan_file), by `kinograph validate` and for warm starts.
-//
-// {"name": "...", "robot": {"urdf": "robots/iiwa14/iiwa14.urdf",
-//   "payload": {"frame": "...", "mass": 2.0, "size": [x,y,z], "offset": [x,y,z]}},
-//  "obstacles": [{"id": "desk", "shape": "box", "size": [..], "mesh": "path",
-//                 "position": [x,y,z], "quaternion": [w,x,y,z],
-//                 "motion": [{"t": s, "position": [..], "quaternion": [..]}] (moving only),
-//                 "rgba": [r,g,b,a] (optional, for pictures; the planner writes none)}],
-//  "joint_names": [...], "unactuated": [joint names], "t": [...], "q": [[...], ...], "qd": ..., "qdd": ..., "tau": ...,
-//  "limits": {"lower": [...], "upper": [...], "velocity": [...], "acceleration": [...],
-//             "effort": [...]}, "stats": {...}, "validation": {...}}
-//
-// JSON has no infinity: an infinite limit or clearance is written as null and read back as
-// infinity (-infinity for a lower joint limit). NaN trajectory values are written as null and
-// read back as NaN, so a broken plan still round-trips to the validator.
+// renderer, by `kinograph validate` and for warm starts. Format: docs/plan_file.md.
 #include <Eigen/Core>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -35,6 +21,10 @@ class PlanFileError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// The plan file format this kinograph writes ("format_version"); it reads this one, older ones
+/// and files without the field (written before it existed).
+inline constexpr int kPlanFormatVersion = 1;
+
 /// The solver statistics as a JSON object (every field of SolveStats).
 nlohmann::json to_json(const SolveStats& stats);
 /// The validation as a JSON object (every figure of Validation, failures as a list).
@@ -54,6 +44,11 @@ std::string summarize(const Validation& validation);
 nlohmann::json plan_to_json(const Plan& plan, const Scene& scene);
 /// Writes plan_to_json to `path`; throws PlanFileError if it cannot be written.
 void write_plan(const Plan& plan, const Scene& scene, const std::string& path);
+
+/// The "format_version" of a plan file, 0 when absent (written before the field existed).
+/// @throws PlanFileError naming `source` when it is not an integer >= 1 or is newer than
+/// kPlanFormatVersion.
+int plan_format_version(const nlohmann::json& json, const std::string& source = "");
 
 /// Parses a plan file for `model`: columns are matched to the model's joints by
 /// "joint_names" (by position when absent) and the sizes checked. Throws PlanFileError.

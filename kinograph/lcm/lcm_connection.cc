@@ -1,0 +1,27 @@
+#include "kinograph/lcm/lcm_connection.h"
+
+#include <algorithm>
+#include <cctype>
+#include <lcm/lcm-cpp.hpp>
+#include <stdexcept>
+
+namespace kinograph::messages {
+
+std::unique_ptr<lcm::LCM> open_lcm(const std::string& url) {
+  auto lcm = std::make_unique<lcm::LCM>(url);
+  if (!lcm->good()) {
+    throw std::runtime_error("LCM could not start on \"" +
+                             (url.empty() ? std::string("default URL") : url) +
+                             "\" (for udpm a multicast route is needed, see docs/network.md)");
+  }
+  return lcm;
+}
+
+std::string default_channel_prefix(const std::string& robot_name) {
+  std::string s = robot_name;
+  std::transform(s.begin(), s.end(), s.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
+  return s;
+}
+
+}  // namespace kinograph::messages

@@ -1,0 +1,20 @@
+#pragma once
+// What every kinograph LCM node does first: open its LCM connection and name its channels.
+#include <memory>
+#include <string>
+
+namespace lcm {
+class LCM;
+}  // namespace lcm
+
+namespace kinograph::messages {
+
+/// Opens LCM on `url` (empty = $LCM_DEFAULT_URL, else LCM's default multicast group).
+/// @throws std::runtime_error naming the URL when LCM cannot start (udpm needs a multicast
+///   route, docs/network.md).
+std::unique_ptr<lcm::LCM> open_lcm(const std::string& url);
+
+/// A robot's default channel prefix: its URDF name upper-cased ("iiwa14" → "IIWA14").
+std::string default_channel_prefix(const std::string& robot_name);
+
+}  // namespace kinograph::messages
