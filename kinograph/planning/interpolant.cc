@@ -28,9 +28,6 @@ IntervalInterpolant::IntervalInterpolant(const dynamics::Model& model)
   qd0_.setZero(n);
   qdd0_.setZero(n);
   qdd1_.setZero(n);
-  tau0_.resize(n);
-  tau0u_.resize(m);
-  fu_.resize(m);
   muu_.resize(m, m);
   rhs_.resize(m, 4 * n);
   for (int i = 0; i < 4; ++i) {
@@ -95,26 +92,15 @@ void IntervalInterpolant::point(double s, const Eigen::VectorXd& y, const Eigen:
     p.tau = data_.tau;
     return;
   }
-  // τ_u(q̈_u) = τ0_u + M_uu q̈_u = 0 with τ0 the torques at q̈_u = 0.
-  dynamics::rnea(model_, data_, p.q, p.qd, p.qdd);
-  tau0_ = data_.tau;
-  dynamics::mass_matrix(model_, data_, p.q);
+  // q̈_u makes τ_u zero, with the torques, M and (derivatives) ∂τ at that q̈ in one pass.
+  dynamics::passive_dynamics(model_, data_, p.q, p.qd, p.qdd, unactuated_, derivatives);
+  p.tau = data_.tau;
+  for (int i = 0; i < m; ++i) p.qdd[unactuated_[i]] = data_.qdd[unactuated_[i]];
+  if (!derivatives) return;
   for (int a = 0; a < m; ++a) {
-    tau0u_[a] = tau0_[unactuated_[a]];
     for (int b = 0; b < m; ++b) muu_(a, b) = data_.M(unactuated_[a], unactuated_[b]);
   }
   llt_.compute(muu_);
-  fu_ = -llt_.solve(tau0u_);
-  for (int i = 0; i < m; ++i) p.qdd[unactuated_[i]] = fu_[i];
-  if (!derivatives) {
-    if (with_tau) {
-      p.tau = tau0_;
-      for (int i = 0; i < m; ++i) p.tau += data_.M.col(unactuated_[i]) * fu_[i];
-    }
-    return;
-  }
-  dynamics::rnea_derivatives(model_, data_, p.q, p.qd, p.qdd);
-  p.tau = data_.tau;
   // Implicit function τ_u(q, q̇, q̈_a, q̈_u) = 0: dq̈_u = −M_uu⁻¹(∂τ_u/∂q dq + ∂τ_u/∂q̇ dq̇ +
   // M_ua dq̈_a), where dq̈ holds only the actuated rows so far.
   for (int i = 0; i < m; ++i) {

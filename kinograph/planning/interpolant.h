@@ -100,7 +100,6 @@ class IntervalInterpolant {
   Eigen::MatrixXd dk_[4];
   Eigen::VectorXd ys_, y_part_;
   Eigen::MatrixXd Ss_, S_part_;
-  Eigen::VectorXd tau0_, tau0u_, fu_;
   Eigen::MatrixXd muu_, rhs_;
   Eigen::LLT<Eigen::MatrixXd> llt_;
 };
