@@ -1,5 +1,9 @@
 #include "render/plan_scene.h"
 
+#include <stdexcept>
+
+#include "kinograph/planning/trajectory_sampler.h"
+
 namespace kinograph::render {
 
 std::vector<SceneObstacle> plan_obstacles(const planning::PlanFileInfo& info) {
@@ -14,18 +18,20 @@ std::vector<SceneObstacle> plan_obstacles(const planning::PlanFileInfo& info) {
   return out;
 }
 
-Trajectory plan_trajectory(const planning::Plan& plan) {
+Trajectory plan_trajectory(const dynamics::Model& model, const planning::Plan& plan) {
+  const planning::SampledPath path = planning::sample_plan(model, plan, kDrawnSamplesPerInterval);
   Trajectory trajectory;
-  trajectory.t = plan.t;
-  for (Eigen::Index k = 0; k < plan.q.rows(); ++k)
-    trajectory.q.push_back(plan.q.row(k).transpose());
+  trajectory.t = path.t;
+  for (Eigen::Index k = 0; k < path.q.rows(); ++k)
+    trajectory.q.push_back(path.q.row(k).transpose());
   return trajectory;
 }
 
 RenderScene plan_scene(const planning::PlanFile& file) {
   RenderScene scene;
   scene.model = file.model.get();
-  scene.trajectory = plan_trajectory(file.plan);
+  if (file.model == nullptr) throw std::invalid_argument("plan file: no robot model");
+  scene.trajectory = plan_trajectory(*file.model, file.plan);
   scene.obstacles = plan_obstacles(file.info);
   return scene;
 }

@@ -12,8 +12,12 @@ namespace kinograph::render {
 /// A plan file's obstacles as drawn: each with its "rgba" or the default blue, moving ones
 /// with their motion.
 std::vector<SceneObstacle> plan_obstacles(const planning::PlanFileInfo& info);
-/// A plan's joint positions over time (its t and the rows of q).
-Trajectory plan_trajectory(const planning::Plan& plan);
+/// Points of the plan's interpolant drawn per interval (docs/interpolation.md); the renderer's
+/// linear blend between them stays within the drawing's resolution.
+inline constexpr int kDrawnSamplesPerInterval = 10;
+/// A plan's joint positions over time: its interpolant sampled kDrawnSamplesPerInterval times
+/// per interval. Throws std::invalid_argument when the plan does not fit the model.
+Trajectory plan_trajectory(const dynamics::Model& model, const planning::Plan& plan);
 /// The picture's scene of a whole plan file: its robot, trajectory and obstacles. The scene
 /// borrows `file.model`, so `file` must outlive it.
 RenderScene plan_scene(const planning::PlanFile& file);

@@ -25,6 +25,7 @@ Data::Data(const Model& model) {
   // Factor once to size the LLT's storage (copying a sized but unfactored LLT reads its
   // uninitialised status, which UBSan flags).
   s.llt.compute(Eigen::MatrixXd::Identity(n, n));
+  s.llt_p.compute(Eigen::MatrixXd::Identity(1, 1));
 
   // G = [[Ī − m[c]², m[c]], [−m[c], m·1]] about the body origin; keep (m, c, Ī) to move the
   // inertia into the world frame with 3×3 products only.

@@ -43,6 +43,9 @@ class Data {
     std::vector<Vector6> hc;  // composite momenta
     Eigen::VectorXd bias;
     Eigen::LLT<Eigen::MatrixXd> llt;
+    Eigen::MatrixXd Mpp;  // passive_dynamics: M of the passive joints, its LLT and right side
+    Eigen::LLT<Eigen::MatrixXd> llt_p;
+    Eigen::VectorXd bias_p;
   } scratch;
 };
 

@@ -93,26 +93,41 @@ const Eigen::VectorXd& rnea(const Model& model, Data& data, const VectorRef& q, 
   return data.tau;
 }
 
-void rnea_derivatives(const Model& model, Data& data, const VectorRef& q, const VectorRef& qd,
-                      const VectorRef& qdd, std::span<const ExternalWrench> ext) {
-  // World-frame RNEA (S_i = Ad_{T_0i} A_i, twists add up along the chain, V̇ is the time
-  // derivative of the spatial twist). Moving joint j moves every world quantity of its subtree
-  // by the bracket with S_j, which gives the derivatives in closed form:
-  //   ∂V_k/∂q_j = [S_j, V_k − V_λj],
-  //   ∂a_k/∂q_j = [S_j, a_k − a_λj] + [Ṡ_j, V_k − V_λj],       Ṡ_j = [V_j, S_j],
-  //   ∂a_k/∂q̇_j = Ṡ_j + [S_j, V_k − V_λj]                       (j an ancestor of k or k).
-  // The wrench f_k = I_k a_k − ad_{V_k}^T I_k V_k − f_ext,k moves covariantly apart from the
-  // parts of V and a inherited from λ(j); summing over subtrees leaves composites
-  //   Ic = Σ I_k,  Ec = Σ ad_{V_k}^T I_k,  hc = Σ I_k V_k,
-  // so every entry of ∂τ/∂q and ∂τ/∂q̇ is a few 6-vector dot products.
-  const int n = model.nq();
-  auto& s = data.scratch;
+namespace {
+
+// World-frame geometry of q shared by the derivatives, the mass matrix and passive_dynamics:
+// poses, screws, inertias, composites and the external wrenches in the world frame.
+void world_geometry(const Model& model, Data& data, const VectorRef& q,
+                    std::span<const ExternalWrench> ext) {
   detail::update_poses(model, data, q);
   world_screws_and_composites(model, data);
   gather_external_world(model, data, ext);
+}
+
+// M_ij = S_i^T Ic_i S_j for j an ancestor of i (or i): composite rigid bodies, from the
+// current world geometry.
+void mass_matrix_from_composites(const Model& model, Data& data) {
+  const int n = model.nq();
+  auto& s = data.scratch;
+  for (int i = 0; i < n; ++i) s.SIc[i].noalias() = s.Ic[i] * s.S[i];
+  data.M.setZero();
+  for (int i = 0; i < n; ++i) {
+    for (int j = i; j >= 0; j = model.bodies[j].parent) {
+      data.M(i, j) = s.SIc[i].dot(s.S[j]);
+      data.M(j, i) = data.M(i, j);
+    }
+  }
+}
+
+// The world-frame Newton–Euler pass on the current geometry: twists, accelerations, wrenches
+// and their subtree sums Fw, and τ into data.tau; with `for_derivatives` also the composites
+// hc and Ec that derivative_assembly needs.
+void world_pass(const Model& model, Data& data, const VectorRef& qd, const VectorRef& qdd,
+                bool for_derivatives) {
+  const int n = model.nq();
+  auto& s = data.scratch;
   Vector6 a0;
   a0 << 0, 0, 0, -model.gravity;
-
   for (int i = 0; i < n; ++i) {
     const int p = model.bodies[i].parent;
     const Vector6 Vp = p < 0 ? Vector6::Zero() : s.Vw[p];
@@ -125,20 +140,28 @@ void rnea_derivatives(const Model& model, Data& data, const VectorRef& q, const 
     s.alpha[i] = ad_apply(S, ap) + ad_apply(s.Sdot[i], Vp);
     const Matrix6& I = s.Iw[i];
     const Vector6 h = I * s.Vw[i];
-    s.hc[i] = h;
     s.fw[i].noalias() = I * s.aw[i];
     s.fw[i] -= ad_transpose_apply(s.Vw[i], h) + s.fext[i];
     s.Fw[i] = s.fw[i];
+    if (!for_derivatives) continue;
+    s.hc[i] = h;
     s.Ec[i].noalias() = ad(s.Vw[i]).transpose() * I;
   }
   for (int i = n - 1; i >= 0; --i) {
     const int p = model.bodies[i].parent;
-    if (p >= 0) {
-      s.Fw[p] += s.Fw[i];
-      s.hc[p] += s.hc[i];
-      s.Ec[p] += s.Ec[i];
-    }
+    if (p < 0) continue;
+    s.Fw[p] += s.Fw[i];
+    if (!for_derivatives) continue;
+    s.hc[p] += s.hc[i];
+    s.Ec[p] += s.Ec[i];
   }
+  for (int i = 0; i < n; ++i) data.tau[i] = s.S[i].dot(s.Fw[i]) + model.bodies[i].damping * qd[i];
+}
+
+// ∂τ/∂q, ∂τ/∂q̇ and M from a world_pass at the same q, q̇; and the body-frame V, V̇, F.
+void derivative_assembly(const Model& model, Data& data) {
+  const int n = model.nq();
+  auto& s = data.scratch;
   // Per body: rows S_i^T Ic_i, S_i^T Bc_i (Bc = Ec^T), S_i^T Dc_i (Dc = B(hc) + Ec), and the
   // derivative of its own subtree wrench with respect to its own q_i and q̇_i.
   for (int i = 0; i < n; ++i) {
@@ -161,8 +184,6 @@ void rnea_derivatives(const Model& model, Data& data, const VectorRef& q, const 
   data.dtau_dqd.setZero();
   data.M.setZero();
   for (int i = 0; i < n; ++i) {
-    const Vector6& Si = s.S[i];
-    data.tau[i] = Si.dot(s.Fw[i]) + model.bodies[i].damping * qd[i];
     for (int j = i; j >= 0; j = model.bodies[j].parent) {
       // j is i or an ancestor of i.
       data.dtau_dq(i, j) =
@@ -185,23 +206,58 @@ void rnea_derivatives(const Model& model, Data& data, const VectorRef& q, const 
   }
 }
 
+}  // namespace
+
+void rnea_derivatives(const Model& model, Data& data, const VectorRef& q, const VectorRef& qd,
+                      const VectorRef& qdd, std::span<const ExternalWrench> ext) {
+  // World-frame RNEA (S_i = Ad_{T_0i} A_i, twists add up along the chain, V̇ is the time
+  // derivative of the spatial twist). Moving joint j moves every world quantity of its subtree
+  // by the bracket with S_j, which gives the derivatives in closed form:
+  //   ∂V_k/∂q_j = [S_j, V_k − V_λj],
+  //   ∂a_k/∂q_j = [S_j, a_k − a_λj] + [Ṡ_j, V_k − V_λj],       Ṡ_j = [V_j, S_j],
+  //   ∂a_k/∂q̇_j = Ṡ_j + [S_j, V_k − V_λj]                       (j an ancestor of k or k).
+  // The wrench f_k = I_k a_k − ad_{V_k}^T I_k V_k − f_ext,k moves covariantly apart from the
+  // parts of V and a inherited from λ(j); summing over subtrees leaves composites
+  //   Ic = Σ I_k,  Ec = Σ ad_{V_k}^T I_k,  hc = Σ I_k V_k,
+  // so every entry of ∂τ/∂q and ∂τ/∂q̇ is a few 6-vector dot products.
+  world_geometry(model, data, q, ext);
+  world_pass(model, data, qd, qdd, true);
+  derivative_assembly(model, data);
+}
+
 const Eigen::MatrixXd& mass_matrix(const Model& model, Data& data, const VectorRef& q) {
-  const int n = model.nq();
-  auto& s = data.scratch;
   detail::update_poses(model, data, q);
   world_screws_and_composites(model, data);
-  // Composite rigid bodies: M_ij = S_i^T Ic_i S_j for j an ancestor of i (or i).
-  for (int i = 0; i < n; ++i) {
-    s.SIc[i].noalias() = s.Ic[i] * s.S[i];
-  }
-  data.M.setZero();
-  for (int i = 0; i < n; ++i) {
-    for (int j = i; j >= 0; j = model.bodies[j].parent) {
-      data.M(i, j) = s.SIc[i].dot(s.S[j]);
-      data.M(j, i) = data.M(i, j);
-    }
-  }
+  mass_matrix_from_composites(model, data);
   return data.M;
+}
+
+void passive_dynamics(const Model& model, Data& data, const VectorRef& q, const VectorRef& qd,
+                      const VectorRef& qdd, std::span<const int> passive, bool derivatives,
+                      std::span<const ExternalWrench> ext) {
+  const int m = static_cast<int>(passive.size());
+  auto& s = data.scratch;
+  world_geometry(model, data, q, ext);
+  mass_matrix_from_composites(model, data);
+  data.qdd = qdd;
+  for (int a = 0; a < m; ++a) data.qdd[passive[a]] = 0;
+  world_pass(model, data, qd, data.qdd, false);
+  // τ is affine in q̈ with slope M: τ_p(q̈_p) = τ0_p + M_pp q̈_p = 0.
+  s.Mpp.resize(m, m);
+  s.bias_p.resize(m);
+  for (int a = 0; a < m; ++a) {
+    s.bias_p[a] = -data.tau[passive[a]];
+    for (int b = 0; b < m; ++b) s.Mpp(a, b) = data.M(passive[a], passive[b]);
+  }
+  s.llt_p.compute(s.Mpp);
+  s.llt_p.solveInPlace(s.bias_p);
+  for (int a = 0; a < m; ++a) {
+    data.qdd[passive[a]] = s.bias_p[a];
+    data.tau.noalias() += data.M.col(passive[a]) * s.bias_p[a];
+  }
+  if (!derivatives) return;
+  world_pass(model, data, qd, data.qdd, true);
+  derivative_assembly(model, data);
 }
 
 const Eigen::VectorXd& forward_dynamics(const Model& model, Data& data, const VectorRef& q,

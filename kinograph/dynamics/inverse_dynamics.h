@@ -35,6 +35,17 @@ void rnea_derivatives(const Model& model, Data& data, const VectorRef& q, const 
 /// Joint-space mass matrix M(q) (composite rigid bodies), written to data.M (returned).
 const Eigen::MatrixXd& mass_matrix(const Model& model, Data& data, const VectorRef& q);
 
+/// Dynamics with passive joints: the accelerations of the joints `passive` (distinct indices)
+/// that make their torques zero while the other joints accelerate as `qdd` says (its passive
+/// entries are ignored), q̈_p = −M_pp⁻¹ τ_p(q̈_p = 0). Writes that q̈ to data.qdd, τ = RNEA(q,
+/// q̇, q̈) (zero on the passive joints up to rounding) to data.tau and M(q) to data.M; with
+/// `derivatives` also data.dtau_dq and data.dtau_dqd at that q̈, as rnea_derivatives. One
+/// kinematics pass for all of it. M_pp must be positive definite. Allocates only when it meets
+/// a passive set of a new size.
+void passive_dynamics(const Model& model, Data& data, const VectorRef& q, const VectorRef& qd,
+                      const VectorRef& qdd, std::span<const int> passive, bool derivatives,
+                      std::span<const ExternalWrench> ext = {});
+
 /// Forward dynamics: q̈ solving M q̈ = τ − (c + g + b q̇ − Σ J^T F_ext), written to data.qdd
 /// (returned). M must be positive definite (every body with mass or inertia about its axis).
 const Eigen::VectorXd& forward_dynamics(const Model& model, Data& data, const VectorRef& q,

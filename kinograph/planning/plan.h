@@ -48,16 +48,22 @@ struct Validation {
   bool valid = false;
   std::vector<std::string> failures;
   double max_dynamics_residual = 0;     ///< max |τ − RNEA(q, q̇, q̈)| (N·m)
-  double max_position_consistency = 0;  ///< max |q_{k+1} − q_k − ½(q̇_k + q̇_{k+1})Δt| (rad)
-  double max_velocity_consistency = 0;  ///< max |q̇_{k+1} − q̇_k − ½(q̈_k + q̈_{k+1})Δt| (rad/s)
-  double max_q_violation = 0;           ///< how far q leaves [lower, upper]
-  double max_qd_violation = 0;          ///< how far |q̇| exceeds the velocity limit
-  double max_qdd_violation = 0;         ///< how far |q̈| exceeds a finite acceleration limit
-  double max_tau_violation = 0;         ///< how far |τ| exceeds the effort limit
+  /// max |q_{k+1} − q(t_{k+1}⁻)| (rad): the gap between where the interpolant of interval k
+  /// arrives and knot k+1 (collocation of actuated joints, shooting defect of unactuated ones)
+  double max_position_consistency = 0;
+  double max_velocity_consistency = 0;  ///< the same for q̇ (rad/s)
+  double max_q_violation = 0;    ///< how far q leaves [lower, upper], at and between the knots
+  double max_qd_violation = 0;   ///< how far |q̇| exceeds the velocity limit, at and between
+  double max_qdd_violation = 0;  ///< how far |q̈| exceeds a finite acceleration limit, same
+  double max_tau_violation = 0;  ///< how far the knots' |τ| exceeds the effort limit (N·m)
+  /// How far |τ| on the interpolant between the knots exceeds the effort limit (N·m).
+  double max_tau_violation_between = 0;
+  /// max |τ| on unactuated joints on the interpolant between the knots (N·m).
+  double max_unactuated_torque_between = 0;
   double min_clearance = std::numeric_limits<double>::infinity();  ///< m, over steps and between
   double goal_error = 0;             ///< joint goal: max |q_N − q_goal|; pose goal: max(m, rad)
   double max_task_error = 0;         ///< worst task-constraint error (rad or m)
-  double max_unactuated_torque = 0;  ///< max |τ| on unactuated joints (N·m)
+  double max_unactuated_torque = 0;  ///< max |τ| on unactuated joints at the knots (N·m)
   double start_error = 0;            ///< max |q_0 − start_q|, |q̇_0 − start_qd|
   double final_velocity = 0;         ///< max |q̇_N|, |q̈_N| (the goal is at rest)
 };

@@ -52,6 +52,11 @@ struct Objectives {
   /// and the floor: smaller than ε, since an arm's own links pass close by design (links two
   /// joints apart are 4.5 cm apart on the iiwa) and it works close to the floor it stands on.
   double self_collision_epsilon = 0.01;
+  /// Number of interior points per interval (evenly spaced) where the planner enforces the
+  /// effort, q and q̇ limits on the interpolant, raised to one per RK4 node of the interpolant
+  /// (limit_points in interpolant.h); 0 = only at the knots. The default matches the
+  /// validator's 10 samples per interval.
+  int limit_substeps = 9;
 };
 
 /// What the robot must clear besides the obstacles: its own links and the floor.

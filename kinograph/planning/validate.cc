@@ -11,6 +11,7 @@
 #include "kinograph/dynamics/kinematics.h"
 #include "kinograph/planning/clearance_world.h"
 #include "kinograph/planning/factors/pose_error.h"
+#include "kinograph/planning/trajectory_sampler.h"
 #include "kinograph/planning/user_terms.h"
 
 namespace kinograph::planning {
@@ -65,64 +66,135 @@ bool check_shape(const Problem& problem, const Plan& plan, Validation& v) {
   return true;
 }
 
-// Physics: inverse dynamics, the trapezoid integration residuals and every limit.
-void check_physics(const Problem& problem, const Plan& plan, const ValidationThresholds& thresholds,
-                   dynamics::Data& data, Validation& v) {
-  const dynamics::Model& model = *problem.model;
-  const int n = model.nq(), N = problem.steps, rows = N + 1;
-  const double dt = problem.dt();
-  for (int k = 0; k < rows; ++k) {
-    const Eigen::VectorXd q = plan.q.row(k).transpose(), qd = plan.qd.row(k).transpose(),
-                          qdd = plan.qdd.row(k).transpose();
-    const Eigen::VectorXd& tau = dynamics::rnea(model, data, q, qd, qdd);
-    v.max_dynamics_residual = std::max(v.max_dynamics_residual,
-                                       (plan.tau.row(k).transpose() - tau).cwiseAbs().maxCoeff());
-    if (k < N) {
-      const Eigen::RowVectorXd rq =
-          plan.q.row(k + 1) - plan.q.row(k) - 0.5 * dt * (plan.qd.row(k) + plan.qd.row(k + 1));
-      const Eigen::RowVectorXd rv =
-          plan.qd.row(k + 1) - plan.qd.row(k) - 0.5 * dt * (plan.qdd.row(k) + plan.qdd.row(k + 1));
-      v.max_position_consistency = std::max(v.max_position_consistency, rq.cwiseAbs().maxCoeff());
-      v.max_velocity_consistency = std::max(v.max_velocity_consistency, rv.cwiseAbs().maxCoeff());
-    }
-    for (int j = 0; j < n; ++j) {
+// The worst excess of one check, and where it is (for the failure line).
+struct Worst {
+  double amount = 0;
+  int joint = -1;
+  double t = 0;
+  int interval = -1;  // ≥ 0 between knots interval and interval + 1, −1 at a knot
+  void see(double x, int j, double time, int k) {
+    if (x > amount) *this = {x, j, time, k};
+  }
+};
+
+// "<what> <amount> exceeds <threshold>: joint '<name>' at t = <t> s (between knots k and k+1)".
+std::string located(const char* what, const Worst& w, double threshold,
+                    const dynamics::Model& model) {
+  std::ostringstream os;
+  os << fmt(what, w.amount, threshold);
+  if (w.joint < 0) return os.str();
+  os << ": joint '" << model.bodies[w.joint].joint_name << "' at t = " << w.t << " s";
+  if (w.interval >= 0) os << " (between knots " << w.interval << " and " << w.interval + 1 << ")";
+  return os.str();
+}
+
+// The limits of one state (at a knot, or a sample of the interpolant between knots).
+struct StateWorst {
+  Worst q, qd, qdd, tau, unactuated;
+  void see(const dynamics::Model& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
+           const Eigen::VectorXd* qdd, const Eigen::VectorXd& tau, double t, int k) {
+    for (int j = 0; j < model.nq(); ++j) {
       const dynamics::JointLimits& lim = model.bodies[j].limits;
-      v.max_q_violation = std::max(v.max_q_violation, excess(plan.q(k, j), lim.lower, lim.upper));
-      v.max_qd_violation =
-          std::max(v.max_qd_violation, excess(plan.qd(k, j), -lim.velocity, lim.velocity));
-      if (std::isfinite(lim.acceleration)) {
-        v.max_qdd_violation = std::max(v.max_qdd_violation,
-                                       excess(plan.qdd(k, j), -lim.acceleration, lim.acceleration));
+      this->q.see(excess(q[j], lim.lower, lim.upper), j, t, k);
+      this->qd.see(excess(qd[j], -lim.velocity, lim.velocity), j, t, k);
+      if (qdd != nullptr && std::isfinite(lim.acceleration)) {
+        this->qdd.see(excess((*qdd)[j], -lim.acceleration, lim.acceleration), j, t, k);
       }
       if (model.bodies[j].actuated) {
-        v.max_tau_violation =
-            std::max(v.max_tau_violation, excess(plan.tau(k, j), -lim.effort, lim.effort));
+        this->tau.see(excess(tau[j], -lim.effort, lim.effort), j, t, k);
       } else {
-        v.max_unactuated_torque = std::max(v.max_unactuated_torque, std::abs(plan.tau(k, j)));
+        unactuated.see(std::abs(tau[j]), j, t, k);
       }
     }
   }
+};
+
+// Physics on the plan's interpolant (interpolant.h): inverse dynamics at the knots, the
+// interpolant's continuity into every next knot (the collocation and, for unactuated joints,
+// the shooting defect), and every limit at the knots and at `interval_samples` points of every
+// interval.
+void check_physics(const Problem& problem, const Plan& plan, const ValidationThresholds& thresholds,
+                   dynamics::Data& data, Validation& v) {
+  const dynamics::Model& model = *problem.model;
+  const int N = problem.steps, rows = N + 1;
+  const double dt = problem.dt();
+  Plan timed;  // the validator reads times from the plan, or the problem's grid without them
+  const Plan* p = &plan;
+  if (plan.t.size() != static_cast<size_t>(rows)) {
+    timed = plan;
+    timed.t.resize(rows);
+    for (int k = 0; k < rows; ++k) timed.t[k] = k * dt;
+    p = &timed;
+  }
+  StateWorst knots, between;
+  Worst position, velocity;
+  for (int k = 0; k < rows; ++k) {
+    const Eigen::VectorXd q = p->q.row(k).transpose(), qd = p->qd.row(k).transpose(),
+                          qdd = p->qdd.row(k).transpose(), tau = p->tau.row(k).transpose();
+    v.max_dynamics_residual = std::max(
+        v.max_dynamics_residual, (tau - dynamics::rnea(model, data, q, qd, qdd)).cwiseAbs().maxCoeff());
+    knots.see(model, q, qd, &qdd, tau, p->t[k], -1);
+  }
+  for (int k = 0; k < N; ++k) {
+    if (!(p->t[k + 1] > p->t[k])) {
+      add_failure(v, "plan times do not increase at t[" + std::to_string(k + 1) + "]");
+      return;
+    }
+  }
+  TrajectorySampler sampler(model, *p);
+  // As dense as the planner's limit points, and at least interval_samples (knot included).
+  const int samples = std::max(1, thresholds.interval_samples) > 1
+                          ? limit_points(thresholds.interval_samples - 1, dt) + 1
+                          : 1;
+  std::vector<double> fractions;
+  for (int i = 1; i < samples; ++i) fractions.push_back(static_cast<double>(i) / samples);
+  fractions.push_back(1.0);
+  std::vector<InterpolantPoint> points;
+  for (int k = 0; k < N; ++k) {
+    sampler.interval(k, fractions, points);
+    for (int i = 0; i + 1 < static_cast<int>(points.size()); ++i) {
+      const InterpolantPoint& x = points[i];
+      between.see(model, x.q, x.qd, &x.qdd, x.tau, p->t[k] + x.s, k);
+    }
+    const InterpolantPoint& end = points.back();
+    for (int j = 0; j < model.nq(); ++j) {
+      position.see(std::abs(p->q(k + 1, j) - end.q[j]), j, p->t[k + 1], k);
+      velocity.see(std::abs(p->qd(k + 1, j) - end.qd[j]), j, p->t[k + 1], k);
+    }
+  }
+  v.max_position_consistency = position.amount;
+  v.max_velocity_consistency = velocity.amount;
+  v.max_q_violation = std::max(knots.q.amount, between.q.amount);
+  v.max_qd_violation = std::max(knots.qd.amount, between.qd.amount);
+  v.max_qdd_violation = std::max(knots.qdd.amount, between.qdd.amount);
+  v.max_tau_violation = knots.tau.amount;
+  v.max_unactuated_torque = knots.unactuated.amount;
+  v.max_tau_violation_between = between.tau.amount;
+  v.max_unactuated_torque_between = between.unactuated.amount;
   if (v.max_dynamics_residual > thresholds.dynamics)
     add_failure(
         v, fmt("dynamics residual |tau - ID| (N·m)", v.max_dynamics_residual, thresholds.dynamics));
-  if (v.max_position_consistency > thresholds.position_consistency)
-    add_failure(v, fmt("position consistency (rad)", v.max_position_consistency,
-                       thresholds.position_consistency));
-  if (v.max_velocity_consistency > thresholds.velocity_consistency)
-    add_failure(v, fmt("velocity consistency (rad/s)", v.max_velocity_consistency,
-                       thresholds.velocity_consistency));
-  if (v.max_q_violation > thresholds.limit)
-    add_failure(v, fmt("joint position limit violation", v.max_q_violation, thresholds.limit));
-  if (v.max_qd_violation > thresholds.limit)
-    add_failure(v, fmt("joint velocity limit violation", v.max_qd_violation, thresholds.limit));
-  if (v.max_qdd_violation > thresholds.limit)
-    add_failure(v,
-                fmt("joint acceleration limit violation", v.max_qdd_violation, thresholds.limit));
-  if (v.max_tau_violation > thresholds.limit)
-    add_failure(v, fmt("effort limit violation (N·m)", v.max_tau_violation, thresholds.limit));
-  if (v.max_unactuated_torque > thresholds.unactuated_torque)
-    add_failure(v, fmt("torque on an unactuated joint (N·m)", v.max_unactuated_torque,
-                       thresholds.unactuated_torque));
+  const auto report = [&](const char* what, const Worst& w, double threshold) {
+    if (w.amount > threshold) add_failure(v, located(what, w, threshold, model));
+  };
+  report("position consistency (rad)", position, thresholds.position_consistency);
+  report("velocity consistency (rad/s)", velocity, thresholds.velocity_consistency);
+  const struct {
+    const char* what;
+    Worst StateWorst::*field;
+    double threshold;
+  } limits[] = {{"joint position limit violation (rad)", &StateWorst::q, thresholds.limit},
+                {"joint velocity limit violation (rad/s)", &StateWorst::qd, thresholds.limit},
+                {"joint acceleration limit violation (rad/s²)", &StateWorst::qdd, thresholds.limit},
+                {"effort limit violation (N·m)", &StateWorst::tau, thresholds.limit},
+                {"torque on an unactuated joint (N·m)", &StateWorst::unactuated,
+                 thresholds.unactuated_torque}};
+  for (const auto& l : limits) {
+    // One line per check: the worse of the knots and the samples between them.
+    const Worst& a = knots.*l.field;
+    const Worst& b = between.*l.field;
+    report(l.what, a.amount >= b.amount ? a : b, l.threshold);
+  }
 }
 
 // The start state and the goal (at rest), naming the joint or frame that misses.

@@ -11,8 +11,9 @@ namespace kinograph::planning {
 /// min_clearance); the planner's safety distance ε is its own margin, not the validator's.
 struct ValidationThresholds {
   double dynamics = 1e-3;              ///< max |τ − RNEA(q,q̇,q̈)| (N·m)
-  double position_consistency = 2e-2;  ///< trapezoid residual of q (rad)
-  double velocity_consistency = 2e-2;  ///< trapezoid residual of q̇ (rad/s)
+  /// Gap between where an interval's interpolant arrives and the next knot: q (rad), q̇ (rad/s).
+  double position_consistency = 1e-3;
+  double velocity_consistency = 1e-2;
   double limit = 1e-3;                 ///< allowed excess over any q, q̇, q̈, τ limit
   double unactuated_torque = 1e-3;     ///< max |τ| on unactuated joints (N·m)
   double min_clearance = 0.0;          ///< m; negative allows that much penetration
@@ -20,6 +21,10 @@ struct ValidationThresholds {
   double start = 1e-6;                 ///< start state error (rad, rad/s)
   double final_velocity = 1e-2;        ///< |q̇_N|, |q̈_N| at the goal
   int collision_samples = 10;          ///< states checked per interval (dense sampling)
+  /// Points per interval (the knot and interval_samples − 1 between, and at least one per RK4
+  /// node of the interpolant: limit_points) where limits and the unactuated torque are
+  /// checked on the interpolant.
+  int interval_samples = 10;
 };
 
 /// Validates `plan` for `problem`: fills every figure of Validation, lists each failed check

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <random>
 #include <vector>
 
@@ -143,6 +144,51 @@ TEST(Derivatives, ForwardDynamicsInvertsInverseDynamics) {
       rnea(m, data, q, qd, qdd, r.ext);
       EXPECT_TRUE(forward_dynamics(m, data, q, qd, data.tau, r.ext).isApprox(qdd, 1e-8));
     }
+  }
+}
+
+TEST(Derivatives, PassiveDynamicsZeroesThePassiveTorques) {
+  std::mt19937 rng(16);
+  for (Robot& r : robots()) {
+    const Model& m = r.model;
+    const int n = m.nq();
+    Data data(m), reference(m);
+    const std::vector<std::vector<int>> sets = {{0}, {1, n - 1}, {n - 2}};
+    for (const std::vector<int>& passive : sets) {
+      for (int k = 0; k < 10; ++k) {
+        const Eigen::VectorXd q = testing::random_vector(rng, n, 3.0);
+        const Eigen::VectorXd qd = testing::random_vector(rng, n, 3.0);
+        const Eigen::VectorXd qdd = testing::random_vector(rng, n, 5.0);
+        for (const bool derivatives : {false, true}) {
+          passive_dynamics(m, data, q, qd, qdd, passive, derivatives, r.ext);
+          const Eigen::VectorXd out = data.qdd;
+          for (int j = 0; j < n; ++j) {
+            const bool is_passive = std::find(passive.begin(), passive.end(), j) != passive.end();
+            if (is_passive) {
+              EXPECT_NEAR(data.tau[j], 0.0, 1e-9) << r.label << " joint " << j;
+            } else {
+              EXPECT_EQ(out[j], qdd[j]) << r.label << " joint " << j;
+            }
+          }
+          // The same torques, mass matrix and derivatives as the separate algorithms at that q̈.
+          EXPECT_LT(relative_error(data.tau, rnea(m, reference, q, qd, out, r.ext)), 1e-10);
+          EXPECT_LT(relative_error(data.M, mass_matrix(m, reference, q)), 1e-12);
+          if (!derivatives) continue;
+          rnea_derivatives(m, reference, q, qd, out, r.ext);
+          EXPECT_LT(relative_error(data.dtau_dq, reference.dtau_dq), 1e-10) << r.label;
+          EXPECT_LT(relative_error(data.dtau_dqd, reference.dtau_dqd), 1e-10) << r.label;
+        }
+      }
+    }
+    // Every joint passive: forward dynamics with zero torque.
+    std::vector<int> all(n);
+    for (int j = 0; j < n; ++j) all[j] = j;
+    const Eigen::VectorXd q = testing::random_vector(rng, n, 3.0);
+    const Eigen::VectorXd qd = testing::random_vector(rng, n, 3.0);
+    passive_dynamics(m, data, q, qd, Eigen::VectorXd::Zero(n), all, false, r.ext);
+    EXPECT_TRUE(data.qdd.isApprox(
+        forward_dynamics(m, reference, q, qd, Eigen::VectorXd::Zero(n), r.ext), 1e-8))
+        << r.label;
   }
 }
 

@@ -24,6 +24,7 @@
 #include "kinograph/planning/formulation/initialization.h"
 #include "kinograph/planning/formulation/planning_graph.h"
 #include "kinograph/planning/incremental/incremental_planner.h"
+#include "kinograph/planning/interpolant.h"
 #include "kinograph/planning/io/scene.h"
 #include "kinograph/planning/replanner.h"
 #include "kinograph/planning/solver/augmented_lagrangian.h"
@@ -316,13 +317,13 @@ TEST(ValidationThresholds, Dynamics) {
 
 TEST(ValidationThresholds, PositionConsistency) {
   Still f;
-  f.plan.q.bottomRows(6).col(0).array() += 0.01;  // a 1 cm jump between steps 4 and 5
+  f.plan.q.bottomRows(6).col(0).array() += 0.0005;  // a 0.5 mrad jump between steps 4 and 5
   f.problem.goal.q = f.plan.q.bottomRows(1).transpose();
   f.plan.tau.setZero();
   ValidationThresholds t;
   t.dynamics = 1e3;  // τ is off: only the consistency check matters here
   ASSERT_FALSE(mentions(validate(f.problem, f.plan, t), "position consistency"));
-  t.position_consistency = 0.005;
+  t.position_consistency = 0.0002;
   EXPECT_TRUE(mentions(validate(f.problem, f.plan, t), "position consistency"));
 }
 
@@ -359,6 +360,9 @@ TEST(ValidationThresholds, UnactuatedTorque) {
   const Validation strict = validate(f.problem, f.plan);
   ASSERT_TRUE(mentions(strict, "unactuated"));
   ValidationThresholds t;
+  // The unpowered joint falls under gravity, away from the still plan: consistency is off too.
+  t.position_consistency = 1e3;
+  t.velocity_consistency = 1e3;
   t.unactuated_torque = 1e3;
   const Validation v = validate(f.problem, f.plan, t);
   EXPECT_TRUE(v.valid) << v.failures.front();
@@ -454,6 +458,43 @@ TEST(ValidationThresholds, CollisionSamples) {
   const Validation sparse = validate(p, plan, t);
   EXPECT_FALSE(mentions(sparse, "collision"));
   EXPECT_GT(sparse.min_clearance, 0.3);
+}
+
+TEST(ValidationThresholds, IntervalSamples) {
+  testing::FastRr f;  // joint 0's q̇ is 0.2 rad/s at the knots and 0.3 between knots 1, 2
+  f.limit_velocity(0.25);
+  ValidationThresholds t;
+  ASSERT_TRUE(mentions(validate(f.problem, f.plan, t), "velocity limit"));
+  t.interval_samples = 1;  // the knots only
+  const Validation v = validate(f.problem, f.plan, t);
+  EXPECT_TRUE(v.valid) << v.failures.front();
+}
+
+// ------------------------------------------------------------------------------------------
+// Objectives: the interior limit points of the planner's between-knot factor.
+
+TEST(Objectives, LimitSubstepsArePointsOfTheIntervalFactor) {
+  Problem p = rr_free();
+  const auto interval_rows = [&](int substeps) {
+    p.objectives.limit_substeps = substeps;
+    const PlanningGraph pg = build_graph(p, straight_line(p, p.goal.q));
+    int rows = 0, factors = 0;
+    for (const FactorEntry& e : pg.entries) {
+      if (e.key.role != FactorRole::kInterval) continue;
+      rows += e.factor->residual_dim();
+      ++factors;
+    }
+    EXPECT_EQ(factors, substeps > 0 ? p.steps : 0);
+    return rows;
+  };
+  // The RR arm: per point each joint's τ, q and q̇ bounds; no unactuated joint, no defect rows.
+  // Points are at least one per RK4 node of the interval (limit_points).
+  EXPECT_EQ(interval_rows(0), 0);
+  const int points = limit_points(3, p.dt());
+  EXPECT_GE(points, 3);
+  EXPECT_EQ(interval_rows(3), p.steps * points * 2 * 3);
+  const int many = points + 5;
+  EXPECT_EQ(interval_rows(many), p.steps * many * 2 * 3);
 }
 
 // ------------------------------------------------------------------------------------------

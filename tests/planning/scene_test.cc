@@ -64,6 +64,7 @@ objectives:
   collision_epsilon: 0.04
   limit_epsilon: 0.01
   collision_substeps: 3
+  limit_substeps: 4
 planner: {formulation: dfg, init: W, warm: )" +
          warm + R"(}
 camera: {eye: [3, 0, 1], target: [0, 0, 0.5]}
@@ -159,6 +160,7 @@ void expect_same_scene(const Scene& a, const Scene& b) {
   EXPECT_EQ(p.objectives.collision_epsilon, q.objectives.collision_epsilon);
   EXPECT_EQ(p.objectives.limit_epsilon, q.objectives.limit_epsilon);
   EXPECT_EQ(p.objectives.collision_substeps, q.objectives.collision_substeps);
+  EXPECT_EQ(p.objectives.limit_substeps, q.objectives.limit_substeps);
   EXPECT_EQ(a.planner.formulation, b.planner.formulation);
   EXPECT_EQ(a.planner.init, b.planner.init);
   EXPECT_EQ(a.planner.warm, b.planner.warm);
@@ -231,6 +233,7 @@ TEST_F(FullScene, EveryFieldReachesTheProblem) {
   EXPECT_EQ(p.objectives.collision_epsilon, 0.04);
   EXPECT_EQ(p.objectives.limit_epsilon, 0.01);
   EXPECT_EQ(p.objectives.collision_substeps, 3);
+  EXPECT_EQ(p.objectives.limit_substeps, 4);
   EXPECT_EQ(s.planner.formulation, "dfg");
   EXPECT_EQ(s.planner.init, "W");
   EXPECT_TRUE(fs::equivalent(s.planner.warm, warm_));

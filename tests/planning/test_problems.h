@@ -124,4 +124,47 @@ struct StillRr {
   }
 };
 
+// The RR arm from rest to rest over 3 intervals of 0.1 s with knot accelerations 0, A, −A, 0
+// on joint 0, knots from the collocation: consistent, and joint 0's q̇ peaks between knots 1
+// and 2 at 1.5 times its knot value hA/2 (0.3 vs 0.2 rad/s).
+struct FastRr {
+  Problem problem;
+  Plan plan;
+  FastRr() {
+    const double h = 0.1, A = 4;
+    problem.model = load_robot("robots/rr/rr.urdf");
+    problem.horizon = 3 * h;
+    problem.steps = 3;
+    const double a[4] = {0, A, -A, 0};
+    plan.q.setZero(4, 2);
+    plan.qd.setZero(4, 2);
+    plan.qdd.setZero(4, 2);
+    plan.tau.setZero(4, 2);
+    plan.q(0, 0) = 0.5;
+    plan.q.col(1).setConstant(-0.3);
+    for (int k = 0; k < 4; ++k) {
+      plan.t.push_back(h * k);
+      plan.qdd(k, 0) = a[k];
+      if (k == 0) continue;
+      plan.q(k, 0) = plan.q(k - 1, 0) + h * plan.qd(k - 1, 0) + h * h / 6 * (2 * a[k - 1] + a[k]);
+      plan.qd(k, 0) = plan.qd(k - 1, 0) + h / 2 * (a[k - 1] + a[k]);
+    }
+    dynamics::Data d(*problem.model);
+    for (int k = 0; k < 4; ++k) {
+      plan.tau.row(k) = dynamics::rnea(*problem.model, d, plan.q.row(k).transpose(),
+                                       plan.qd.row(k).transpose(), plan.qdd.row(k).transpose())
+                            .transpose();
+    }
+    problem.start_q = plan.q.row(0).transpose();
+    problem.start_qd = Eigen::Vector2d::Zero();
+    problem.goal.q = plan.q.row(3).transpose();
+  }
+  // The same robot with joint 0's velocity limit set to `limit`.
+  void limit_velocity(double limit) {
+    auto m = std::make_shared<dynamics::Model>(*problem.model);
+    m->bodies[0].limits.velocity = limit;
+    problem.model = m;
+  }
+};
+
 }  // namespace kinograph::planning::testing

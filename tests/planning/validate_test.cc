@@ -5,6 +5,7 @@
 
 #include "kinograph/dynamics/inverse_dynamics.h"
 #include "kinograph/dynamics/kinematics.h"
+#include "kinograph/planning/trajectory_sampler.h"
 
 #include "tests/planning/test_problems.h"
 
@@ -96,7 +97,7 @@ TEST(Validate, CatchesEachViolation) {
   }
   {
     Fixture f;
-    f.plan.q(5, 0) += 0.1;  // a jump in q alone breaks the position trapezoid
+    f.plan.q(5, 0) += 0.1;  // a jump in q: the interpolant of interval 4 misses knot 5
     const Validation v = validate(f.problem, f.plan);
     EXPECT_TRUE(mentions(v, "position consistency"));
   }
@@ -158,6 +159,101 @@ TEST(Validate, CatchesEachViolation) {
     f.plan.q.resize(3, 2);
     EXPECT_FALSE(validate(f.problem, f.plan).valid);
   }
+}
+
+using testing::FastRr;
+
+TEST(Validate, ChecksLimitsBetweenTheKnots) {
+  FastRr f;
+  const double v_knot = f.plan.qd.col(0).cwiseAbs().maxCoeff();  // hA/2 = 0.2 rad/s
+  ASSERT_NEAR(v_knot, 0.2, 1e-12);
+  const Validation ok = validate(f.problem, f.plan);
+  ASSERT_TRUE(ok.valid) << ok.failures.front();
+  EXPECT_LT(ok.max_position_consistency, 1e-12);
+  // Limit 0.25 rad/s: every knot is within it, the motion between knots 1 and 2 is not.
+  f.limit_velocity(0.25);
+  const Validation v = validate(f.problem, f.plan);
+  EXPECT_FALSE(v.valid);
+  ASSERT_EQ(v.failures.size(), 1u);
+  const std::string& why = v.failures.front();
+  EXPECT_NE(why.find("velocity limit"), std::string::npos) << why;
+  EXPECT_NE(why.find("joint 'joint1'"), std::string::npos) << why;
+  EXPECT_NE(why.find("between knots 1 and 2"), std::string::npos) << why;
+  // The peak is 0.3 rad/s at t = 0.15 s (the validator samples it at i·Δt/10).
+  EXPECT_NEAR(v.max_qd_violation, 0.05, 1e-9);
+  EXPECT_NE(why.find("t = 0.15 s"), std::string::npos) << why;
+}
+
+TEST(Validate, ChecksEffortBetweenTheKnots) {
+  // The RR arm's shoulder swept at a constant 2 rad/s (q̈ = 0, elbow still) through the angle
+  // of its largest gravity torque: the torque between the knots exceeds both knots' torques.
+  Problem problem = testing::rr_reach();
+  problem.obstacles.clear();
+  dynamics::Data d(*problem.model);
+  const auto gravity = [&](double q0) {
+    return std::abs(
+        dynamics::rnea(*problem.model, d, Eigen::Vector2d(q0, -0.3), Eigen::Vector2d(2, 0),
+                       Eigen::Vector2d::Zero())[0]);
+  };
+  double peak = 0;
+  for (double q0 = -M_PI; q0 < M_PI; q0 += 1e-3) peak = gravity(q0) > gravity(peak) ? q0 : peak;
+  problem.steps = 1;
+  problem.horizon = 0.2;
+  Plan plan;
+  plan.t = {0, 0.2};
+  plan.q.resize(2, 2);
+  plan.q << peak - 0.2, -0.3, peak + 0.2, -0.3;
+  plan.qd.resize(2, 2);
+  plan.qd << 2, 0, 2, 0;
+  plan.qdd.setZero(2, 2);
+  plan.tau.resize(2, 2);
+  for (int k = 0; k < 2; ++k) {
+    plan.tau.row(k) = dynamics::rnea(*problem.model, d, plan.q.row(k).transpose(),
+                                     plan.qd.row(k).transpose(), plan.qdd.row(k).transpose())
+                          .transpose();
+  }
+  problem.start_q = plan.q.row(0).transpose();
+  problem.start_qd = plan.qd.row(0).transpose();
+  problem.goal.q = plan.q.row(1).transpose();
+  const double knot = plan.tau.col(0).cwiseAbs().maxCoeff(), between = gravity(peak);
+  ASSERT_GT(between, knot + 0.01);
+  auto m = std::make_shared<dynamics::Model>(*problem.model);
+  m->bodies[0].limits.effort = 0.5 * (knot + between);
+  problem.model = m;
+  const Validation v = validate(problem, plan);
+  EXPECT_FALSE(v.valid);
+  EXPECT_EQ(v.max_tau_violation, 0);  // every knot is within the limit
+  EXPECT_NEAR(v.max_tau_violation_between, 0.5 * (between - knot), 1e-3 * between);
+  EXPECT_TRUE(mentions(v, "effort limit"));
+  EXPECT_TRUE(mentions(v, "between knots 0 and 1"));
+}
+
+TEST(Validate, UnactuatedJointMustFollowTheDynamics) {
+  // The Acrobot's shoulder between two knots that a cubic joins but the dynamics do not: the
+  // shooting defect (continuity of the interpolant into knot 1) rejects it.
+  Problem problem = testing::acrobot_swingup();
+  problem.steps = 1;
+  problem.horizon = 0.1;
+  Plan plan;
+  plan.t = {0, 0.1};
+  plan.q.setZero(2, 2);
+  plan.qd.setZero(2, 2);
+  plan.qdd.setZero(2, 2);
+  plan.tau.setZero(2, 2);
+  plan.q.row(0) << 0.3, 0;  // released from 0.3 rad: the shoulder falls, the plan says it rests
+  plan.q.row(1) << 0.3, 0;
+  problem.start_q = plan.q.row(0).transpose();
+  problem.goal.q = plan.q.row(1).transpose();
+  dynamics::Data d(*problem.model);
+  for (int k = 0; k < 2; ++k) {
+    plan.tau.row(k) = dynamics::rnea(*problem.model, d, plan.q.row(k).transpose(),
+                                     plan.qd.row(k).transpose(), plan.qdd.row(k).transpose())
+                          .transpose();
+  }
+  const Validation v = validate(problem, plan);
+  EXPECT_FALSE(v.valid);
+  EXPECT_TRUE(mentions(v, "consistency")) << (v.failures.empty() ? "" : v.failures.front());
+  EXPECT_TRUE(mentions(v, "joint 'shoulder'"));
 }
 
 }  // namespace

@@ -55,12 +55,18 @@ TEST_F(PlanScene, RobotTrajectoryAndObstaclesComeFromThePlanFile) {
   const dynamics::Model bare = dynamics::Model::from_urdf_file(std::string(KINOGRAPH_SOURCE_DIR) +
                                                                "/robots/iiwa14/iiwa14.urdf");
   EXPECT_EQ(scene.model->visual.size(), bare.visual.size() + 1);  // the payload box shows
-  ASSERT_EQ(scene.trajectory.t.size(), 7u);
-  ASSERT_EQ(scene.trajectory.q.size(), 7u);
-  for (std::size_t k = 0; k < 7; ++k) {
-    EXPECT_EQ(scene.trajectory.t[k], j["t"][k].get<double>());
-    for (int i = 0; i < 7; ++i) EXPECT_EQ(scene.trajectory.q[k][i], j["q"][k][i].get<double>());
+  // The plan's interpolant, kDrawnSamplesPerInterval points per interval: each interval's
+  // first point is its knot, and the last point is at the last knot's time.
+  const std::size_t per = kDrawnSamplesPerInterval;
+  ASSERT_EQ(scene.trajectory.t.size(), 6 * per + 1);
+  ASSERT_EQ(scene.trajectory.q.size(), 6 * per + 1);
+  for (std::size_t k = 0; k < 6; ++k) {
+    EXPECT_EQ(scene.trajectory.t[k * per], j["t"][k].get<double>());
+    for (int i = 0; i < 7; ++i) {
+      EXPECT_EQ(scene.trajectory.q[k * per][i], j["q"][k][i].get<double>());
+    }
   }
+  EXPECT_EQ(scene.trajectory.t.back(), j["t"][6].get<double>());
   ASSERT_EQ(scene.obstacles.size(), 2u);
   const SceneObstacle &desk = scene.obstacles[0], &ball = scene.obstacles[1];
   EXPECT_EQ(desk.name, "desk");

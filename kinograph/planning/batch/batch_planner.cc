@@ -8,6 +8,7 @@
 #include <optional>
 #include <sstream>
 
+#include "kinograph/planning/batch/interval_limits.h"
 #include "kinograph/planning/formulation/initialization.h"
 #include "kinograph/planning/solver/violation_text.h"
 
@@ -156,26 +157,112 @@ Plan BatchPlanner::plan(const Problem& problem, const Plan* warm, BatchSolution*
   return best;
 }
 
+namespace {
+
+// How close (a fraction of the limit) an interval's interpolant may come to a limit between
+// the knots before its interior limit points join the graph: close enough that few intervals
+// qualify, far enough that the re-solve rarely pushes an unlisted one over.
+constexpr double kNearLimit = 0.1;
+// Re-solves with more between-knot rows after the knot-only solve; each adds the intervals
+// the last one left near a limit, so few are ever needed.
+constexpr int kMaxIntervalRounds = 4;
+
+// Whether the problem's robot has joints that follow their dynamics between the knots.
+bool has_unactuated(const Problem& problem) {
+  for (const dynamics::Body& b : problem.model->bodies) {
+    if (!b.actuated) return true;
+  }
+  return false;
+}
+
+// Intervals whose interior limit points gain rows: the union of `flags` and `near`; returns
+// whether any was added.
+bool add_flags(std::vector<char>& flags, const std::vector<char>& near) {
+  bool added = false;
+  for (size_t k = 0; k < flags.size(); ++k) {
+    if (near[k] && !flags[k]) flags[k] = added = true;
+  }
+  return added;
+}
+
+// Carries the multipliers of every interval factor that gains rows (its defect rows come
+// first and keep their multipliers) into a record of the new size, which bind() then keeps.
+void grow_interval_records(ConstraintState& state, const PlanningGraph& pg) {
+  for (const FactorEntry* e : pg.constraints(false)) {
+    if (e->key.role != FactorRole::kInterval || !state.contains(e->key)) continue;
+    Multipliers& m = state.at(e->key);
+    const Eigen::Index rows = e->constrained->residual_dim(), kept = m.lower.size();
+    if (kept >= rows) continue;
+    Multipliers grown(static_cast<int>(rows), m.penalty);
+    grown.lower.head(kept) = m.lower;
+    grown.upper.head(kept) = m.upper;
+    m = std::move(grown);
+  }
+}
+
+}  // namespace
+
 Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init, const std::string& method,
                          BatchSolution* solution) const {
   const auto t0 = std::chrono::steady_clock::now();
   if (solution != nullptr) *solution = BatchSolution();  // empty unless the solve runs
+  // Between-knot rows by constraint generation: the knot-only graph first, then the intervals'
+  // dynamics (unactuated joints) and interior limit points only where the interpolant of the
+  // last solve comes near a limit, each re-solve warm from the last.
+  IntervalRows between;
+  between.knots_only = true;
+  between.limits.assign(static_cast<size_t>(problem.steps), 0);
+  const bool shooting = has_unactuated(problem);
   PlanningGraph pg;
-  std::vector<DfgConstraintStep> dfg_steps;
-  try {
-    pg = build_graph(problem, init, options_.graph);
-    if (options_.formulation == Formulation::kDynamicFactorGraph) {
-      dfg_steps = use_dfg_dynamics(pg, problem, options_.graph, options_.dfg);
-    }
-  } catch (const std::exception& e) {
-    Plan p = failed_plan(method, PlanStatus::kInvalidProblem, e.what());
-    return p;
-  }
-  const OuterLoopOptions loop =
-      dfg_steps.empty() ? options_.outer_loop : outer_loop_options(options_);
   ConstraintState state;
-  AugmentedLagrangian al(pg.constraints(false), state, options_.augmented_lagrangian);
-  OuterLoopResult r = solve_outer_loop(pg.graph, pg.values, al, loop, problem.name);
+  OuterLoopResult r;
+  for (int round = 0;; ++round) {
+    PlanningGraph next;
+    std::vector<DfgConstraintStep> dfg_steps;
+    try {
+      next = build_graph(problem, init, options_.graph, GraphForm::kBatch, between);
+      if (options_.formulation == Formulation::kDynamicFactorGraph) {
+        dfg_steps = use_dfg_dynamics(next, problem, options_.graph, options_.dfg);
+      }
+    } catch (const std::exception& e) {
+      Plan p = failed_plan(method, PlanStatus::kInvalidProblem, e.what());
+      return p;
+    }
+    if (round > 0) {
+      next.values = pg.values;  // the same variables: interval rows add none
+      grow_interval_records(state, next);
+    }
+    pg = std::move(next);
+    OuterLoopOptions loop = dfg_steps.empty() ? options_.outer_loop : outer_loop_options(options_);
+    loop.max_total_iterations -= r.iterations;  // one budget for all rounds
+    AugmentedLagrangian al(pg.constraints(false), state, options_.augmented_lagrangian);
+    // A re-solve starts feasible but for the rows just added: at the largest penalty it is a
+    // projection onto them (the multipliers carry the objective's balance), where a smaller one
+    // lets LM trade feasibility for the objective first and spend many more linearizations.
+    if (round > 0) state.set_penalty(options_.augmented_lagrangian.max_penalty);
+    const OuterLoopResult stage = solve_outer_loop(pg.graph, pg.values, al, loop, problem.name);
+    const int before = r.iterations, before_outer = r.outer_iterations,
+              before_solves = r.linear_solves;
+    r = stage;
+    r.iterations += before;
+    r.outer_iterations += before_outer;
+    r.linear_solves += before_solves;
+    spdlog::debug(
+        "{}: interval round {}: {} LM iterations, {}; {} of {} intervals with limit points",
+        problem.name, round, stage.iterations, to_string(stage.status),
+        std::count(between.limits.begin(), between.limits.end(), 1), problem.steps);
+    if (r.status == PlanStatus::kNonFinite || round == kMaxIntervalRounds ||
+        r.iterations >= options_.outer_loop.max_total_iterations) {
+      break;
+    }
+    const bool added = add_flags(
+        between.limits,
+        intervals_near_limits(problem, plan_from_values(problem, pg.values, options_.dfg.keys),
+                              kNearLimit));
+    const bool more_dynamics = between.knots_only && shooting;
+    if (!added && !more_dynamics) break;
+    between.knots_only = false;
+  }
   if (r.status == PlanStatus::kInfeasible) r.reason = infeasible_reason(problem, r);
 
   Plan plan = solved_plan(problem, pg, r, method, options_);

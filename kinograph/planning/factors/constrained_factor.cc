@@ -40,9 +40,42 @@ void ConstrainedFactor::penalty_changed() {
   penalty_read_ = m_->penalty;
 }
 
+namespace {
+// The factor whose evaluate() runs on this thread (jacobian_row_needed answers for it only).
+thread_local const ConstrainedFactor* evaluating = nullptr;
+
+// Marks `f` as evaluating for its lifetime (also when compute() throws).
+struct Evaluating {
+  explicit Evaluating(const ConstrainedFactor* f) { evaluating = f; }
+  ~Evaluating() { evaluating = nullptr; }
+  Evaluating(const Evaluating&) = delete;
+  Evaluating& operator=(const Evaluating&) = delete;
+};
+
+// The hinge terms of a bound row: a = √μ c_l + λ_l/√μ, b = √μ c_u + λ_u/√μ (on when positive).
+struct Hinge {
+  double a, b;
+};
+Hinge hinge(const RowSpec& row, double z, double sq, double lambda, double lambda_upper) {
+  return {sq * (row.lower - z) / row.scale + lambda / sq,
+          sq * (z - row.upper) / row.scale + lambda_upper / sq};
+}
+}  // namespace
+
+bool ConstrainedFactor::jacobian_row_needed(int row, double z) const {
+  const RowSpec& spec = rows_[static_cast<size_t>(row)];
+  if (evaluating != this || spec.kind != RowKind::kBounds) return true;
+  const Hinge h = m_ ? hinge(spec, z, std::sqrt(m_->penalty), m_->lower[row], m_->upper[row])
+                     : hinge(spec, z, 1.0, 0.0, 0.0);
+  return h.a > 0 || h.b > 0;
+}
+
 void ConstrainedFactor::evaluate(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> e,
                                  const graph::Jacobians* J) const {
-  compute(x, e, J);
+  {
+    const Evaluating guard(this);
+    compute(x, e, J);
+  }
   // An unbound factor reads μ = 1 and λ = 0 (per-thread zeros that only grow).
   thread_local Eigen::VectorXd zeros;
   if (!m_ && zeros.size() < residual_dim()) zeros.setZero(residual_dim());
@@ -68,10 +101,9 @@ void ConstrainedFactor::evaluate(const graph::FactorValues& x, Eigen::Ref<Eigen:
         e[i] = f[i] * (z - row.lower) + lambda[i] / sq;
         break;
       case RowKind::kBounds: {
-        const double a = sq * (row.lower - z) / row.scale + lambda[i] / sq;
-        const double b = sq * (z - row.upper) / row.scale + lambda_upper[i] / sq;
-        e[i] = std::max(0.0, a) - std::max(0.0, b);
-        f[i] = -(sq / row.scale) * ((a > 0 ? 1.0 : 0.0) + (b > 0 ? 1.0 : 0.0));
+        const Hinge h = hinge(row, z, sq, lambda[i], lambda_upper[i]);
+        e[i] = std::max(0.0, h.a) - std::max(0.0, h.b);
+        f[i] = -(sq / row.scale) * ((h.a > 0 ? 1.0 : 0.0) + (h.b > 0 ? 1.0 : 0.0));
         break;
       }
     }

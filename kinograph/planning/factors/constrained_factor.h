@@ -120,6 +120,10 @@ class ConstrainedFactor : public graph::Factor {
   Violation update_multipliers(const graph::Values& values, Multipliers& m) const;
 
  protected:
+  /// Whether compute() must fill row `row`'s Jacobian for raw value z: false only while
+  /// evaluate() runs and the row is a bound whose hinge is off under the bound multipliers
+  /// (its residual and Jacobian row are then zero whatever compute() writes).
+  bool jacobian_row_needed(int row, double z) const;
   /// For a subclass whose compute() is linear in the variables: with soft and equality rows only
   /// the whitened Jacobian is then constant between penalty changes (Factor::jacobian_version).
   /// Throws std::logic_error if a row is a bound.

@@ -4,6 +4,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
 #include <stdexcept>
+#include <string>
 
 namespace kinograph::planning {
 
@@ -62,39 +63,54 @@ void GpPriorFactor::evaluate(const graph::FactorValues& x, Eigen::Ref<Eigen::Vec
 }
 
 namespace {
-std::vector<RowSpec> collocation_rows(int n, double dt, double scale) {
-  std::vector<RowSpec> rows(2 * n);
-  for (int j = 0; j < n; ++j) {
-    rows[j].scale = scale * dt * dt;
-    rows[n + j].scale = scale * dt;
+std::vector<int> all_or(std::vector<int> joints, int n) {
+  if (joints.empty()) {
+    for (int j = 0; j < n; ++j) joints.push_back(j);
+  }
+  for (int j : joints) {
+    if (j < 0 || j >= n) throw std::invalid_argument("CollocationFactor: no joint " + std::to_string(j));
+  }
+  return joints;
+}
+
+std::vector<RowSpec> collocation_rows(int m, double dt, double scale) {
+  std::vector<RowSpec> rows(2 * m);
+  for (int i = 0; i < m; ++i) {
+    rows[i].scale = scale * dt * dt;
+    rows[m + i].scale = scale * dt;
   }
   return rows;
 }
 }  // namespace
 
-CollocationFactor::CollocationFactor(int k, int n, double dt, double scale)
-    : ConstrainedFactor(two_state_keys(k), std::vector<int>(6, n), collocation_rows(n, dt, scale)),
+CollocationFactor::CollocationFactor(int k, int n, double dt, double scale,
+                                     std::vector<int> joints)
+    : ConstrainedFactor(two_state_keys(k), std::vector<int>(6, n),
+                        collocation_rows(static_cast<int>(all_or(joints, n).size()), dt, scale)),
       n_(n),
-      dt_(dt) {
+      dt_(dt),
+      joints_(all_or(std::move(joints), n)) {
   declare_linear();
 }
 
 void CollocationFactor::compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
                                 const graph::Jacobians* J) const {
   const double h = dt_, h2 = dt_ * dt_;
-  z.head(n_) = x[3] - x[0] - h * x[1] - h2 / 6 * (2 * x[2] + x[5]);
-  z.tail(n_) = x[4] - x[1] - 0.5 * h * (x[2] + x[5]);
-  if (J == nullptr) return;
-  for (int j = 0; j < n_; ++j) {
-    J->block(0)(j, j) = -1;
-    J->block(1)(j, j) = -h;
-    J->block(2)(j, j) = -h2 / 3;
-    J->block(3)(j, j) = 1;
-    J->block(5)(j, j) = -h2 / 6;
-    J->block(1)(n_ + j, j) = -1;
-    J->block(2)(n_ + j, j) = -0.5 * h;
-    J->block(4)(n_ + j, j) = 1;
-    J->block(5)(n_ + j, j) = -0.5 * h;
+  const int m = static_cast<int>(joints_.size());
+  for (int i = 0; i < m; ++i) {
+    const int j = joints_[i];
+    z[i] = x[3][j] - x[0][j] - h * x[1][j] - h2 / 6 * (2 * x[2][j] + x[5][j]);
+    z[m + i] = x[4][j] - x[1][j] - 0.5 * h * (x[2][j] + x[5][j]);
+    if (J == nullptr) continue;
+    J->block(0)(i, j) = -1;
+    J->block(1)(i, j) = -h;
+    J->block(2)(i, j) = -h2 / 3;
+    J->block(3)(i, j) = 1;
+    J->block(5)(i, j) = -h2 / 6;
+    J->block(1)(m + i, j) = -1;
+    J->block(2)(m + i, j) = -0.5 * h;
+    J->block(4)(m + i, j) = 1;
+    J->block(5)(m + i, j) = -0.5 * h;
   }
 }
 
@@ -126,7 +142,8 @@ void StateLimitFactor::compute(const graph::FactorValues& x, Eigen::Ref<Eigen::V
 }
 
 std::string CollocationFactor::describe_row(int row, double, const RowContext& c) const {
-  const int j = row % n_, derivative = row < n_ ? 0 : 1;
+  const int m = static_cast<int>(joints_.size());
+  const int j = joints_[static_cast<size_t>(row % m)], derivative = row < m ? 0 : 1;
   return joint_label(c.model, j) + (derivative == 0 ? " position" : " velocity") + " between " +
          at_time(c.t) + " and " + number(c.t + c.dt) + " s disagrees with its " +
          (derivative == 0 ? "velocity and acceleration" : "acceleration") + " by " +

@@ -39,21 +39,22 @@ class GpPriorFactor final : public graph::Factor {
 
 /// Must-hold consistency of a piecewise-linear acceleration between states k and k+1:
 ///   q_{k+1} = q_k + q̇_k Δt + Δt²(2q̈_k + q̈_{k+1})/6,  q̇_{k+1} = q̇_k + Δt(q̈_k + q̈_{k+1})/2.
-/// Linear, 2n equality rows (q rows first). Keys as GpPriorFactor.
+/// Linear, two equality rows per joint of `joints` (q rows first). Keys as GpPriorFactor.
 class CollocationFactor final : public ConstrainedFactor {
  public:
   /// Rows are scaled by Δt² (positions) and Δt (velocities) so that both read as accelerations;
-  /// `scale` multiplies those.
-  CollocationFactor(int k, int n, double dt, double scale = 1.0);
+  /// `scale` multiplies those. `joints` are the joints that follow the cubic (empty: all n; the
+  /// unactuated ones follow the dynamics instead, IntervalDynamicsFactor). Throws
+  /// std::invalid_argument for a joint outside 0..n−1.
+  CollocationFactor(int k, int n, double dt, double scale = 1.0, std::vector<int> joints = {});
   void compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
                const graph::Jacobians* J) const override;
   std::string describe_row(int row, double z, const RowContext& c) const override;
-  /// Number of joints n (rows 0..n−1 are positions, n..2n−1 velocities).
-  int joints() const { return n_; }
 
  private:
   int n_;
   double dt_;
+  std::vector<int> joints_;
 };
 
 /// Box limits on one state's q, q̇, q̈ (the paper's c_limit as an inequality constraint): one

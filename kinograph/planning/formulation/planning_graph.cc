@@ -1,5 +1,6 @@
 #include "kinograph/planning/formulation/planning_graph.h"
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <stdexcept>
@@ -8,6 +9,7 @@
 #include "kinograph/dynamics/inverse_dynamics.h"
 #include "kinograph/planning/clearance_world.h"
 #include "kinograph/planning/factors/dynamics_factors.h"
+#include "kinograph/planning/factors/interval_factors.h"
 #include "kinograph/planning/factors/pose_factors.h"
 #include "kinograph/planning/factors/state_target_factor.h"
 #include "kinograph/planning/factors/trajectory_factors.h"
@@ -130,16 +132,45 @@ FactorEntry make_soft_entry(graph::FactorPtr soft_factor, FactorKey key) {
   return e;
 }
 
-std::vector<FactorEntry> timing_entries(const Problem& problem, const GraphOptions& options) {
+std::vector<FactorEntry> timing_entries(const Problem& problem, const GraphOptions& options,
+                                        const IntervalRows& rows) {
   std::vector<FactorEntry> out;
-  const int n = problem.model->nq();
+  const dynamics::Model& model = *problem.model;
+  const int n = model.nq();
   const double dt = problem.dt();
+  if (!rows.limits.empty() && static_cast<int>(rows.limits.size()) != problem.steps) {
+    throw std::invalid_argument("interval rows: " + std::to_string(rows.limits.size()) +
+                                " limit flags for " + std::to_string(problem.steps) +
+                                " intervals");
+  }
+  std::vector<int> cubic;  // joints on the collocation cubic
+  for (int j = 0; j < n; ++j) {
+    if (rows.knots_only || model.bodies[j].actuated) cubic.push_back(j);
+  }
+  IntervalDynamicsOptions between;
+  between.limit_epsilon = problem.objectives.limit_epsilon;
+  between.defect_scale = options.collocation_scale;
+  between.torque_scale = options.torque_scale;
+  between.limit_scale = options.limit_scale;
+  IntervalDynamicsOptions without_limits = between;
+  between.checks = limit_points(problem.objectives.limit_substeps, dt);
+  const bool has_between = !IntervalDynamicsFactor::layout(model, between).empty();
+  const bool has_defect = !IntervalDynamicsFactor::layout(model, without_limits).empty();
   for (int k = 0; k < problem.steps; ++k) {
     out.push_back(make_soft_entry(std::make_shared<GpPriorFactor>(k, n, dt, problem.objectives.qc),
-                             {FactorRole::kGpPrior, k}));
-    out.push_back(make_entry(
-        std::make_shared<CollocationFactor>(k, n, dt, options.collocation_scale),
-        {FactorRole::kCollocation, k}));
+                                  {FactorRole::kGpPrior, k}));
+    if (!cubic.empty()) {
+      out.push_back(
+          make_entry(std::make_shared<CollocationFactor>(k, n, dt, options.collocation_scale, cubic),
+                     {FactorRole::kCollocation, k}));
+    }
+    if (rows.knots_only) continue;
+    const bool limits = rows.limits.empty() || rows.limits[k] != 0;
+    if (limits ? has_between : has_defect) {
+      out.push_back(make_entry(std::make_shared<IntervalDynamicsFactor>(
+                                   k, dt, problem.model, limits ? between : without_limits),
+                               {FactorRole::kInterval, k}));
+    }
   }
   return out;
 }
@@ -237,7 +268,8 @@ FactorEntry goal_entry(const Problem& problem, const std::shared_ptr<dynamics::D
 }
 
 PlanningGraph build_graph(const Problem& problem, const Trajectory& init,
-                          const GraphOptions& options, GraphForm form) {
+                          const GraphOptions& options, GraphForm form,
+                          const IntervalRows& between) {
   if (!problem.model) throw std::invalid_argument("problem has no model");
   const int n = problem.model->nq(), N = problem.steps;
   if (init.q.rows() != N + 1 || init.q.cols() != n || init.qd.rows() != N + 1 ||
@@ -254,7 +286,7 @@ PlanningGraph build_graph(const Problem& problem, const Trajectory& init,
   const bool with_collision = !problem.obstacles.empty() && !problem.model->collision.empty();
   if (form == GraphForm::kBatch) {
     if (pose_goal) pg.add(goal_entry(problem, pg.dynamics_workspace, options));
-    for (FactorEntry& e : timing_entries(problem, options)) pg.add(std::move(e));
+    for (FactorEntry& e : timing_entries(problem, options, between)) pg.add(std::move(e));
     add_state_factors(pg, problem, options);
     if (with_collision) {
       auto ctx = collision_context(problem, problem.obstacles, options);
@@ -265,7 +297,7 @@ PlanningGraph build_graph(const Problem& problem, const Trajectory& init,
     add_task_factors(pg, problem, options);
     return pg;
   }
-  for (FactorEntry& e : timing_entries(problem, options)) pg.add(std::move(e));
+  for (FactorEntry& e : timing_entries(problem, options, between)) pg.add(std::move(e));
   add_state_factors(pg, problem, options);
   for (FactorEntry& e : self_collision_entries(problem, options)) pg.add(std::move(e));
   add_task_factors(pg, problem, options);

@@ -36,7 +36,8 @@ enum class FactorRole {
   kStart,        ///< prior on (q_0, q̇_0) (incremental form; the batch form fixes them)
   kGoal,         ///< joint goal on q_N (incremental form) or pose goal (both forms)
   kGpPrior,      ///< GP prior of interval k (depends on Δt)
-  kCollocation,  ///< collocation of interval k (depends on Δt)
+  kCollocation,  ///< collocation of interval k's actuated joints (depends on Δt)
+  kInterval,     ///< interval k's dynamics between the knots: shooting defect, interior limits
   kLimits,       ///< q, q̇, q̈ limits of state k
   kDynamics,     ///< equations of motion and torque rows of state k
   kCollision,    ///< hinges of state k (sub-step s) against one obstacle or all of them
@@ -63,7 +64,8 @@ struct FactorKey {
   /// Whether the factor depends on the time step Δt (replaced when the horizon changes).
   bool depends_on_dt() const {
     return role == FactorRole::kGpPrior || role == FactorRole::kCollocation ||
-           role == FactorRole::kCollision || role == FactorRole::kSelfCollision;
+           role == FactorRole::kInterval || role == FactorRole::kCollision ||
+           role == FactorRole::kSelfCollision;
   }
 };
 
@@ -86,6 +88,18 @@ enum class GraphForm {
   /// Start and joint goal as anchor factors, collision factors per obstacle (an obstacle
   /// change then replaces only its own factors).
   kIncremental,
+};
+
+/// Which between-knot rows (IntervalDynamicsFactor, docs/interpolation.md) a graph holds. The
+/// batch planner solves the knot-only graph first and adds these where the interpolant needs
+/// them; every other graph holds all of them (the default).
+struct IntervalRows {
+  /// No interval factors: every joint on the collocation cubic and limits at the knots only
+  /// (unactuated joints then follow the cubic too, so the plan holds only at its knots).
+  bool knots_only = false;
+  /// Per interval, whether its interior limit points are enforced; empty = on every interval.
+  /// Intervals without them keep the unactuated joints' shooting defect.
+  std::vector<char> limits;
 };
 
 /// A built planning graph: the role table, the factor graph of its non-anchor factors, the
@@ -113,14 +127,18 @@ struct PlanningGraph {
 /// goal) or its velocity and acceleration (pose goal). Throws std::invalid_argument or
 /// std::out_of_range for inconsistent input (sizes, unknown frames, repeated obstacle ids).
 PlanningGraph build_graph(const Problem& problem, const Trajectory& init,
-                          const GraphOptions& options = {}, GraphForm form = GraphForm::kBatch);
+                          const GraphOptions& options = {}, GraphForm form = GraphForm::kBatch,
+                          const IntervalRows& between = {});
 
 /// An entry for a constraint factor (or, make_soft_entry, a plain one) under `key`.
 FactorEntry make_entry(std::shared_ptr<ConstrainedFactor> factor, FactorKey key);
 FactorEntry make_soft_entry(graph::FactorPtr soft_factor, FactorKey key);
 
-/// The GP prior and collocation of every interval for the problem's Δt, interval by interval.
-std::vector<FactorEntry> timing_entries(const Problem& problem, const GraphOptions& options);
+/// The GP prior, collocation and between-knot dynamics (those of `between`) of every interval
+/// for the problem's Δt, interval by interval. Throws std::invalid_argument if `between.limits`
+/// is neither empty nor one entry per interval.
+std::vector<FactorEntry> timing_entries(const Problem& problem, const GraphOptions& options,
+                                        const IntervalRows& between = {});
 /// The collision hinges of every free state and sub-step against the obstacles of `context`,
 /// keyed by `obstacle` (an id, or −1 for a context of all obstacles).
 std::vector<FactorEntry> collision_entries(const Problem& problem,

@@ -231,7 +231,7 @@ Eigen::MatrixXd read_rows(const json& j, const char* key, const std::string& sou
 }
 
 // The figures of a validation by their plan-file keys, in file order.
-std::array<std::pair<const char*, double*>, 13> validation_figures(Validation& v) {
+std::array<std::pair<const char*, double*>, 15> validation_figures(Validation& v) {
   return {{{"max_dynamics_residual", &v.max_dynamics_residual},
            {"max_position_consistency", &v.max_position_consistency},
            {"max_velocity_consistency", &v.max_velocity_consistency},
@@ -239,6 +239,8 @@ std::array<std::pair<const char*, double*>, 13> validation_figures(Validation& v
            {"max_qd_violation", &v.max_qd_violation},
            {"max_qdd_violation", &v.max_qdd_violation},
            {"max_tau_violation", &v.max_tau_violation},
+           {"max_tau_violation_between", &v.max_tau_violation_between},
+           {"max_unactuated_torque_between", &v.max_unactuated_torque_between},
            {"min_clearance", &v.min_clearance},
            {"goal_error", &v.goal_error},
            {"max_task_error", &v.max_task_error},
@@ -344,6 +346,8 @@ std::string summarize(const Validation& v) {
               {"max qdd limit violation", v.max_qdd_violation, "rad/s²"},
               {"max tau limit violation", v.max_tau_violation, "N·m"},
               {"max unactuated torque", v.max_unactuated_torque, "N·m"},
+              {"max tau limit violation between knots", v.max_tau_violation_between, "N·m"},
+              {"max unactuated torque between knots", v.max_unactuated_torque_between, "N·m"},
               {"min clearance", v.min_clearance, "m"},
               {"goal error", v.goal_error, ""},
               {"max task error", v.max_task_error, ""},

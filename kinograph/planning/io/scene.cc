@@ -557,7 +557,7 @@ class SceneParser {
   void parse_objectives(const YAML::Node& node, Objectives& o) {
     r_.expect_map(node, "objectives",
                   {"min_torque", "qc", "collision_epsilon", "limit_epsilon", "collision_substeps",
-                   "self_collision_epsilon"});
+                   "self_collision_epsilon", "limit_substeps"});
     if (node["min_torque"]) {
       o.min_torque = r_.non_negative(node["min_torque"], "objectives.min_torque");
     }
@@ -578,6 +578,12 @@ class SceneParser {
           r_.integer(node["collision_substeps"], "objectives.collision_substeps");
       if (o.collision_substeps < 0) {
         r_.fail(node["collision_substeps"], "objectives.collision_substeps", "must be >= 0");
+      }
+    }
+    if (node["limit_substeps"]) {
+      o.limit_substeps = r_.integer(node["limit_substeps"], "objectives.limit_substeps");
+      if (o.limit_substeps < 0) {
+        r_.fail(node["limit_substeps"], "objectives.limit_substeps", "must be >= 0");
       }
     }
   }
@@ -860,6 +866,7 @@ std::string scene_to_yaml(const Scene& scene) {
   out << YAML::Key << "limit_epsilon" << YAML::Value << o.limit_epsilon;
   out << YAML::Key << "collision_substeps" << YAML::Value << o.collision_substeps;
   out << YAML::Key << "self_collision_epsilon" << YAML::Value << o.self_collision_epsilon;
+  out << YAML::Key << "limit_substeps" << YAML::Value << o.limit_substeps;
   out << YAML::EndMap;
   out << YAML::Key << "planner" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "formulation" << YAML::Value << scene.planner.formulation;

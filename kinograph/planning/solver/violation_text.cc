@@ -9,9 +9,16 @@ namespace kinograph::planning {
 namespace {
 
 // The user's name of each role, in FactorRole's declaration order.
-constexpr const char* kRoleNames[] = {"start",       "goal",   "smoothness prior",
-                                      "collocation", "limits", "equations of motion",
-                                      "collision",   "task constraint", "self-collision"};
+constexpr const char* kRoleNames[] = {"start",
+                                      "goal",
+                                      "smoothness prior",
+                                      "collocation",
+                                      "dynamics between the knots",
+                                      "limits",
+                                      "equations of motion",
+                                      "collision",
+                                      "task constraint",
+                                      "self-collision"};
 static_assert(std::size(kRoleNames) == static_cast<size_t>(FactorRole::kSelfCollision) + 1,
               "one name per role: a new role needs its name here");
 

@@ -1,0 +1,159 @@
+#include "kinograph/planning/factors/interval_factors.h"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "kinograph/planning/factors/trajectory_factors.h"
+#include "kinograph/planning/user_terms.h"
+
+namespace kinograph::planning {
+namespace {
+
+std::vector<RowSpec> row_specs(const dynamics::Model& model, double dt,
+                               const IntervalDynamicsOptions& o) {
+  using Kind = IntervalDynamicsFactor::Row::Kind;
+  std::vector<RowSpec> rows;
+  for (const IntervalDynamicsFactor::Row& r : IntervalDynamicsFactor::layout(model, o)) {
+    const dynamics::JointLimits& l = model.bodies[r.joint].limits;
+    const double e = o.limit_epsilon;
+    RowSpec spec;
+    switch (r.kind) {
+      case Kind::kDefectQ: spec.scale = o.defect_scale * dt * dt; break;
+      case Kind::kDefectQd: spec.scale = o.defect_scale * dt; break;
+      case Kind::kTau: {
+        const double m = std::max(0.0, l.effort - e);
+        spec = {RowKind::kBounds, -m, m, o.torque_scale};
+        break;
+      }
+      case Kind::kQ: spec = {RowKind::kBounds, l.lower + e, l.upper - e, o.limit_scale}; break;
+      case Kind::kQd:
+        spec = {RowKind::kBounds, -l.velocity + e, l.velocity - e, o.limit_scale};
+        break;
+    }
+    rows.push_back(spec);
+  }
+  if (rows.empty()) throw std::invalid_argument("IntervalDynamicsFactor would have no rows");
+  return rows;
+}
+
+}  // namespace
+
+std::vector<IntervalDynamicsFactor::Row> IntervalDynamicsFactor::layout(
+    const dynamics::Model& model, const IntervalDynamicsOptions& o) {
+  std::vector<Row> rows;
+  for (int j = 0; j < model.nq(); ++j) {
+    if (!model.bodies[j].actuated) rows.push_back({Row::Kind::kDefectQ, j, -1});
+  }
+  for (int j = 0; j < model.nq(); ++j) {
+    if (!model.bodies[j].actuated) rows.push_back({Row::Kind::kDefectQd, j, -1});
+  }
+  for (int i = 0; i < o.checks; ++i) {
+    for (int j = 0; j < model.nq(); ++j) {
+      const dynamics::Body& b = model.bodies[j];
+      if (b.actuated && std::isfinite(b.limits.effort)) rows.push_back({Row::Kind::kTau, j, i});
+      if (std::isfinite(b.limits.lower) || std::isfinite(b.limits.upper))
+        rows.push_back({Row::Kind::kQ, j, i});
+      if (std::isfinite(b.limits.velocity)) rows.push_back({Row::Kind::kQd, j, i});
+    }
+  }
+  return rows;
+}
+
+IntervalDynamicsFactor::IntervalDynamicsFactor(int k, double dt,
+                                               std::shared_ptr<const dynamics::Model> model,
+                                               const IntervalDynamicsOptions& options)
+    : ConstrainedFactor({q_key(k), v_key(k), a_key(k), q_key(k + 1), v_key(k + 1), a_key(k + 1)},
+                        std::vector<int>(6, model->nq()),
+                        (dt > 0 ? row_specs(*model, dt, options)
+                                : throw std::invalid_argument("IntervalDynamicsFactor: dt <= 0"))),
+      model_(std::move(model)),
+      dt_(dt),
+      layout_(layout(*model_, options)),
+      interpolant_(*model_) {
+  for (int i = 1; i <= options.checks; ++i) times_.push_back(dt * i / (options.checks + 1));
+  times_.push_back(dt);
+  points_.resize(times_.size());
+  while (defect_rows_ < static_cast<int>(layout_.size()) && layout_[defect_rows_].point < 0) {
+    ++defect_rows_;
+  }
+  int row = defect_rows_;
+  for (int i = 0; i < options.checks; ++i) {
+    point_begin_.push_back(row);
+    while (row < static_cast<int>(layout_.size()) && layout_[row].point == i) ++row;
+  }
+  point_begin_.push_back(row);
+}
+
+void IntervalDynamicsFactor::jacobian_row(int row, const Eigen::MatrixXd& d, double sign,
+                                          const graph::Jacobians& J) const {
+  const int n = model_->nq(), j = layout_[static_cast<size_t>(row)].joint;
+  // d's blocks 0, 1, 2 are q_k, q̇_k, q̈_k; its fourth, q̈_{k+1}, is key 5.
+  const int key_of[4] = {0, 1, 2, 5};
+  for (int b = 0; b < 4; ++b) J.block(key_of[b]).row(row) += sign * d.block(j, b * n, 1, n);
+}
+
+void IntervalDynamicsFactor::compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
+                                     const graph::Jacobians* J) const {
+  using Kind = Row::Kind;
+  const int checks = static_cast<int>(times_.size()) - 1;
+  // The defect needs the sensitivities to the end; check points only if a row of theirs is on.
+  const bool derivatives = J != nullptr;
+  interpolant_.start(x[0], x[1], x[2], x[5], dt_, derivatives);
+  for (int i = 0; i < checks; ++i) interpolant_.at(times_[i], false, points_[i]);
+  // The value of a row at a point.
+  const auto value = [&](const Row& r, const InterpolantPoint& p) {
+    switch (r.kind) {
+      case Kind::kTau: return p.tau[r.joint];
+      case Kind::kQ: return p.q[r.joint];
+      default: return p.qd[r.joint];
+    }
+  };
+  // Defect rows come in unactuated() order, positions first: row i reads y[i] and S.row(i).
+  const Eigen::VectorXd& y = interpolant_.end_state();
+  for (int row = 0; row < defect_rows_; ++row) {
+    const Row& r = layout_[row];
+    const int block = r.kind == Kind::kDefectQ ? 3 : 4;
+    z[row] = x[block][r.joint] - y[row];
+    if (!derivatives) continue;
+    J->block(block)(row, r.joint) = 1;
+    const Eigen::MatrixXd& S = interpolant_.end_sensitivity();
+    const int n = model_->nq(), key_of[4] = {0, 1, 2, 5};
+    for (int b = 0; b < 4; ++b) J->block(key_of[b]).row(row) -= S.block(row, b * n, 1, n);
+  }
+  for (int i = 0; i < checks; ++i) {
+    bool needed = false;
+    for (int row = point_begin_[i]; row < point_begin_[i + 1]; ++row) {
+      z[row] = value(layout_[row], points_[i]);
+      needed = needed || (derivatives && jacobian_row_needed(row, z[row]));
+    }
+    if (!needed) continue;
+    interpolant_.at(times_[i], true, with_derivatives_);
+    for (int row = point_begin_[i]; row < point_begin_[i + 1]; ++row) {
+      if (!jacobian_row_needed(row, z[row])) continue;
+      const Kind kind = layout_[row].kind;
+      jacobian_row(row,
+                   kind == Kind::kTau  ? with_derivatives_.dtau
+                   : kind == Kind::kQ ? with_derivatives_.dq
+                                      : with_derivatives_.dqd,
+                   1, *J);
+    }
+  }
+}
+
+std::string IntervalDynamicsFactor::describe_row(int row, double z, const RowContext& c) const {
+  const Row& r = layout_[static_cast<size_t>(row)];
+  const RowSpec& spec = rows()[static_cast<size_t>(row)];
+  if (r.kind == Row::Kind::kDefectQ || r.kind == Row::Kind::kDefectQd) {
+    const int derivative = r.kind == Row::Kind::kDefectQ ? 0 : 1;
+    return joint_label(c.model, r.joint) + ", unactuated, follows its dynamics from " +
+           at_time(c.t) + " and arrives at " + at_time(c.t + dt_) + " " + number(c.violation) +
+           " " + joint_unit(c.model, r.joint, derivative) + " off the next knot's " +
+           (derivative == 0 ? "position" : "velocity");
+  }
+  const double t = c.t + times_[static_cast<size_t>(r.point)];
+  const int derivative = r.kind == Row::Kind::kQ ? 0 : r.kind == Row::Kind::kQd ? 1 : 3;
+  return limit_text(c.model, derivative, r.joint, z, spec.lower, spec.upper, c.violation, t) +
+         " (between the knots)";
+}
+
+}  // namespace kinograph::planning

@@ -1,0 +1,314 @@
+// The plan's interpolant and the between-knot factor: the cubic of the actuated joints, the
+// unactuated joints following the dynamics (checked by inverse dynamics on numerically
+// differentiated samples and by executing the plan's own torques through forward dynamics),
+// and the IntervalDynamicsFactor's Jacobians against central differences.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "kinograph/dynamics/inverse_dynamics.h"
+#include "kinograph/graph/testing/numerical_jacobian.h"
+#include "kinograph/planning/factors/interval_factors.h"
+#include "kinograph/planning/factors/trajectory_factors.h"
+#include "kinograph/planning/interpolant.h"
+#include "kinograph/planning/trajectory_sampler.h"
+#include "test_problems.h"
+
+namespace kinograph::planning {
+namespace {
+
+using graph::testing::check_jacobians;
+using testing::load_robot;
+
+// A random interval: knot k, accelerations at both ends, and knot k+1 from the collocation
+// (so the actuated joints' cubic meets it); the unactuated joints' k+1 values are random.
+graph::Values random_interval(int n, double dt, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-1, 1);
+  const auto rnd = [&] {
+    Eigen::VectorXd v(n);
+    for (int j = 0; j < n; ++j) v[j] = u(rng);
+    return v;
+  };
+  const Eigen::VectorXd q0 = rnd(), v0 = rnd(), a0 = rnd(), a1 = rnd();
+  graph::Values x;
+  x.insert(q_key(0), q0);
+  x.insert(v_key(0), v0);
+  x.insert(a_key(0), a0);
+  x.insert(q_key(1), Eigen::VectorXd(q0 + dt * v0 + dt * dt / 6 * (2 * a0 + a1)));
+  x.insert(v_key(1), Eigen::VectorXd(v0 + dt / 2 * (a0 + a1)));
+  x.insert(a_key(1), a1);
+  return x;
+}
+
+TEST(Interpolant, IntegrationStepsFollowTheLongestStep) {
+  EXPECT_EQ(integration_steps(0.1), 10);
+  EXPECT_EQ(integration_steps(0.2), 20);
+  EXPECT_EQ(integration_steps(0.025), 3);
+  EXPECT_EQ(integration_steps(1e-4), 1);
+}
+
+TEST(Interpolant, FullyActuatedIsTheCollocationCubic) {
+  const auto model = load_robot("robots/rr/rr.urdf");
+  std::mt19937 rng(3);
+  const double dt = 0.1;
+  const graph::Values x = random_interval(2, dt, rng);
+  IntervalInterpolant interp(*model);
+  std::vector<InterpolantPoint> p;
+  interp.evaluate(x.at(q_key(0)), x.at(v_key(0)), x.at(a_key(0)), x.at(a_key(1)), dt,
+                  {0.0, 0.03, dt}, false, p);
+  EXPECT_LT((p[0].q - x.at(q_key(0))).norm(), 1e-14);
+  EXPECT_LT((p[2].q - x.at(q_key(1))).norm(), 1e-12);
+  EXPECT_LT((p[2].qd - x.at(v_key(1))).norm(), 1e-12);
+  EXPECT_LT((p[2].qdd - x.at(a_key(1))).norm(), 1e-12);
+  // q̈ is linear between the knots; τ is the computed torque there.
+  const Eigen::VectorXd a = 0.7 * x.at(a_key(0)) + 0.3 * x.at(a_key(1));
+  EXPECT_LT((p[1].qdd - a).norm(), 1e-12);
+  dynamics::Data data(*model);
+  EXPECT_LT((p[1].tau - dynamics::rnea(*model, data, p[1].q, p[1].qd, p[1].qdd)).norm(), 1e-12);
+}
+
+// Samples a plan's interpolant on a fine grid inside every interval, takes q̇ and q̈ by central
+// differences of the sampled q alone, and returns the worst |τ_u| by RNEA: independent of the
+// interpolant's own q̇, q̈.
+double worst_unactuated_torque_numeric(const dynamics::Model& model, const Plan& plan) {
+  TrajectorySampler sampler(model, plan);
+  dynamics::Data data(model);
+  double worst = 0;
+  for (int k = 0; k < sampler.intervals(); ++k) {
+    const double dt = sampler.interval_length(k), e = dt / 200;
+    for (int i = 0; i < 10; ++i) {
+      const double t = plan.t[k] + (i + 0.5) / 10 * dt;
+      const Eigen::VectorXd qm = sampler.at(t - e).q, q0 = sampler.at(t).q,
+                            qp = sampler.at(t + e).q;
+      const Eigen::VectorXd qd = (qp - qm) / (2 * e), qdd = (qp - 2 * q0 + qm) / (e * e);
+      const Eigen::VectorXd& tau = dynamics::rnea(model, data, q0, qd, qdd);
+      for (int j = 0; j < model.nq(); ++j) {
+        if (!model.bodies[j].actuated) worst = std::max(worst, std::abs(tau[j]));
+      }
+    }
+  }
+  return worst;
+}
+
+// A two-knot Acrobot plan whose knot 1 is where the interpolant arrives.
+Plan consistent_acrobot_interval(const dynamics::Model& model, double dt, std::mt19937& rng) {
+  const graph::Values x = random_interval(2, dt, rng);
+  Plan plan;
+  plan.t = {0.0, dt};
+  plan.q.resize(2, 2);
+  plan.qd.resize(2, 2);
+  plan.qdd.resize(2, 2);
+  plan.tau.setZero(2, 2);
+  plan.q.row(0) = x.at(q_key(0)).transpose();
+  plan.qd.row(0) = x.at(v_key(0)).transpose();
+  plan.qdd.row(0) = x.at(a_key(0)).transpose();
+  plan.qdd.row(1) = x.at(a_key(1)).transpose();
+  IntervalInterpolant interp(model);
+  std::vector<InterpolantPoint> p;
+  interp.evaluate(plan.q.row(0).transpose(), plan.qd.row(0).transpose(),
+                  plan.qdd.row(0).transpose(), plan.qdd.row(1).transpose(), dt, {dt}, false, p);
+  plan.q.row(1) = p[0].q.transpose();
+  plan.qd.row(1) = p[0].qd.transpose();
+  return plan;
+}
+
+TEST(Interpolant, UnactuatedJointFollowsTheDynamics) {
+  const auto model = testing::acrobot_model();
+  ASSERT_FALSE(model->bodies[0].actuated);
+  std::mt19937 rng(5);
+  for (int trial = 0; trial < 5; ++trial) {
+    const Plan plan = consistent_acrobot_interval(*model, 0.1, rng);
+    EXPECT_LT(worst_unactuated_torque_numeric(*model, plan), 1e-3) << "trial " << trial;
+  }
+}
+
+TEST(Interpolant, ComputedTorqueExecutesThePlan) {
+  // The executor's contract: apply τ_a(t) of the interpolant, nothing on the shoulder, and the
+  // true Acrobot (forward dynamics, fine RK4) stays on the interpolant.
+  const auto model = testing::acrobot_model();
+  std::mt19937 rng(11);
+  const double dt = 0.2;
+  const Plan plan = consistent_acrobot_interval(*model, dt, rng);
+  TrajectorySampler sampler(*model, plan);
+  dynamics::Data data(*model);
+  const auto f = [&](double t, const Eigen::VectorXd& x) {
+    Eigen::VectorXd tau = sampler.at(t).tau;
+    tau[0] = 0;
+    Eigen::VectorXd dx(4);
+    dx << x.tail(2), dynamics::forward_dynamics(*model, data, x.head(2), x.tail(2), tau);
+    return dx;
+  };
+  Eigen::VectorXd x(4);
+  x << plan.q.row(0).transpose(), plan.qd.row(0).transpose();
+  const int steps = 2000;
+  const double h = dt / steps;
+  double worst = 0;
+  for (int i = 0; i < steps; ++i) {
+    const double t = i * h;
+    const Eigen::VectorXd k1 = f(t, x), k2 = f(t + h / 2, x + h / 2 * k1),
+                          k3 = f(t + h / 2, x + h / 2 * k2), k4 = f(t + h, x + h * k3);
+    x += h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+    const InterpolantPoint p = sampler.at(std::min(t + h, dt - 1e-12));
+    worst = std::max(worst, (x.head(2) - p.q).cwiseAbs().maxCoeff());
+  }
+  EXPECT_LT(worst, 1e-6);
+}
+
+TEST(Interpolant, SamplerRefusesPlansThatDoNotFit) {
+  const auto model = testing::acrobot_model();
+  std::mt19937 rng(1);
+  Plan plan = consistent_acrobot_interval(*model, 0.1, rng);
+  plan.t = {0.0, 0.0};
+  EXPECT_THROW(TrajectorySampler(*model, plan), std::invalid_argument);
+  plan.t = {0.0, 0.1};
+  plan.qd.resize(2, 3);
+  EXPECT_THROW(TrajectorySampler(*model, plan), std::invalid_argument);
+}
+
+// The factor's raw rows z (compute(), not the hinged residual, which is zero for rows inside
+// their bounds) as a factor of their own, so their Jacobians are checked against central
+// differences row by row.
+class RawRows final : public graph::Factor {
+ public:
+  explicit RawRows(const ConstrainedFactor& f)
+      : graph::Factor(f.keys(), f.dims(), f.residual_dim()), f_(f) {}
+  void evaluate(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> e,
+                const graph::Jacobians* J) const override {
+    f_.compute(x, e, J);
+  }
+
+ private:
+  const ConstrainedFactor& f_;
+};
+
+// A random interval with the unactuated joints' knot k+1 moved off the defect's zero.
+graph::Values off_defect_interval(int n, double dt, std::mt19937& rng) {
+  graph::Values x = random_interval(n, dt, rng);
+  x.update(q_key(1), Eigen::VectorXd(x.at(q_key(1)) + Eigen::VectorXd::Constant(n, 0.05)));
+  return x;
+}
+
+void expect_raw_jacobians(std::shared_ptr<const dynamics::Model> model, int checks,
+                          unsigned seed) {
+  IntervalDynamicsOptions o;
+  o.checks = checks;
+  const double dt = 0.1;
+  IntervalDynamicsFactor f(0, dt, model, o);
+  std::mt19937 rng(seed);
+  for (int trial = 0; trial < 3; ++trial) {
+    const graph::Values x = off_defect_interval(model->nq(), dt, rng);
+    graph::testing::JacobianCheckOptions c;
+    c.tolerance = 1e-6;
+    const auto check = check_jacobians(RawRows(f), x, c);
+    EXPECT_TRUE(check.ok) << model->name << " trial " << trial << "\n" << check.report();
+  }
+}
+
+TEST(IntervalDynamicsFactor, JacobiansUnderactuated) {
+  expect_raw_jacobians(testing::acrobot_model(), 3, 21);
+}
+TEST(IntervalDynamicsFactor, JacobiansFullyActuated) {
+  expect_raw_jacobians(load_robot("robots/rr/rr.urdf"), 2, 22);
+}
+
+// While linearizing, the factor skips the derivatives of check points whose rows are all off.
+// The hinged residual's Jacobian must still be exact: rows violated, rows inside their bound
+// but kept on by a multiplier, and rows off, against central differences of the residual.
+TEST(IntervalDynamicsFactor, LinearizationIsExactWithRowsOnAndOff) {
+  for (const auto& robot : {testing::acrobot_model(), load_robot("robots/rr/rr.urdf")}) {
+    auto model = std::make_shared<dynamics::Model>(*robot);
+    const std::string& urdf = model->name;
+    for (dynamics::Body& b : model->bodies) b.limits.effort = std::min(b.limits.effort, 0.5);
+    IntervalDynamicsOptions o;
+    o.checks = 5;
+    const double dt = 0.1;
+    IntervalDynamicsFactor f(0, dt, model, o);
+    std::mt19937 rng(31);
+    const graph::Values x = off_defect_interval(model->nq(), dt, rng);
+    Eigen::VectorXd z;
+    f.values_at(x, z);
+    auto m = std::make_shared<Multipliers>(f.residual_dim(), 4.0);
+    int on = 0, off = 0, kept_on = 0;
+    for (int i = 0; i < f.residual_dim(); ++i) {
+      const RowSpec& r = f.rows()[i];
+      if (r.kind != RowKind::kBounds) continue;
+      const bool violated = z[i] > r.upper || z[i] < r.lower;
+      if (!violated && off % 2 == 0) {
+        m->upper[i] = 50.0;  // inside its bound, but on through its multiplier
+        ++kept_on;
+      }
+      (violated ? on : off) += 1;
+    }
+    f.bind(m);
+    ASSERT_GT(on, 0) << urdf;
+    ASSERT_GT(off, kept_on) << urdf;
+    ASSERT_GT(kept_on, 0) << urdf;
+    graph::testing::JacobianCheckOptions c;
+    c.tolerance = 1e-6;
+    const auto check = check_jacobians(f, x, c);
+    EXPECT_TRUE(check.ok) << urdf << "\n" << check.report();
+  }
+}
+
+TEST(IntervalDynamicsFactor, RowsOfTheAcrobot) {
+  const auto model = testing::acrobot_model();
+  IntervalDynamicsOptions o;
+  o.checks = 4;
+  // 2 defect rows; per point the elbow's τ, both q and both q̇ limits.
+  EXPECT_EQ(IntervalDynamicsFactor(0, 0.1, model, o).residual_dim(), 2 + 4 * 5);
+  o.checks = 0;
+  EXPECT_EQ(IntervalDynamicsFactor(0, 0.1, model, o).residual_dim(), 2);
+  const auto rr = load_robot("robots/rr/rr.urdf");
+  EXPECT_THROW(IntervalDynamicsFactor(0, 0.1, rr, o), std::invalid_argument);
+}
+
+// Rows in the user's terms: the defect as the unactuated joint missing the next knot, a limit
+// row at its check point's own time.
+TEST(IntervalDynamicsFactor, RowsSpeakUserTerms) {
+  const auto model = testing::acrobot_model();
+  IntervalDynamicsOptions o;
+  o.checks = 4;
+  IntervalDynamicsFactor f(55, 0.1, model, o);
+  const auto context = [&](double violation) {
+    return ConstrainedFactor::RowContext{*model, 5.5, 0.1, "dynamics between the knots", -1,
+                                         violation};
+  };
+  EXPECT_EQ(f.describe_row(0, 0.02, context(0.02)),
+            "joint 1 (shoulder), unactuated, follows its dynamics from t = 5.5 s and arrives at "
+            "t = 5.6 s 0.02 rad off the next knot's position");
+  EXPECT_EQ(f.describe_row(1, -0.3, context(0.3)),
+            "joint 1 (shoulder), unactuated, follows its dynamics from t = 5.5 s and arrives at "
+            "t = 5.6 s 0.3 rad/s off the next knot's velocity");
+  // Rows of check point 1 (t = 5.5 + 2·0.1/5 s): shoulder q, q̇, then the elbow's τ first.
+  int tau_row = -1;
+  for (int i = 0; i < f.residual_dim(); ++i) {
+    if (tau_row < 0 && f.rows()[i].upper == 8.0) tau_row = i;
+  }
+  ASSERT_GE(tau_row, 0);
+  const int per_point = 5;  // elbow τ, both q and both q̇
+  EXPECT_EQ(f.describe_row(tau_row + per_point, 8.6, context(0.6)),
+            "joint 2 (elbow) torque 8.6 N·m exceeds its 8 N·m limit by 0.6 N·m at t = 5.54 s "
+            "(between the knots)");
+}
+
+TEST(IntervalDynamicsFactor, DefectIsZeroOnTheInterpolant) {
+  const auto model = testing::acrobot_model();
+  std::mt19937 rng(8);
+  const Plan plan = consistent_acrobot_interval(*model, 0.1, rng);
+  graph::Values x;
+  for (int k = 0; k < 2; ++k) {
+    x.insert(q_key(k), Eigen::VectorXd(plan.q.row(k).transpose()));
+    x.insert(v_key(k), Eigen::VectorXd(plan.qd.row(k).transpose()));
+    x.insert(a_key(k), Eigen::VectorXd(plan.qdd.row(k).transpose()));
+  }
+  IntervalDynamicsFactor f(0, 0.1, model, {});
+  Eigen::VectorXd z;
+  f.values_at(x, z);
+  EXPECT_LT(z.cwiseAbs().maxCoeff(), 1e-12);
+  x.update(v_key(1), Eigen::VectorXd(x.at(v_key(1)) + Eigen::Vector2d(0.01, 0)));
+  f.values_at(x, z);
+  EXPECT_NEAR(z[1], 0.01, 1e-12);  // the shoulder's q̇ defect
+}
+
+}  // namespace
+}  // namespace kinograph::planning
