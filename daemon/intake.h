@@ -30,7 +30,8 @@ struct Intake {
   std::vector<int64_t> superseded;
   std::vector<LostGoals> lost;
   std::vector<messages::ObstacleUpdate> obstacles;
-  bool replace_all = false;  ///< the obstacle list starts from an empty world
+  bool replace_all = false;      ///< the obstacle list starts from an empty world
+  int64_t obstacles_utime = -1;  ///< newest obstacle_list_t.utime (robot clock), -1 = none
   std::optional<messages::MeasuredState> state;
   std::uint64_t states = 0;  ///< measured states received
   /// Why the newest measured state was refused as a start (beyond the limits), or empty when
