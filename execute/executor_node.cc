@@ -196,18 +196,20 @@ void ExecutorNode::carry_out_stop(int64_t utime) {
 bool ExecutorNode::publish_at(int64_t utime) {
   if (pending_stop_) carry_out_stop(utime);
   const std::optional<Setpoint> s = schedule_.at(utime);
+  if (s) {
+    messages::CommandSetpoint command{utime, s->plan_id, s->q, s->qd, s->tau};
+    const joint_command_t msg = messages::command_to_message(command, *scene_.problem.model);
+    lcm_->publish(channel("COMMAND"), &msg);
+    ++counters_.commands;
+  }
+  // Logged after the command is sent: whoever reads the line knows the robot has it.
   const std::vector<Takeover>& switches = schedule_.takeovers();
   for (; takeovers_logged_ < switches.size(); ++takeovers_logged_) {
     const Takeover& t = switches[takeovers_logged_];
     spdlog::info("plan {} takes over from plan {} at {} us: jump {:.3g} rad, {:.3g} rad/s", t.to,
                  t.from, t.utime, t.jump_q, t.jump_qd);
   }
-  if (!s) return false;
-  messages::CommandSetpoint command{utime, s->plan_id, s->q, s->qd, s->tau};
-  const joint_command_t msg = messages::command_to_message(command, *scene_.problem.model);
-  lcm_->publish(channel("COMMAND"), &msg);
-  ++counters_.commands;
-  return true;
+  return s.has_value();
 }
 
 void ExecutorNode::run(const std::atomic<bool>& stop) {
