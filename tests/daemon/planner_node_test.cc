@@ -468,6 +468,34 @@ TEST_F(NodeFixture, AReplanWhileAnExecutorFollowsJoinsTheMotion) {
   EXPECT_EQ(node_->counters().late_takeovers, 0);
 }
 
+// --takeover-latency sets how far after the latest state a joining replan takes over.
+class LatencyNodeFixture : public NodeFixture {
+ protected:
+  LatencyNodeFixture() { defer_start_ = true; }
+};
+
+TEST_F(LatencyNodeFixture, TheTakeOverLatencyIsTheOptionsValue) {
+  PlannerNodeOptions options;
+  options.takeover_latency_s = 0.12;
+  start(default_scene(), options);
+  send_state(1'000'000, {-0.8, 0.4});
+  send_goal(15, {0.8, -0.4}, 1'000'000);
+  auto plans = listener_->wait_plans(1);
+  ASSERT_EQ(plans[0].status, plan_t::SUCCESS) << plans[0].status_message;
+  const dynamics::Model model =
+      dynamics::Model::from_urdf_file(std::string(KINOGRAPH_SOURCE_DIR) + "/robots/rr/rr.urdf");
+  messages::CommandSetpoint setpoint{1'100'000, plans[0].plan_id, Eigen::Vector2d(-0.8, 0.4),
+                                     Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
+  const joint_command_t command = messages::command_to_message(setpoint, model);
+  lcm_.publish("RR_COMMAND", &command);
+  send_state(1'100'000, {-0.8, 0.4});
+  send_obstacle("ball", obstacle_t::ADD_OR_MOVE, 0.05, {0, 0, 1.85}, false, 1'100'000);
+  plans = listener_->wait_plans(2);
+  ASSERT_EQ(plans.size(), 2u);
+  ASSERT_EQ(plans[1].status, plan_t::SUCCESS) << plans[1].status_message;
+  EXPECT_EQ(plans[1].takeover_utime, 1'100'000 + 120'000);
+}
+
 // An executor that stopped (commands of no plan) is not joined: the replan starts at the state.
 TEST_F(NodeFixture, AfterAStopTheReplanStartsAtTheMeasuredState) {
   send_state(1'000'000, {-0.8, 0.4});

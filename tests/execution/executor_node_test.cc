@@ -7,7 +7,11 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
 #include <lcm/lcm-cpp.hpp>
+#include <mutex>
+#include <thread>
 #include <vector>
 
 #include "kinograph/execution/stopping_trajectory.h"
@@ -196,6 +200,68 @@ TEST_F(ExecutorNodeTest, StopsToRestOnAValidatedTrajectory) {
   node_->publish_at(4'200'000);
   pump();
   EXPECT_EQ(sink_.commands.back().plan_id, 3);
+}
+
+// --rate: run() streams on its own thread at the asked rate of the robot's clock (here the
+// wall clock's, read from states the test publishes). A busy machine only spreads the setpoints
+// further apart, so the bound is one-sided: at 50 Hz they are never as dense as the default's
+// 200 Hz.
+TEST(ExecutorNodeRate, StreamsNoFasterThanTheRateAsked) {
+  const planning::Scene scene =
+      planning::load_scene(std::string(KINOGRAPH_SOURCE_DIR) + "/robots/scenes/iiwa_desk.yaml");
+  lcm::LCM lcm("memq://");
+  std::mutex mutex;
+  std::vector<int64_t> utimes;
+  struct Sink {
+    std::mutex* mutex;
+    std::vector<int64_t>* utimes;
+    void on(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+      joint_command_t msg;
+      if (!lcmtypes::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), msg).ok) return;
+      std::lock_guard lock(*mutex);
+      utimes->push_back(msg.utime);
+    }
+  } sink{&mutex, &utimes};
+  lcm.subscribe("IIWA_COMMAND", &Sink::on, &sink)->setQueueCapacity(100000);
+  ExecutorNodeOptions options;
+  options.channel_prefix = "IIWA";
+  options.rate_hz = 50;
+  ExecutorNode node(scene, options, &lcm);
+  const auto wall_us = [] {
+    using namespace std::chrono;
+    return duration_cast<microseconds>(steady_clock::now().time_since_epoch()).count();
+  };
+  const int64_t t0 = wall_us();
+  // A plan at rest, held: every tick publishes a setpoint.
+  const dynamics::Model& model = *scene.problem.model;
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(7);
+  planning::Plan plan =
+      linear_acceleration_plan(model, scene.problem.start_q, zero, {0, 10.0}, {zero, zero}, 1);
+  plan.validation.valid = true;
+  const plan_t msg =
+      messages::plan_to_message(plan, model, "iiwa14", 1, 1, {plan_t::CLOCK_ROBOT, t0, t0, t0, t0});
+  lcm.publish("IIWA_PLAN", &msg);
+  std::atomic<bool> stop{false};
+  std::thread runner([&] { node.run(stop); });
+  // States stamped with the wall clock every 5 ms for 1 s (at least 200 of them).
+  robot_state_t state{};
+  state.robot = "iiwa14";
+  state.num_joints = 7;
+  for (const auto& body : model.bodies) state.joint_name.push_back(body.joint_name);
+  state.position.assign(scene.problem.start_q.data(), scene.problem.start_q.data() + 7);
+  state.velocity.assign(7, 0.0);
+  for (int i = 0; i < 200; ++i) {
+    state.utime = wall_us();
+    lcm.publish("IIWA_STATE", &state);
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  stop = true;
+  runner.join();
+  std::lock_guard lock(mutex);
+  ASSERT_GE(utimes.size(), 3u);
+  const double mean_spacing_us =
+      static_cast<double>(utimes.back() - utimes.front()) / static_cast<double>(utimes.size() - 1);
+  EXPECT_GT(mean_spacing_us, 0.7 * 20'000) << utimes.size() << " commands";
 }
 
 }  // namespace

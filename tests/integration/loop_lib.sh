@@ -61,3 +61,24 @@ check_takeovers() {
     fail "a replan came after its take-over time"
   fi
 }
+
+# Goal i of a goal moving slowly: the desk goal with the base joint turned 0.004·i rad.
+goal_q() { echo "$GOAL" | awk -F, -v i="$1" '{ $1 = $1 + 0.004 * i; print }' OFS=,; }
+
+# stream_goals N: goal 1 (goal_q 1) from rest, and once the executor follows its plan (so the
+# daemon has heard it), goals 2..N, one every 0.1 s of the robot's clock, each stamped with the
+# latest state's time. Waits on the robot's clock (its states), never on a fixed sleep.
+stream_goals() {
+  local next now
+  next=$(robot_now)
+  "$KG" send-goal --prefix IIWA --lcm-url "$URL" --id 1 --q "$(goal_q 1)" --utime "$next" \
+    --wait 120 >/dev/null || fail "goal 1 not answered with a valid plan"
+  wait_for_line "$WORK/execute.log" "plan 1 takes over" || fail "the executor did not follow plan 1"
+  next=$((next + 100000))
+  for i in $(seq 2 "$1"); do
+    while now=$(robot_now) && [ "$now" -lt "$next" ]; do :; done
+    "$KG" send-goal --prefix IIWA --lcm-url "$URL" --id "$i" --q "$(goal_q "$i")" --utime "$now" \
+      >/dev/null
+    next=$((next + 100000))
+  done
+}

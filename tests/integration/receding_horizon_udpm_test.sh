@@ -16,23 +16,8 @@ URL="udpm://239.255.76.67:7732?ttl=0&recv_buf_size=4194304"
 source "$SRC/tests/integration/loop_lib.sh"
 GOALS=50
 
-# Goal i: the desk goal with the base joint turned 0.004·i rad.
-goal_q() { echo "$GOAL" | awk -F, -v i="$1" '{ $1 = $1 + 0.004 * i; print }' OFS=,; }
-
 start_loop "$WORK/run.lcmlog" 'IIWA_STATE|IIWA_PLAN' --slowdown 10 --start-utime 1000000
-# Goal 1 from rest, and the stream once the executor follows its plan (the daemon has heard it).
-next=$(robot_now)
-"$KG" send-goal --prefix IIWA --lcm-url "$URL" --id 1 --q "$(goal_q 1)" --utime "$next" \
-  --wait 120 >/dev/null || fail "goal 1 not answered with a valid plan"
-wait_for_line "$WORK/execute.log" "plan 1 takes over" || fail "the executor did not follow plan 1"
-next=$((next + 100000))
-for i in $(seq 2 $GOALS); do
-  # Waits on the robot's clock (its states), never on a fixed sleep.
-  while now=$(robot_now) && [ "$now" -lt "$next" ]; do :; done
-  "$KG" send-goal --prefix IIWA --lcm-url "$URL" --id "$i" --q "$(goal_q "$i")" --utime "$now" \
-    >/dev/null
-  next=$((next + 100000))
-done
+stream_goals $GOALS
 arrive_and_stop "$(goal_q $GOALS)"
 check_takeovers 1
 "$KG" log-plans "$WORK/run.lcmlog" --channel IIWA_PLAN --scene "$SCENE" --out-dir "$WORK/plans" \
