@@ -18,7 +18,7 @@ BUILD=$1
 SRC=$2
 URL="udpm://239.255.76.67:7731?ttl=0&recv_buf_size=4194304"
 source "$SRC/tests/integration/loop_lib.sh"
-BALL="$SRC/tests/integration/iiwa_desk_late_ball.yaml"
+BALL="$SRC/robots/scenes/changes/iiwa_desk_late_ball.yaml"
 
 echo "== 1: goal, plan, execution, the simulator 10x slower than the wall clock from 5 s"
 start_loop "$WORK/run1.lcmlog" IIWA_STATE --slowdown 10 --start-utime 5000000
