@@ -1,5 +1,6 @@
 #include "daemon/intake.h"
 
+#include <algorithm>
 #include <iterator>
 #include <utility>
 
@@ -23,6 +24,7 @@ void Intake::absorb(Intake&& newer) {
   }
   obstacles.insert(obstacles.end(), std::make_move_iterator(newer.obstacles.begin()),
                    std::make_move_iterator(newer.obstacles.end()));
+  obstacles_utime = std::max(obstacles_utime, newer.obstacles_utime);
   if (newer.state) {
     state = std::move(newer.state);
     state_refused.clear();

@@ -33,6 +33,7 @@ struct Intake {
   std::vector<messages::ObstacleUpdate> obstacles;
   /// Sources whose obstacles the changes start from nothing (a replace_all of theirs).
   std::set<std::string> replaced_sources;
+  int64_t obstacles_utime = -1;  ///< newest obstacle_list_t.utime (robot clock), -1 = none
   std::optional<messages::MeasuredState> state;
   std::uint64_t states = 0;  ///< measured states received
   /// Why the newest measured state was refused as a start (beyond the limits), or empty when

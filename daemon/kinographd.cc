@@ -1,7 +1,7 @@
 // kinographd: the kinograph planner daemon for one robot on an LCM network.
 //   kinographd SCENE.yaml [--prefix IIWA] [--lcm-url URL] [--status-period 1.0]
 //              [--batch-only] [--max-goal-change RAD] [--formulation condensed|dfg]
-//              [--ignore-goal-id-gaps] [--max-state-age 0.5]
+//              [--ignore-goal-id-gaps] [--max-state-age 0.5] [--takeover-latency 0.3]
 //              [--iiwa-status-channel IIWA_STATUS] [--drake-plan-channel COMMITTED_ROBOT_PLAN]
 //              [--state-file FILE]
 // The scene gives the robot, default horizon and steps, start, fixed obstacles, objective
@@ -64,6 +64,11 @@ int main(int argc, char** argv) {
   app.add_option("--max-state-age", options.max_state_age_s,
                  "refuse a goal (INVALID_STATE) issued more than this many seconds after the "
                  "latest measured state, on the robot's clock")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--takeover-latency", options.takeover_latency_s,
+                 "while an executor follows the plans, a replan starts where the motion will be "
+                 "this many seconds (robot clock) after the latest state and takes over there; "
+                 "set it above the planner's latency (default 0.3)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--iiwa-status-channel", options.iiwa_status_channel,
                  "also read Drake's lcmt_iiwa_status on this channel as the measured state "

@@ -23,6 +23,14 @@
 #include "lcmtypes/safe_decode.h"
 
 namespace kinograph::daemon {
+namespace {
+
+const dynamics::Model& robot_of(const planning::Scene& scene) {
+  if (!scene.problem.model) throw std::invalid_argument("PlannerNode: the scene has no robot");
+  return *scene.problem.model;
+}
+
+}  // namespace
 
 namespace {
 // Why a goal got CANCELLED: a solve cut short, or a goal never started.
@@ -37,8 +45,10 @@ std::string obstacle_name(const ObstacleKey& key) {
 }  // namespace
 
 PlannerNode::PlannerNode(planning::Scene scene, PlannerNodeOptions options, lcm::LCM* shared)
-    : scene_(std::move(scene)), options_(std::move(options)), replanner_(options_.replanning) {
-  if (!scene_.problem.model) throw std::invalid_argument("PlannerNode: the scene has no robot");
+    : scene_(std::move(scene)),
+      options_(std::move(options)),
+      motion_join_(robot_of(scene_), options_.takeover_latency_s),
+      replanner_(options_.replanning) {
   identity_.model_name = scene_.problem.model->name;
   identity_.channel_prefix = options_.channel_prefix.empty()
                                  ? messages::default_channel_prefix(identity_.model_name)
@@ -60,8 +70,9 @@ PlannerNode::PlannerNode(planning::Scene scene, PlannerNodeOptions options, lcm:
                     lcm_->subscribe(channel("STATE"), &PlannerNode::on_state, this)};
   subscriptions_.push_back(
       lcm_->subscribe(channel("PLANNER_STATUS"), &PlannerNode::on_heartbeat, this));
+  subscriptions_.push_back(lcm_->subscribe(channel("COMMAND"), &PlannerNode::on_command, this));
   std::vector<int> capacities = {kGoalQueueCapacity, kObstacleQueueCapacity, kStateQueueCapacity,
-                                 kHeartbeatQueueCapacity};
+                                 kHeartbeatQueueCapacity, kStateQueueCapacity};
   if (!options_.iiwa_status_channel.empty()) {
     subscriptions_.push_back(
         lcm_->subscribe(options_.iiwa_status_channel, &PlannerNode::on_iiwa_status, this));
@@ -169,15 +180,14 @@ messages::PlanTime PlannerNode::clock_now_locked() const {
   return time;
 }
 
-std::string PlannerNode::stale_state_reason(const GoalRequest& goal,
+std::string PlannerNode::stale_state_reason(const std::string& what, int64_t utime,
                                             const MeasuredState& state) const {
-  const double age_s = static_cast<double>(goal.utime - state.utime) * 1e-6;
+  const double age_s = static_cast<double>(utime - state.utime) * 1e-6;
   if (age_s <= options_.max_state_age_s) return {};
   return "the latest measured state (utime " + std::to_string(state.utime) + " us) is " +
-         std::to_string(age_s) + " s older than goal " + std::to_string(goal.goal_id) + " (utime " +
-         std::to_string(goal.utime) + " us), more than the " +
-         std::to_string(options_.max_state_age_s) +
-         " s allowed (--max-state-age): has the robot's state stream stopped, or are the goal "
+         std::to_string(age_s) + " s older than " + what + " (utime " + std::to_string(utime) +
+         " us), more than the " + std::to_string(options_.max_state_age_s) +
+         " s allowed (--max-state-age): has the robot's state stream stopped, or are the message "
          "and the states on different clocks?";
 }
 
@@ -343,6 +353,7 @@ void PlannerNode::on_obstacles(const lcm::ReceiveBuffer* rbuf, const std::string
     return;
   }
   if (msg.replace_all) arrived.replaced_sources.insert(msg.source);
+  arrived.obstacles_utime = msg.utime;
   intake_.absorb(std::move(arrived));
 }
 
@@ -389,6 +400,17 @@ void PlannerNode::on_iiwa_status(const lcm::ReceiveBuffer* rbuf, const std::stri
     return;
   }
   take_state(channel, std::move(state));
+}
+
+void PlannerNode::on_command(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+  joint_command_t msg;
+  if (auto s = lcmtypes::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), msg); !s.ok) {
+    reject(channel, channel + ": malformed joint_command_t: " + s.reason);
+    return;
+  }
+  if (!identity_.matches(msg.robot)) return;
+  std::lock_guard lock(mutex_);
+  motion_join_.commanded(msg.plan_id, msg.utime);
 }
 
 void PlannerNode::on_heartbeat(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
@@ -541,17 +563,21 @@ bool PlannerNode::apply_obstacles(const std::vector<ObstacleUpdate>& updates,
   return changed;
 }
 
-void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan) {
+void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t trigger_utime) {
   planning::Problem problem = scene_.problem;
   bool new_state = false;
   std::optional<int64_t> state_utime;  // of the measured state the plan starts from
+  std::optional<JoinPoint> join;       // where it joins the motion under way, if it does
   std::string stale;
   {
     std::lock_guard lock(mutex_);
     if (!state_refusal_.empty()) {
       stale = "the robot's latest measured state cannot be a start, " + state_refusal_;
     } else if (latest_state_) {
-      stale = stale_state_reason(goal, *latest_state_);
+      const std::string what = replan
+                                   ? "the obstacle update for goal " + std::to_string(goal.goal_id)
+                                   : "goal " + std::to_string(goal.goal_id);
+      stale = stale_state_reason(what, trigger_utime, *latest_state_);
     }
     if (stale.empty()) {
       state_ = planner_status_t::PLANNING;
@@ -560,6 +586,12 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan) {
         problem.start_q = latest_state_->q;
         problem.start_qd = latest_state_->qd;
         state_utime = latest_state_->utime;
+        // While an executor follows our plans, start where the commanded motion will be.
+        join = motion_join_.join(latest_state_->utime, options_.max_state_age_s);
+        if (join) {
+          problem.start_q = join->q;
+          problem.start_qd = join->qd;
+        }
       }
       new_state = state_count_ != used_state_count_;
       used_state_count_ = state_count_;
@@ -625,10 +657,10 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan) {
     state_ = threw ? planner_status_t::ERROR : planner_status_t::IDLE;
     last_message_ = threw ? error : (plan.success() ? "" : plan.stats.reason);
   }
-  // Knot 0 is the measured state, at its own time; without a state the plan starts when it
-  // is published. Until replans join the motion under way, a plan takes over at its start.
+  // Knot 0 is the measured state, at its own time, or where the motion under way will be at
+  // the take-over; without a state the plan starts when it is published.
   time.state_utime = state_utime.value_or(-1);
-  time.start_utime = state_utime.value_or(time.utime);
+  time.start_utime = join ? join->takeover_utime : state_utime.value_or(time.utime);
   time.takeover_utime = time.start_utime;
   plan_t msg;
   if (threw) {
@@ -642,6 +674,25 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan) {
     spdlog::info("goal {}: plan {} {} ({}, {} iterations, {:.1f} ms)", goal.goal_id, plan_id,
                  plan.success() ? "valid" : "INVALID", msg.method, plan.stats.iterations,
                  plan.stats.solve_time_s * 1e3);
+  }
+  // Recorded before it is sent, so that the executor's first command of it is recognised.
+  if (msg.status == plan_t::SUCCESS) {
+    std::lock_guard lock(mutex_);
+    if (join) {
+      ++counters_.joined;
+      // Planning took longer than expected: the executor switches late, with a jump.
+      if (latest_state_ && latest_state_->utime > join->takeover_utime) {
+        ++counters_.late_takeovers;
+        spdlog::warn(
+            "goal {}: plan {} published {:.3f} s after its take-over (--takeover-latency "
+            "{} s is too short for this planner)",
+            goal.goal_id, plan_id,
+            static_cast<double>(latest_state_->utime - join->takeover_utime) * 1e-6,
+            options_.takeover_latency_s);
+      }
+    }
+    motion_join_.published(
+        {plan_id, time.start_utime, time.takeover_utime, time.state_utime, plan});
   }
   publish(channel("PLAN"), msg);
   if (!options_.drake_plan_channel.empty() && msg.status == plan_t::SUCCESS) {
@@ -687,9 +738,9 @@ void PlannerNode::worker_loop(const std::atomic<bool>& stop) {
     if (obstacles_changed) store_obstacles();
     if (taken.goal) {
       current_goal_ = taken.goal;
-      plan_and_publish(*taken.goal, /*replan=*/false);
+      plan_and_publish(*taken.goal, /*replan=*/false, taken.goal->utime);
     } else if (obstacles_changed && current_goal_) {
-      plan_and_publish(*current_goal_, /*replan=*/true);
+      plan_and_publish(*current_goal_, /*replan=*/true, taken.obstacles_utime);
     }
   }
 }

@@ -22,6 +22,7 @@
 
 #include "daemon/intake.h"
 #include "daemon/log_limiter.h"
+#include "daemon/motion_join.h"
 #include "daemon/own_heartbeats.h"
 #include "kinograph/lcm/message_convert.h"
 #include "kinograph/planning/io/scene.h"
@@ -73,6 +74,10 @@ struct PlannerNodeOptions {
   /// restarts (daemon/state_file.h); empty = none: plan ids start at 1 and those obstacles are
   /// forgotten when it stops.
   std::string state_file;
+  /// Expected time (s, robot clock) from the latest state to a replan in the executor's hands:
+  /// while an executor follows this daemon's plans, a replan starts where the plan in force is
+  /// this long after the latest state, and takes over there (daemon/motion_join.h).
+  double takeover_latency_s = 0.3;
 };
 
 /// What a node has done since it started (for its status and for tests).
@@ -91,6 +96,8 @@ struct NodeCounters {
   int64_t states_refused = 0;      ///< states beyond the limits or not finite (never a start)
   int64_t foreign_heartbeats = 0;  ///< heartbeats on this daemon's channel published by another
   int64_t goals_cancelled = 0;     ///< goals answered CANCELLED: planning or pending at shutdown
+  int64_t joined = 0;              ///< plans that join the motion under way (take over later)
+  int64_t late_takeovers = 0;      ///< of which published after their take-over time had passed
 };
 
 /// The planner daemon's node: scene (robot, defaults, fixed obstacles) + LCM + worker thread.
@@ -142,6 +149,8 @@ class PlannerNode {
   void on_obstacles(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   void on_state(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   void on_iiwa_status(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  /// An executor's setpoint: which of this daemon's plans it follows (MotionJoin).
+  void on_command(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   /// A heartbeat on this daemon's status channel: its own, or another daemon's (reported).
   void on_heartbeat(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   /// Hands a decoded measured state to the intake (LCM thread); one beyond the robot's limits
@@ -163,8 +172,10 @@ class PlannerNode {
   /// second answer to a goal (a replan's) is not counted as an answered goal again.
   void answer_with_failure(int8_t status, const std::string& reason, int64_t goal_id,
                            bool first_answer = true);
-  /// Why a goal must not be planned from `state` (older than max_state_age_s), or empty.
-  std::string stale_state_reason(const GoalRequest& goal, const MeasuredState& state) const;
+  /// Why a plan for `what` (a goal, an obstacle update), stamped `utime` on the robot's clock,
+  /// must not start from `state` (older than max_state_age_s), or empty.
+  std::string stale_state_reason(const std::string& what, int64_t utime,
+                                 const MeasuredState& state) const;
   /// Answers the goals a newer one replaced and the ids that never arrived (worker thread).
   void answer_superseded(const Intake& taken);
   /// Hands what the handlers took off LCM to the worker, in one go (LCM thread).
@@ -183,7 +194,9 @@ class PlannerNode {
   /// Writes the state file when obstacles changed and the last write is kStateWritePeriod
   /// old (worker thread).
   void save_state_if_due();
-  void plan_and_publish(const GoalRequest& goal, bool replan);
+  /// Plans `goal` and publishes the answer; `trigger_utime` is the robot-clock time of what
+  /// made it plan (the goal, or for a replan the obstacle update), for the state's age.
+  void plan_and_publish(const GoalRequest& goal, bool replan, int64_t trigger_utime);
   void publish_status();
   /// Takes the next plan id; first writes a new reservation to the state file when the
   /// reserved ids run out. Caller holds mutex_.
@@ -236,6 +249,7 @@ class PlannerNode {
   std::chrono::steady_clock::time_point state_written_at_{};
   // Set when run() ends: the worker's solver loops poll it (graph/cancellation.h).
   std::atomic<bool> cancel_{false};
+  MotionJoin motion_join_;  // the newest valid plan and the executor following it
 
   // Owned by the worker thread.
   std::map<ObstacleKey, collision::Obstacle> live_obstacles_;  // by (source, id)

@@ -27,6 +27,7 @@
 #include "kinograph/plan_v1_t.hpp"
 #include "kinograph/planner_status_t.hpp"
 #include "kinograph/robot_state_t.hpp"
+#include "kinograph/stop_request_t.hpp"
 #include "kinograph/task_constraint_t.hpp"
 
 namespace kinograph::lcmtypes {
@@ -253,6 +254,12 @@ inline bool check_fields(WireReader& r, const joint_command_t*) {
   for (int32_t i = 0; i < n; ++i)
     if (!r.string("joint_command_t.joint_name")) return false;
   return r.skip(3 * static_cast<int64_t>(n), 8, "joint_command_t.position/velocity/torque");
+}
+
+inline bool check_fields(WireReader& r, const stop_request_t*) {
+  int64_t i64 = 0;
+  return r.read_i64(i64, "stop_request_t.utime") && r.string("stop_request_t.robot") &&
+         r.read_i64(i64, "stop_request_t.request_id") && r.string("stop_request_t.reason");
 }
 
 inline bool check_fields(WireReader& r, const ::drake::lcmt_iiwa_status*) {

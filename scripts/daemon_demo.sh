@@ -10,14 +10,7 @@
 # ttl=0 (packets stay on this host).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-if [ -z "${KINOGRAPH_NETNS:-}" ] && [ "$(id -u)" -eq 0 ] && command -v unshare >/dev/null; then
-  exec unshare -n env KINOGRAPH_NETNS=1 bash "$0" "$@"
-fi
-if [ -n "${KINOGRAPH_NETNS:-}" ]; then
-  ip link set lo up
-  ip link set lo multicast on
-  ip route add 224.0.0.0/4 dev lo
-fi
+source scripts/lib/demo_netns.sh
 URL="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304"
 BUILD=${KINOGRAPH_BUILD_DIR:-build}
 KG="$BUILD/tools/kinograph"

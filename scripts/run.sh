@@ -69,4 +69,8 @@ fi
 # The daemon end to end over LCM: a goal, then an obstacle that forces a replan (out/daemon/).
 echo "== daemon demo (kinographd over LCM)"
 ./scripts/daemon_demo.sh || echo "   (daemon demo: a plan did not validate; see out/daemon/kinographd.log)"
-ls -l out/ out/daemon/
+# The loop closed: daemon, executor and simulated iiwa; a ball appears while the arm moves
+# (out/closed_loop/).
+echo "== closed-loop demo (kinographd, kinograph execute, kinograph sim over LCM)"
+./scripts/closed_loop_demo.sh || echo "   (closed-loop demo failed; see out/closed_loop/*.log)"
+ls -l out/ out/daemon/ out/closed_loop/

@@ -2,6 +2,7 @@
 //   kinograph send-goal     --prefix IIWA (--q ... | --joint NAME=V ... | --frame F
 //                           --position ... (--quaternion ... | --position-only)) [--utime US]
 //   kinograph send-obstacle --prefix IIWA --id box --shape box --size ... --position ...
+//                           [--utime US]
 //   kinograph send-state    --prefix IIWA --scene S --q ... [--qd ...] [--utime US]
 //   kinograph send-raw      CHANNEL --text BYTES
 //   kinograph log-plans     LOG.lcmlog --channel IIWA_PLAN --scene S --out-dir DIR
@@ -296,8 +297,12 @@ const bool kSendObstacle = register_command([](CLI::App& root) {
   auto quaternion = std::make_shared<std::string>("1,0,0,0");
   auto remove = std::make_shared<bool>(false);
   auto goal_id = std::make_shared<int64_t>(-1);
+  auto utime = std::make_shared<int64_t>(-1);
   c->add(sub, true);
   sub->add_option("--id", *id, "obstacle name")->required();
+  sub->add_option("--utime", *utime,
+                  "the update's time on the robot's clock, µs (default: the wall clock); the "
+                  "daemon replans only from a state at most --max-state-age older");
   sub->add_option("--shape", *shape, "box, sphere, cylinder or capsule")
       ->check(CLI::IsMember({"box", "sphere", "cylinder", "capsule"}));
   sub->add_option("--size", *size, "box: x,y,z; sphere: r; cylinder/capsule: r,length");
@@ -324,7 +329,7 @@ const bool kSendObstacle = register_command([](CLI::App& root) {
     std::copy(p.begin(), p.end(), o.position);
     std::copy(r.begin(), r.end(), o.quaternion);
     obstacle_list_t msg;
-    msg.utime = now_utime();
+    msg.utime = *utime >= 0 ? *utime : now_utime();
     msg.num_obstacles = 1;
     msg.obstacles.push_back(o);
     msg.replace_all = false;

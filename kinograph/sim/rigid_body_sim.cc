@@ -1,5 +1,7 @@
 #include "kinograph/sim/rigid_body_sim.h"
 
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -7,17 +9,29 @@
 #include "kinograph/dynamics/se3.h"
 
 namespace kinograph::sim {
+namespace {
+
+// τ clamped to ±effort on every joint with a finite effort limit: a motor gives no more.
+Eigen::VectorXd saturated(const dynamics::Model& plant, Eigen::VectorXd tau) {
+  for (int j = 0; j < plant.nq(); ++j) {
+    const double effort = plant.bodies[j].limits.effort;
+    if (std::isfinite(effort)) tau[j] = std::clamp(tau[j], -effort, effort);
+  }
+  return tau;
+}
+
+}  // namespace
 
 RigidBodySim::RigidBodySim(const dynamics::Model& plant) : plant_(plant), data_(plant) {}
 
 Eigen::VectorXd RigidBodySim::torque(const PdGains& gains, const Setpoint& setpoint,
                                      const JointState& state) const {
-  return control_torque(gains, setpoint, state.q, state.qd);
+  return saturated(plant_, control_torque(gains, setpoint, state.q, state.qd));
 }
 
 Eigen::VectorXd RigidBodySim::acceleration(const PdGains& gains, const Setpoint& setpoint,
                                            const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
-  const Eigen::VectorXd tau = control_torque(gains, setpoint, q, qd);
+  const Eigen::VectorXd tau = saturated(plant_, control_torque(gains, setpoint, q, qd));
   return dynamics::forward_dynamics(plant_, data_, q, qd, tau);
 }
 
@@ -39,6 +53,18 @@ void RigidBodySim::step(double dt, const PdGains& gains, const Setpoint& setpoin
     throw std::runtime_error(
         "the simulated motion diverged (a joint position or velocity is "
         "not finite): torques too large for the step");
+  }
+  // End stops: a joint that reached a position limit stays on it, its velocity into the stop
+  // absorbed (a perfectly inelastic stop; moving away from it is free).
+  for (int j = 0; j < plant_.nq(); ++j) {
+    const dynamics::JointLimits& limits = plant_.bodies[j].limits;
+    if (state.q[j] >= limits.upper) {
+      state.q[j] = limits.upper;
+      state.qd[j] = std::min(state.qd[j], 0.0);
+    } else if (state.q[j] <= limits.lower) {
+      state.q[j] = limits.lower;
+      state.qd[j] = std::max(state.qd[j], 0.0);
+    }
   }
 }
 

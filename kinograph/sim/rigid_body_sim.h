@@ -15,8 +15,9 @@ struct JointState {
 };
 
 /// Integrates q̈ = FD(q, q̇, τ) with τ the controllers' torque, evaluated at every RK4 stage
-/// (the controllers act continuously between setpoint changes). Joint limits are not
-/// simulated: the plant moves where its torques take it. One instance per thread.
+/// (the controllers act continuously between setpoint changes) and saturated at the plant's
+/// effort limits. Position limits are end stops: after each step a joint beyond one is put back
+/// on it and its velocity into the stop removed. One instance per thread.
 class RigidBodySim {
  public:
   /// Borrows `plant`, which must outlive the simulator.
@@ -25,7 +26,8 @@ class RigidBodySim {
   /// Advances `state` by one RK4 step of `dt` seconds under the controllers. Throws
   /// std::runtime_error when the new state is not finite (the motion diverged).
   void step(double dt, const PdGains& gains, const Setpoint& setpoint, JointState& state);
-  /// The controllers' torque at `state` (what step() applies at the step's start).
+  /// The torque the motors give at `state`: the controllers', clamped to ±effort (what step()
+  /// applies at the step's start).
   Eigen::VectorXd torque(const PdGains& gains, const Setpoint& setpoint,
                          const JointState& state) const;
 

@@ -99,7 +99,11 @@ class Answers {
       for (int64_t id = first; id <= last; ++id) {
         if (!first_answer_.count(id)) return false;
       }
+      // The heartbeat counts every goal since the daemon started (earlier storms too): it must
+      // account for all it received, not only for as many as this storm sent.
       return status_ && status_->num_goals_answered >= last - first + 1 &&
+             status_->num_goals_received + status_->num_goals_dropped ==
+                 status_->num_goals_answered &&
              status_->state == 0 /* IDLE */;
     });
   }

@@ -23,8 +23,10 @@
 #include "drake/lcmt_iiwa_status.hpp"
 #include "kinograph/dynamics/data.h"
 #include "kinograph/dynamics/kinematics.h"
+#include "kinograph/lcm/message_convert.h"
 #include "kinograph/planner_status_t.hpp"
 #include "kinograph/planning/io/scene.h"
+#include "kinograph/planning/trajectory_sampler.h"
 #include "kinograph/planning/validate.h"
 #include "lcmtypes/safe_decode.h"
 #include "tests/lcmtypes/sample_messages.h"
@@ -154,9 +156,10 @@ class NodeFixture : public ::testing::Test {
 
   void send_obstacle(const std::string& id, int8_t action, double radius,
                      const Eigen::Vector3d& position, bool replace_all = false,
-                     const std::string& source = "") {
+                     const std::string& source = "", int64_t utime = 0) {
     obstacle_list_t list{};
     list.source = source;
+    list.utime = utime;
     obstacle_t o{};
     o.id = id;
     o.action = action;
@@ -657,6 +660,112 @@ TEST_F(NodeFixture, AnObstacleInThePathTriggersACollisionFreeReplan) {
   EXPECT_EQ(plans[1].status, plan_t::SUCCESS) << plans[1].status_message;
   EXPECT_GE(plans[1].min_clearance, 0.0);
   EXPECT_EQ(node_->counters().replans, 1);
+}
+
+// While an executor follows the daemon's plan (its commands name it), a replan starts where
+// that plan is at the latest state's time plus --takeover-latency and takes over there, so the
+// commanded motion is continuous; without such commands plans start at the measured state.
+TEST_F(NodeFixture, AReplanWhileAnExecutorFollowsJoinsTheMotion) {
+  send_state(1'000'000, {-0.8, 0.4});
+  send_goal(15, {0.8, -0.4}, 1'000'000);
+  auto plans = listener_->wait_plans(1);
+  ASSERT_EQ(plans[0].status, plan_t::SUCCESS) << plans[0].status_message;
+  EXPECT_EQ(plans[0].takeover_utime, 1'000'000);
+  // The executor's setpoint of that plan, then a state the robot measured 0.2 s in.
+  const dynamics::Model model =
+      dynamics::Model::from_urdf_file(std::string(KINOGRAPH_SOURCE_DIR) + "/robots/rr/rr.urdf");
+  const planning::Plan first = messages::plan_from_message(plans[0]);
+  planning::TrajectorySampler sampler(model, first);
+  const planning::InterpolantPoint at_state = sampler.at(0.2);
+  messages::CommandSetpoint setpoint{1'200'000, plans[0].plan_id, at_state.q, at_state.qd,
+                                     at_state.tau};
+  const joint_command_t command = messages::command_to_message(setpoint, model);
+  lcm_.publish("RR_COMMAND", &command);
+  send_state(1'200'000, {at_state.q[0] + 0.01, at_state.q[1]}, {at_state.qd[0], at_state.qd[1]});
+  send_obstacle("ball", obstacle_t::ADD_OR_MOVE, 0.05, {0, 0, 1.85}, false, 1'200'000);
+  plans = listener_->wait_plans(2);
+  ASSERT_EQ(plans.size(), 2u);
+  const plan_t& replan = plans[1];
+  ASSERT_EQ(replan.status, plan_t::SUCCESS) << replan.status_message;
+  EXPECT_EQ(replan.state_utime, 1'200'000);
+  EXPECT_EQ(replan.takeover_utime, 1'200'000 + 300'000);  // the default latency
+  EXPECT_EQ(replan.start_utime, replan.takeover_utime);
+  // Knot 0 is the first plan at the take-over (0.5 s in), not the measured state.
+  const planning::InterpolantPoint join = sampler.at(0.5);
+  for (int j = 0; j < 2; ++j) {
+    EXPECT_LE(std::abs(replan.q[0][j] - join.q[j]), 1e-6) << j;
+    EXPECT_LE(std::abs(replan.qd[0][j] - join.qd[j]), 1e-4) << j;
+  }
+  EXPECT_EQ(node_->counters().joined, 1);
+  EXPECT_EQ(node_->counters().late_takeovers, 0);
+}
+
+// --takeover-latency sets how far after the latest state a joining replan takes over.
+class LatencyNodeFixture : public NodeFixture {
+ protected:
+  LatencyNodeFixture() { defer_start_ = true; }
+};
+
+TEST_F(LatencyNodeFixture, TheTakeOverLatencyIsTheOptionsValue) {
+  PlannerNodeOptions options;
+  options.takeover_latency_s = 0.12;
+  start(default_scene(), options);
+  send_state(1'000'000, {-0.8, 0.4});
+  send_goal(15, {0.8, -0.4}, 1'000'000);
+  auto plans = listener_->wait_plans(1);
+  ASSERT_EQ(plans[0].status, plan_t::SUCCESS) << plans[0].status_message;
+  const dynamics::Model model =
+      dynamics::Model::from_urdf_file(std::string(KINOGRAPH_SOURCE_DIR) + "/robots/rr/rr.urdf");
+  messages::CommandSetpoint setpoint{1'100'000, plans[0].plan_id, Eigen::Vector2d(-0.8, 0.4),
+                                     Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
+  const joint_command_t command = messages::command_to_message(setpoint, model);
+  lcm_.publish("RR_COMMAND", &command);
+  send_state(1'100'000, {-0.8, 0.4});
+  send_obstacle("ball", obstacle_t::ADD_OR_MOVE, 0.05, {0, 0, 1.85}, false, 1'100'000);
+  plans = listener_->wait_plans(2);
+  ASSERT_EQ(plans.size(), 2u);
+  ASSERT_EQ(plans[1].status, plan_t::SUCCESS) << plans[1].status_message;
+  EXPECT_EQ(plans[1].takeover_utime, 1'100'000 + 120'000);
+}
+
+// An executor that stopped (commands of no plan) is not joined: the replan starts at the state.
+TEST_F(NodeFixture, AfterAStopTheReplanStartsAtTheMeasuredState) {
+  send_state(1'000'000, {-0.8, 0.4});
+  send_goal(15, {0.8, -0.4}, 1'000'000);
+  auto plans = listener_->wait_plans(1);
+  ASSERT_EQ(plans[0].status, plan_t::SUCCESS) << plans[0].status_message;
+  const dynamics::Model model =
+      dynamics::Model::from_urdf_file(std::string(KINOGRAPH_SOURCE_DIR) + "/robots/rr/rr.urdf");
+  messages::CommandSetpoint hold{1'200'000, -1, Eigen::Vector2d(-0.7, 0.3), Eigen::Vector2d::Zero(),
+                                 Eigen::Vector2d::Zero()};
+  const joint_command_t command = messages::command_to_message(hold, model);
+  lcm_.publish("RR_COMMAND", &command);
+  send_state(1'200'000, {-0.7, 0.3});
+  send_obstacle("ball", obstacle_t::ADD_OR_MOVE, 0.05, {0, 0, 1.85}, false, 1'200'000);
+  plans = listener_->wait_plans(2);
+  ASSERT_EQ(plans.size(), 2u);
+  ASSERT_EQ(plans[1].status, plan_t::SUCCESS) << plans[1].status_message;
+  EXPECT_EQ(plans[1].takeover_utime, 1'200'000);
+  EXPECT_NEAR(plans[1].q[0][0], -0.7, 1e-6);
+  EXPECT_EQ(node_->counters().joined, 0);
+}
+
+// An obstacle update stamped later than the latest state by more than --max-state-age replans
+// nothing from that state: the goal is answered INVALID_STATE, naming the update.
+TEST_F(NodeFixture, AnObstacleUpdateChecksTheStatesAge) {
+  send_state(1'000'000, {-0.8, 0.4});
+  send_goal(15, {0.8, -0.4}, 1'000'000);
+  auto plans = listener_->wait_plans(1);
+  ASSERT_EQ(plans[0].status, plan_t::SUCCESS) << plans[0].status_message;
+  send_obstacle("ball", obstacle_t::ADD_OR_MOVE, 0.05, {0, 0, 1.85}, false, 1'700'000);
+  plans = listener_->wait_plans(2);
+  ASSERT_EQ(plans.size(), 2u);
+  EXPECT_EQ(plans[1].goal_id, 15);
+  EXPECT_EQ(plans[1].status, plan_t::INVALID_STATE);
+  EXPECT_NE(plans[1].status_message.find("0.700000 s older than the obstacle update for goal 15"),
+            std::string::npos)
+      << plans[1].status_message;
+  EXPECT_EQ(node_->counters().goals_answered, 1);  // a replan's answer is not a new answer
 }
 
 TEST_F(NodeFixture, NewestGoalWinsAndEveryGoalIsAnswered) {

@@ -65,6 +65,7 @@ TEST(SafeDecode, AcceptsWellFormedMessagesOfEveryType) {
   expect_accepts(make_plan_v1(6));
   expect_accepts(make_planner_status());
   expect_accepts(make_joint_command());
+  expect_accepts(make_stop_request());
   expect_accepts(make_iiwa_status());
   expect_accepts(make_robot_plan(5));
   expect_accepts(make_robot_plan(0));
@@ -92,6 +93,7 @@ TEST(SafeDecode, RejectsEveryTruncation) {
   expect_prefixes_rejected(make_plan_v1(3));
   expect_prefixes_rejected(make_planner_status());
   expect_prefixes_rejected(make_joint_command());
+  expect_prefixes_rejected(make_stop_request());
   expect_prefixes_rejected(make_iiwa_status());
   expect_prefixes_rejected(make_robot_plan(3));
 }

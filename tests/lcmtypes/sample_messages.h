@@ -17,6 +17,7 @@
 #include "kinograph/plan_v1_t.hpp"
 #include "kinograph/planner_status_t.hpp"
 #include "kinograph/robot_state_t.hpp"
+#include "kinograph/stop_request_t.hpp"
 
 namespace kinograph::lcmtypes::testing {
 
@@ -30,6 +31,7 @@ using kinograph::plan_t;
 using kinograph::plan_v1_t;
 using kinograph::planner_status_t;
 using kinograph::robot_state_t;
+using kinograph::stop_request_t;
 
 inline std::mt19937& rng() {
   static std::mt19937 engine(20240611);
@@ -201,6 +203,15 @@ inline joint_command_t make_joint_command() {
   m.position = random_vector(7);
   m.velocity = random_vector(7);
   m.torque = random_vector(7);
+  return m;
+}
+
+inline stop_request_t make_stop_request() {
+  stop_request_t m;
+  m.utime = 5'010'000;
+  m.robot = "iiwa14";
+  m.request_id = 3;
+  m.reason = "operator";
   return m;
 }
 

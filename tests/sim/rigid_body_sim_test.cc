@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 
@@ -115,9 +116,11 @@ TEST(RigidBodySim, AStepAcrossTheWorkspaceConverges) {
 }
 
 // Gains far too stiff for a 1 ms step (a 1 kHz loop) make the motion diverge: the simulator
-// says so instead of carrying on with NaN.
+// says so instead of carrying on with NaN. (Motors without effort limits: saturated ones would
+// keep the torques, and the motion, bounded.)
 TEST(RigidBodySim, ADivergingMotionIsReportedNotContinued) {
-  const dynamics::Model& model = *iiwa_desk().problem.model;
+  dynamics::Model model = *iiwa_desk().problem.model;
+  for (auto& body : model.bodies) body.limits.effort = std::numeric_limits<double>::infinity();
   dynamics::Data data(model);
   const Eigen::VectorXd q0 = iiwa_desk().problem.start_q;
   const Setpoint target = hold_setpoint(model, data, q0.array() + 0.1);
@@ -129,6 +132,51 @@ TEST(RigidBodySim, ADivergingMotionIsReportedNotContinued) {
         for (int k = 0; k < 1000; ++k) sim.step(1e-3, gains, target, state);
       },
       std::runtime_error);
+}
+
+// A setpoint far away asks for more torque than the motor has: it gives exactly its effort
+// limit, so from rest the joint accelerates at effort / inertia (constant over the step).
+TEST(RigidBodySim, TorqueSaturatesAtTheEffortLimit) {
+  const dynamics::Model model = dynamics::Model::from_urdf_string(kTurntable);  // effort 100
+  dynamics::Data data(model);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(1);
+  const PdGains gains = gains_for(model, data, zero, 10.0, 1.0);
+  const Setpoint far{Eigen::VectorXd::Constant(1, 2.5), zero, zero};
+  RigidBodySim sim(model);
+  JointState state{zero, zero};
+  EXPECT_GT(control_torque(gains, far, state.q, state.qd)[0], 100.0);  // what the PD asks
+  EXPECT_EQ(sim.torque(gains, far, state)[0], 100.0);                  // what the motor gives
+  const double inertia = 0.03 + 2 * 0.2 * 0.2, dt = 1e-3;
+  sim.step(dt, gains, far, state);
+  EXPECT_NEAR(state.qd[0], 100.0 / inertia * dt, 1e-12);
+  EXPECT_NEAR(state.q[0], 100.0 / inertia * dt * dt / 2, 1e-12);
+}
+
+// A setpoint beyond a position limit drives the joint into its end stop: it stops there, on the
+// limit exactly and at rest, and leaves it freely when the setpoint comes back.
+TEST(RigidBodySim, APositionLimitIsAnEndStop) {
+  const dynamics::Model model = dynamics::Model::from_urdf_string(kTurntable);  // limits ±3
+  dynamics::Data data(model);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(1);
+  const PdGains gains = gains_for(model, data, zero, 2.0, 1.0);
+  RigidBodySim sim(model);
+  JointState state{Eigen::VectorXd::Constant(1, 2.5), zero};
+  const Setpoint beyond{Eigen::VectorXd::Constant(1, 3.5), zero, zero};
+  double highest = 0;
+  bool reached = false;
+  for (int k = 0; k < 2000; ++k) {
+    sim.step(1e-3, gains, beyond, state);
+    highest = std::max(highest, state.q[0]);
+    if (state.q[0] == 3.0) {
+      reached = true;
+      EXPECT_EQ(state.qd[0], 0.0) << k;
+    }
+  }
+  EXPECT_TRUE(reached);
+  EXPECT_EQ(highest, 3.0);
+  const Setpoint back{Eigen::VectorXd::Constant(1, 2.0), zero, zero};
+  for (int k = 0; k < 2000; ++k) sim.step(1e-3, gains, back, state);
+  EXPECT_NEAR(state.q[0], 2.0, 1e-3);
 }
 
 // The mass change is a point mass at the last body's centre of mass: the same as a box of no
