@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "bench/common/bench_stats.h"
+#include "bench/common/between_knots_measure.h"
 #include "kinograph/dynamics/inverse_dynamics.h"
 #include "kinograph/planning/batch/batch_planner.h"
 #include "kinograph/planning/io/scene.h"
@@ -23,41 +24,6 @@ namespace kinograph::bench {
 namespace {
 
 using nlohmann::json;
-
-struct Measure {
-  double shoulder = 0;        // max |τ| on the unactuated joints (N·m)
-  double elbow_excess = 0;    // max (|τ| − effort) / effort of the actuated joints, ≥ 0
-  double elbow_max = 0;       // max |τ| of the actuated joints (N·m)
-};
-
-// Inverse dynamics at `points` times (i + ½)/points of every interval, on derivatives of the
-// sampled q taken over ±dt/200 (inside the interval, so no knot is straddled).
-Measure measure(const dynamics::Model& model, const planning::Plan& plan, int points) {
-  planning::TrajectorySampler sampler(model, plan);
-  dynamics::Data data(model);
-  Measure m;
-  for (int k = 0; k < sampler.intervals(); ++k) {
-    const double dt = sampler.interval_length(k), e = dt / 200;
-    for (int i = 0; i < points; ++i) {
-      const double t = plan.t[k] + (i + 0.5) / points * dt;
-      const Eigen::VectorXd qm = sampler.at(t - e).q, q0 = sampler.at(t).q,
-                            qp = sampler.at(t + e).q;
-      const Eigen::VectorXd qd = (qp - qm) / (2 * e), qdd = (qp - 2 * q0 + qm) / (e * e);
-      const Eigen::VectorXd& tau = dynamics::rnea(model, data, q0, qd, qdd);
-      for (int j = 0; j < model.nq(); ++j) {
-        const dynamics::Body& b = model.bodies[j];
-        if (!b.actuated) {
-          m.shoulder = std::max(m.shoulder, std::abs(tau[j]));
-        } else {
-          m.elbow_max = std::max(m.elbow_max, std::abs(tau[j]));
-          m.elbow_excess =
-              std::max(m.elbow_excess, (std::abs(tau[j]) - b.limits.effort) / b.limits.effort);
-        }
-      }
-    }
-  }
-  return m;
-}
 
 int run(int argc, char** argv) {
   std::vector<int> grids = {50, 100, 200, 400};
@@ -134,7 +100,7 @@ int run(int argc, char** argv) {
                 {"iterations", plan.stats.iterations},
                 {"failures", plan.validation.failures}};
     if (plan.q.rows() == steps + 1) {
-      const Measure m = measure(*problem.model, plan, points);
+      const BetweenKnots m = measure_between_knots(*problem.model, plan, points);
       row["shoulder_torque_max"] = m.shoulder;
       row["elbow_torque_max"] = m.elbow_max;
       row["elbow_over_limit"] = m.elbow_excess;

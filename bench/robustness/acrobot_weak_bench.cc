@@ -1,14 +1,12 @@
 // The Acrobot swing-up under a weak elbow (robots/scenes/acrobot_swingup_4nm.yaml: ±4 N·m,
-// |q̇| ≤ 6 rad/s) over several horizons and five start variants, planned three ways: straight
-// from the batch planner, warm-started from the ±8 N·m plan, and by continuation in the limits.
+// |q̇| ≤ 6 rad/s) from five start variants, planned by the batch planner as it is (straight
+// line, then continuation in the effort limit) and with its continuation switched off.
 // Prints one JSON document, then a Markdown table; see bench/robustness/README.md.
 #include <spdlog/spdlog.h>
 
-#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <iostream>
-#include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -16,6 +14,8 @@
 
 #include "bench/common/bench_flags.h"
 #include "bench/common/bench_stats.h"
+#include "bench/common/between_knots_measure.h"
+#include "bench/common/timed_plan.h"
 #include "kinograph/planning/batch/batch_planner.h"
 #include "kinograph/planning/io/scene.h"
 
@@ -33,137 +33,90 @@ std::vector<double> parse_list(const std::string& s) {
   return out;
 }
 
-// The problem with every finite effort and velocity limit multiplied by `scale` (model copied).
-Problem with_scaled_limits(const Problem& problem, double scale) {
-  Problem p = problem;
-  auto model = std::make_shared<dynamics::Model>(*problem.model);
-  for (dynamics::Body& b : model->bodies) {
-    if (std::isfinite(b.limits.effort)) b.limits.effort *= scale;
-    if (std::isfinite(b.limits.velocity)) b.limits.velocity *= scale;
+json record(const Problem& p, const Run& r) {
+  const Plan& plan = r.plan;
+  json j = {{"success", plan.success()},
+            {"status", to_string(plan.stats.status)},
+            {"time_s", r.wall_s},
+            {"iterations", plan.stats.iterations},
+            {"attempts", plan.stats.attempts}};
+  if (plan.q.rows() == p.steps + 1) {
+    const BetweenKnots m = measure_between_knots(*p.model, plan, 10);
+    j["between_knots_shoulder_torque"] = m.shoulder;
+    j["between_knots_elbow_peak"] = m.elbow_max;
+    j["validator_shoulder_torque_between"] = plan.validation.max_unactuated_torque_between;
+    j["max_speed"] = plan.qd.cwiseAbs().maxCoeff();
   }
-  p.model = std::move(model);
-  return p;
-}
-
-// Continuation in the limits through the planner's API: the problem with its limits scaled by
-// each of `scales` in turn, each stage warm-started from the plan before it (valid or not), the
-// first from the planner's own initialization, then the problem itself from the last stage.
-// `stages_valid` gets whether each stage's plan validated (against its own scaled limits).
-Plan plan_with_continuation(const planning::BatchPlanner& planner, const Problem& problem,
-                            const std::vector<double>& scales, std::vector<bool>& stages_valid) {
-  Plan last;
-  bool have_last = false;
-  stages_valid.clear();
-  for (double s : scales) {
-    last = planner.plan(with_scaled_limits(problem, s), have_last ? &last : nullptr);
-    have_last = last.q.rows() == problem.steps + 1;
-    stages_valid.push_back(last.success());
-  }
-  return planner.plan(problem, have_last ? &last : nullptr);
-}
-
-// The horizon and steps of `p` (10 steps per second) and its start variant.
-Problem variant(const Problem& base, double horizon, const Eigen::Vector2d& start) {
-  Problem p = base;
-  p.horizon = horizon;
-  p.steps = static_cast<int>(std::lround(10 * horizon));
-  p.start_q = start;
-  return p;
-}
-
-struct Timed {
-  Plan plan;
-  double wall_s = 0;
-};
-
-template <class F>
-Timed timed(F&& f) {
-  const auto t0 = std::chrono::steady_clock::now();
-  Timed t;
-  t.plan = f();
-  t.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  return t;
-}
-
-json record(const Timed& t) {
-  const Plan& p = t.plan;
-  json j = {{"success", p.success()},
-            {"status", to_string(p.stats.status)},
-            {"time_s", t.wall_s},
-            {"iterations", p.stats.iterations}};
-  if (p.q.rows() > 0) {
-    j["max_elbow_torque"] = p.tau.col(1).cwiseAbs().maxCoeff();
-    j["max_speed"] = p.qd.cwiseAbs().maxCoeff();
-  }
-  if (!p.success()) {
-    j["first_failure"] = p.validation.failures.empty() ? "" : p.validation.failures[0];
+  if (!plan.success()) {
+    j["first_failure"] = plan.validation.failures.empty() ? "" : plan.validation.failures[0];
+    j["reason"] = plan.stats.reason;
   }
   return j;
 }
 
+std::string start_name(const Eigen::Vector2d& q) {
+  std::ostringstream os;
+  os << "(" << q[0] << ", " << q[1] << ")";
+  return os.str();
+}
+
 int run(int argc, char** argv) {
-  std::vector<double> horizons{8, 10, 12, 15, 20}, scales{2, 1.5, 1.25};
+  std::vector<double> horizons{40};
+  double per_second = 10;
+  bool direct = true;
   std::string json_path;
   if (!Flags("acrobot_weak_bench")
-           .value("--horizons", "8,10,...", [&](const std::string& s) { horizons = parse_list(s); })
-           .value("--scales", "2,1.5,...", [&](const std::string& s) { scales = parse_list(s); })
+           .value("--horizons", "40,...", [&](const std::string& s) { horizons = parse_list(s); })
+           .value("--steps-per-second", &per_second)
+           .toggle("--no-direct", [&] { direct = false; })
            .value("--json", &json_path)
            .parse(argc, argv)) {
     return 1;
   }
-  spdlog::set_level(spdlog::level::warn);
+  spdlog::set_level(spdlog::level::err);
   const Problem weak = planning::load_scene(kScenes + "acrobot_swingup_4nm.yaml").problem;
-  const Problem strong = planning::load_scene(kScenes + "acrobot_swingup.yaml").problem;
   const std::vector<Eigen::Vector2d> starts{{0, 0}, {0.05, 0}, {-0.05, 0}, {0, 0.05}, {0, -0.05}};
   const planning::BatchPlanner planner;
+  planning::BatchPlannerOptions off;
+  off.effort_continuation.clear();
+  const planning::BatchPlanner without(off);
   json runs = json::array();
-  std::cout << std::flush;
   for (double T : horizons) {
-    for (size_t v = 0; v < starts.size(); ++v) {
-      const Problem p = variant(weak, T, starts[v]);
-      const Timed direct = timed([&] { return planner.plan(p); });
-      const Timed warm = timed([&] {
-        const Plan eight = planner.plan(variant(strong, T, starts[v]));
-        return planner.plan(p, &eight);
-      });
-      std::vector<bool> stages;
-      const Timed cont = timed([&] { return plan_with_continuation(planner, p, scales, stages); });
+    for (const Eigen::Vector2d& start : starts) {
+      Problem p = weak;
+      p.horizon = T;
+      p.steps = static_cast<int>(std::lround(per_second * T));
+      p.start_q = start;
       json r = {{"horizon_s", T},
-                {"start_q", {starts[v][0], starts[v][1]}},
-                {"direct", record(direct)},
-                {"warm_from_8Nm", record(warm)},
-                {"continuation", record(cont)},
-                {"continuation_stages_valid", stages}};
+                {"steps", p.steps},
+                {"start_q", {start[0], start[1]}},
+                {"planner", record(p, plan_once(planner, p))}};
+      if (direct) r["without_continuation"] = record(p, plan_once(without, p));
       std::cerr << r.dump() << "\n";
       runs.push_back(r);
     }
   }
   json result = {{"scene", "robots/scenes/acrobot_swingup_4nm.yaml"},
-                 {"continuation_scales", scales},
-                 {"steps_per_second", 10},
+                 {"effort_continuation", planning::BatchPlannerOptions().effort_continuation},
                  {"runs", runs}};
   std::cout << result.dump(2) << "\n\n";
   if (!json_path.empty()) std::ofstream(json_path) << result.dump(2) << "\n";
-  std::cout << "| horizon (s) | method | valid | median time (s) | max time (s) | max |τ elbow| "
-               "(N·m) | max |q̇| (rad/s) |\n|---|---|---|---|---|---|---|\n";
-  for (double T : horizons) {
-    for (const char* m : {"direct", "warm_from_8Nm", "continuation"}) {
-      int ok = 0, n = 0;
-      std::vector<double> times;
-      double tau = 0, speed = 0;
-      for (const json& r : runs) {
-        if (r["horizon_s"].get<double>() != T) continue;
-        ++n;
-        const json& x = r[m];
-        times.push_back(x["time_s"].get<double>());
-        if (!x["success"].get<bool>()) continue;
-        ++ok;
-        tau = std::max(tau, x["max_elbow_torque"].get<double>());
-        speed = std::max(speed, x["max_speed"].get<double>());
-      }
-      std::cout << "| " << cell(T, 1, 0) << " | " << m << " | " << ok << "/" << n << " | "
-                << cell(median(times), 1, 2) << " | " << cell(max_of(times), 1, 2) << " | "
-                << (ok ? cell(tau, 1, 2) : "–") << " | " << (ok ? cell(speed, 1, 2) : "–")
+  std::cout << "| start q (rad) | horizon (s) | steps | planner | valid | time (s) | iterations | "
+               "max between-knot shoulder τ (N·m) | elbow peak (N·m) |\n"
+               "|---|---|---|---|---|---|---|---|---|\n";
+  for (const json& r : runs) {
+    for (const char* m : {"planner", "without_continuation"}) {
+      if (!r.contains(m)) continue;
+      const json& x = r[m];
+      const bool ok = x["success"].get<bool>();
+      const Eigen::Vector2d start(r["start_q"][0].get<double>(), r["start_q"][1].get<double>());
+      std::cout << "| " << start_name(start) << " | " << cell(r["horizon_s"].get<double>(), 1, 0)
+                << " | " << r["steps"].get<int>() << " | "
+                << (std::string(m) == "planner" ? "as it is" : "no continuation") << " | "
+                << (ok ? "yes" : "no") << " | " << cell(x["time_s"].get<double>(), 1, 1) << " | "
+                << x["iterations"].get<int>() << " | "
+                << (ok ? cell(x["between_knots_shoulder_torque"].get<double>(), 1, 4) : "–")
+                << " | " << (ok ? cell(x["between_knots_elbow_peak"].get<double>(), 1, 2) : "–")
                 << " |\n";
     }
   }

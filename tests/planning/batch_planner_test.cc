@@ -158,6 +158,7 @@ TEST(BatchPlanner, ImpossibleProblemsFailCleanly) {
     p.model = weak;
     BatchPlannerOptions o;
     o.outer_loop.max_total_iterations = 150;
+    o.effort_continuation.clear();  // one solve: its iteration limit is what this checks
     const Plan plan = BatchPlanner(o).plan(p);
     EXPECT_FALSE(plan.success());
     EXPECT_EQ(plan.stats.status, PlanStatus::kInfeasible);

@@ -821,6 +821,40 @@ TEST(BatchPlannerOptions, MaxRestarts) {
   EXPECT_EQ(BatchPlanner(o).plan(testing::rr_reach()).stats.attempts, 1);
 }
 
+// A short, coarse Acrobot swing-up whose plans never validate: the continuation in the effort
+// limits runs after the straight line (one attempt more), once per factor of
+// effort_continuation. Short, since each interval integrates the shoulder in 0.01 s steps.
+Problem never_valid_acrobot(BatchPlannerOptions& o) {
+  o.validation.final_velocity = -1;  // no plan can meet this
+  o.effort_continuation = {2};
+  Problem p = testing::acrobot_swingup();
+  p.horizon = 3;
+  p.steps = 6;
+  return p;
+}
+
+TEST(BatchPlannerOptions, EffortContinuationRunsForUnactuatedRobots) {
+  BatchPlannerOptions o;
+  const Problem p = never_valid_acrobot(o);
+  ASSERT_EQ(BatchPlanner(o).plan(p).stats.attempts, 2);
+  o.effort_continuation.clear();
+  EXPECT_EQ(BatchPlanner(o).plan(p).stats.attempts, 1);
+}
+
+// No stage validates, so each one and the final solve start from the straight line: the final
+// solve repeats the first attempt (`none` iterations) and each factor adds a stage of its own.
+TEST(BatchPlannerOptions, EffortContinuationSolvesEachFactor) {
+  BatchPlannerOptions o;
+  const Problem p = never_valid_acrobot(o);
+  const int one = BatchPlanner(o).plan(p).stats.iterations;  // {2}
+  o.effort_continuation = {2, 1.5};
+  const int two = BatchPlanner(o).plan(p).stats.iterations;
+  o.effort_continuation.clear();
+  const int none = BatchPlanner(o).plan(p).stats.iterations;
+  EXPECT_GT(one, 2 * none);
+  EXPECT_GT(two, one);
+}
+
 TEST(BatchPlannerOptions, DetourCandidatesBoundTheRestarts) {
   BatchPlannerOptions o;
   o.validation.final_velocity = -1;

@@ -262,6 +262,7 @@ TEST(ViolationText, InfeasibleSolveReasonSpeaksUserTerms) {
   BatchPlannerOptions o;
   o.outer_loop.max_total_iterations = 60;
   o.max_restarts = 0;
+  o.effort_continuation.clear();
   const Plan plan = BatchPlanner(o).plan(p);
   ASSERT_EQ(plan.stats.status, PlanStatus::kInfeasible);
   const std::string& why = plan.stats.reason;

@@ -124,10 +124,8 @@ Plan BatchPlanner::plan(const Problem& problem, const Plan* warm, BatchSolution*
   SolveStats total;
   BatchSolution attempt;
   int made = 0;
-  for (size_t a = 0; a < inits.size(); ++a) {
-    if (!inits[a]) inits[a] = searched_path(problem, q_goal, options_.path_search);
-    if (!inits[a]) continue;  // no path found: on to the next initialization
-    Plan p = solve(problem, *inits[a], method, solution != nullptr ? &attempt : nullptr);
+  // Counts attempt `p` into the totals and keeps it when it is the best so far.
+  auto consider = [&](Plan p) {
     const bool first = made++ == 0;
     if (first) {
       total = p.stats;
@@ -135,7 +133,7 @@ Plan BatchPlanner::plan(const Problem& problem, const Plan* warm, BatchSolution*
       total.iterations += p.stats.iterations;
       total.outer_iterations += p.stats.outer_iterations;
       total.linear_solves += p.stats.linear_solves;
-      ++total.attempts;
+      total.attempts += p.stats.attempts;
     }
     spdlog::debug("plan {}: attempt {}: {}", problem.name, made,
                   p.success() ? std::string("valid") : to_string(p.stats.status));
@@ -144,8 +142,18 @@ Plan BatchPlanner::plan(const Problem& problem, const Plan* warm, BatchSolution*
       best = std::move(p);
       if (solution != nullptr) *solution = std::move(attempt);
     }
+  };
+  for (size_t a = 0; a < inits.size(); ++a) {
+    if (!inits[a]) inits[a] = searched_path(problem, q_goal, options_.path_search);
+    if (!inits[a]) continue;  // no path found: on to the next initialization
+    consider(solve(problem, *inits[a], method, solution != nullptr ? &attempt : nullptr));
     if (best.success() || best.stats.status == PlanStatus::kInvalidProblem) break;
     add_restarts(false, a + 1);
+  }
+  if (!best.success() && best.stats.status != PlanStatus::kInvalidProblem && warm == nullptr &&
+      !options_.effort_continuation.empty() && effort_continuation_applies(problem)) {
+    consider(solve_by_effort_continuation(problem, q_goal, method,
+                                          solution != nullptr ? &attempt : nullptr));
   }
   const SolveStats own = best.stats;
   best.stats = total;
@@ -272,6 +280,30 @@ Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init, const s
     solution->graph = std::move(pg);
     solution->constraints = std::move(state);
   }
+  return plan;
+}
+
+Plan BatchPlanner::solve_by_effort_continuation(const Problem& problem,
+                                                const Eigen::VectorXd& q_goal,
+                                                const std::string& method,
+                                                BatchSolution* solution) const {
+  std::optional<Plan> last;  // the last stage that validated
+  SolveStats stages;
+  for (double scale : options_.effort_continuation) {
+    const Problem stage = with_effort_scaled(problem, scale);
+    Plan p = solve(stage, last ? warm_start(stage, *last) : straight_line(stage, q_goal), method);
+    spdlog::debug("plan {}: effort x{}: {}", problem.name, scale,
+                  p.success() ? std::string("valid") : to_string(p.stats.status));
+    stages.iterations += p.stats.iterations;
+    stages.outer_iterations += p.stats.outer_iterations;
+    stages.linear_solves += p.stats.linear_solves;
+    if (p.success()) last = std::move(p);
+  }
+  Plan plan = solve(problem, last ? warm_start(problem, *last) : straight_line(problem, q_goal),
+                    method, solution);
+  plan.stats.iterations += stages.iterations;
+  plan.stats.outer_iterations += stages.outer_iterations;
+  plan.stats.linear_solves += stages.linear_solves;
   return plan;
 }
 

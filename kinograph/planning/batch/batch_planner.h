@@ -1,6 +1,9 @@
 #pragma once
 // DFGP batch planning: the problem's factor graph solved by Levenberg–Marquardt inside an
 // augmented-Lagrangian outer loop, then validated independently.
+#include <vector>
+
+#include "kinograph/planning/batch/effort_continuation.h"
 #include "kinograph/planning/batch/path_search.h"
 #include "kinograph/planning/formulation/dfg_builder.h"
 #include "kinograph/planning/formulation/initialization.h"
@@ -58,6 +61,12 @@ struct BatchPlannerOptions {
   /// the straight line collides, first (second after the best detour when that detour's path is
   /// clear); else right after a failed first attempt. max_samples = 0 switches it off.
   PathSearchOptions path_search;
+  /// When no attempt validates and the robot has an unactuated joint and a finite effort limit
+  /// (effort_continuation_applies), one more attempt by continuation in the effort limits: the
+  /// problem with every actuated joint's limit multiplied by each of these factors in turn (the
+  /// first from the straight line, each later one and finally the problem itself warm-started
+  /// from the last stage that validated). Dimensionless, > 0; empty = off.
+  std::vector<double> effort_continuation{2, 1.5, 1.25, 1.125, 1.0625};
 };
 
 /// Where the solve of a plan ended: its graph, values and the constraint state (final
@@ -97,6 +106,10 @@ class BatchPlanner {
   /// when that is non-null.
   Plan solve(const Problem& problem, const Trajectory& init, const std::string& method,
              BatchSolution* solution = nullptr) const;
+  /// The continuation attempt (options().effort_continuation), its stats summed over every
+  /// stage; the final solve's state goes to `solution` when that is non-null.
+  Plan solve_by_effort_continuation(const Problem& problem, const Eigen::VectorXd& q_goal,
+                                    const std::string& method, BatchSolution* solution) const;
 
   BatchPlannerOptions options_;
 };
