@@ -25,6 +25,8 @@ PACKAGES=(
   dart-doc
   # the Python client's tests (the client needs only python3 and liblcm1)
   python3
+  # the API reference (target docs, test docs.doxygen); the build skips both without it
+  doxygen
   # network namespaces for LCM multicast tests
   iproute2 util-linux
 )

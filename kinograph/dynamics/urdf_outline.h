@@ -10,13 +10,13 @@ namespace kinograph::dynamics {
 
 /// Where the elements of one URDF are, by name, and how many geometry elements each link has.
 struct UrdfOutline {
-  /// One <link>: its line and the lines of its <collision> and <visual> children.
+  /// One `<link>`: its line and the lines of its `<collision>` and `<visual>` children.
   struct Link {
     int line = 0;
     std::vector<int> collision_lines, visual_lines;
   };
   std::map<std::string, Link> links;
-  std::map<std::string, int> joint_lines;  ///< 1-based line of each <joint>
+  std::map<std::string, int> joint_lines;  ///< 1-based line of each `<joint>`
 
   /// " (line N)" for a link or joint named in the outline, empty when unknown.
   std::string link_line(const std::string& link) const;
@@ -25,7 +25,7 @@ struct UrdfOutline {
 
 /// Reads the XML of a URDF. `source` names it in messages (a path or "<urdf string>").
 /// @throws UrdfError for XML that does not parse (with its line), a xacro file ("expand it with
-///   xacro first"), a root that is not <robot>, or a numeric attribute that is not a list of the
+///   xacro first"), a root that is not `<robot>`, or a numeric attribute that is not a list of the
 ///   right number of finite numbers (sizes must also be > 0), naming the link or joint, the
 ///   element path and the line.
 UrdfOutline outline_urdf(const std::string& xml, const std::string& source);

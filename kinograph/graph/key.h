@@ -40,9 +40,12 @@ class Key {
 
 }  // namespace kinograph::graph
 
+/// @cond
+// Doxygen cannot place a specialization of std's template: left out of the reference.
 template <>
 struct std::hash<kinograph::graph::Key> {
   size_t operator()(const kinograph::graph::Key& k) const noexcept {
     return std::hash<uint64_t>{}(k.id());
   }
 };
+/// @endcond

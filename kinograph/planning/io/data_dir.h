@@ -11,7 +11,7 @@ namespace kinograph::planning {
 inline constexpr const char* kDataDirVariable = "KINOGRAPH_DATA_DIR";
 
 /// The data directories, in the order they are searched, that exist: $KINOGRAPH_DATA_DIR,
-/// then <directory of the running program>/../share/kinograph (an installed prefix, or the
+/// then `<directory of the running program>/../share/kinograph` (an installed prefix, or the
 /// build tree's share/kinograph).
 std::vector<std::filesystem::path> data_dirs();
 

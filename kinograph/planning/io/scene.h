@@ -40,7 +40,7 @@ struct PayloadSpec {
   Eigen::Vector3d offset = Eigen::Vector3d::Zero();  ///< box centre in `frame` (m)
 };
 
-/// Replacement limits for one joint (scene key limits.<joint>); unset entries keep the URDF's.
+/// Replacement limits for one joint (scene key `limits.<joint>`); unset entries keep the URDF's.
 /// An effort must be > 0 (a passive joint is listed in Scene::unactuated instead).
 struct LimitOverride {
   std::optional<double> lower, upper, velocity, effort, acceleration;

@@ -11,7 +11,7 @@
 
 namespace kinograph::planning {
 
-/// An SRDF that cannot be used: unreadable, not well-formed XML, a root other than <robot>, a
+/// An SRDF that cannot be used: unreadable, not well-formed XML, a root other than `<robot>`, a
 /// disable_collisions without link1 or link2, or a link the robot does not have. what() names
 /// the file, the line and the element.
 class SrdfError : public std::runtime_error {
@@ -26,7 +26,7 @@ class SrdfError : public std::runtime_error {
   int line_ = 0;
 };
 
-/// One <disable_collisions> element: a link pair allowed to touch.
+/// One `<disable_collisions>` element: a link pair allowed to touch.
 struct DisabledCollision {
   std::string link1, link2;
   std::string reason;  ///< as written ("Adjacent", "Never", ...); may be empty
@@ -34,7 +34,7 @@ struct DisabledCollision {
 };
 
 /// The disable_collisions elements of SRDF text in file order; `source` names it in errors.
-/// @throws SrdfError for malformed XML, a root other than <robot> or a missing link attribute.
+/// @throws SrdfError for malformed XML, a root other than `<robot>` or a missing link attribute.
 std::vector<DisabledCollision> parse_srdf(const std::string& xml, const std::string& source = "");
 
 /// Reads an SRDF file's disable_collisions elements. @throws SrdfError as parse_srdf, and
