@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "kinograph/collision/capsule_bound.h"
 #include "kinograph/collision/convex_shape.h"
 #include "kinograph/collision/obstacle.h"
 #include "kinograph/collision/proximity.h"
@@ -21,8 +22,9 @@ struct CollisionWorldOptions {
   // Pairs whose signed distance exceeds this (m) are not reported by query(); the planner's
   // hinge ignores them anyway. Default 0.3 m, a few times a typical safety distance.
   double query_distance = 0.3;
-  // Cull pairs by bounding spheres before running GJK. Only a speed-up: turning it off must
-  // not change any result (tests compare both). Default on.
+  // Cull pairs by bounds before running GJK (per link a capsule, per geometry a sphere and a
+  // capsule). Only a speed-up: turning it off must not change any result (tests compare both).
+  // Default on.
   bool cull = true;
   // Also report pairs of robot geometries on bodies that are neither the same nor parent and
   // child. Default off: arm links rarely meet, and the check costs O(n²).
@@ -77,6 +79,9 @@ class CollisionWorld {
   std::span<const Proximity> query(const dynamics::Data& data, double t = 0);
   // As query(data, t) with another query distance.
   std::span<const Proximity> query(const dynamics::Data& data, double t, double query_distance);
+  // True when some pair is within `distance` (what query(data, t, distance) would report),
+  // stopping at the first one found.
+  bool any_within(const dynamics::Data& data, double t, double distance);
   // The pair with the smallest signed distance (over obstacles, and over self pairs when
   // enabled), culled against the best so far; distance +inf and robot_geom -1 when there is
   // nothing to check.
@@ -88,15 +93,25 @@ class CollisionWorld {
     Eigen::Isometry3d origin;  // in its body's frame
     ConvexShape shape;
     Eigen::Vector3d local_centre;  // bounding sphere centre in the body's frame
+    CapsuleBound local_capsule;    // bounding capsule in the body's frame
     Eigen::Isometry3d world;       // valid when posed == pose_stamp_
-    Eigen::Vector3d centre;        // bounding sphere centre, world (after update_poses)
-    uint64_t posed = 0;
+    Eigen::Vector3d centre;        // bounding sphere centre, world; valid when centred == stamp
+    CapsuleBound capsule;          // bounding capsule, world; valid when capsuled == stamp
+    uint64_t posed = 0, centred = 0, capsuled = 0;
+    bool elongated = false;  // the capsule is longer than a point (else it is the sphere)
+  };
+  // A capsule around all geometry of one body (index body + 1; the base is 0), posed per query.
+  struct BodyBound {
+    CapsuleBound local, world;
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // of the sphere around it, world
+    double sphere_radius = 0;
+    bool present = false;  // the body has collision geometry
   };
   // A pair closest() may check, with its lower bound; checked in order of the bound.
   struct Candidate {
     double bound;
     int order;  // position in the brute-force visiting order (ties keep the earlier pair)
-    int a, b;   // robot geometry and obstacle index, or two robot geometries (b < 0: ~b)
+    int a, b;   // robot geometry and obstacle index, or (b < 0) the index of a self pair
   };
   struct ObstacleEntry {
     Obstacle obstacle;
@@ -107,24 +122,38 @@ class CollisionWorld {
     void place(const Eigen::Isometry3d& pose);
   };
 
-  // Sets the bounding-sphere centres and moving obstacles; full geometry poses are made only
-  // for pairs that survive culling (geom_world).
+  // Poses the body capsules and moving obstacles; link-level bounds, geometry bounds and poses
+  // are made only for pairs that reach them (body_bound, centre, capsule, geom_world).
   void update_poses(const dynamics::Data& data, double t);
+  // Fills out_ with the pairs within query_distance, in order; only the first with first_only.
+  void scan(const dynamics::Data& data, double t, double query_distance, bool first_only);
   const Eigen::Isometry3d& geom_world(int g);
+  const Eigen::Vector3d& centre(int g);
+  const CapsuleBound& capsule(int g);
   void reserve_output();
-  // True when the bounds prove the pair's signed distance exceeds `threshold` (no square roots
-  // when threshold + radii >= 0).
-  bool beyond(int g, const ObstacleEntry& o, double threshold) const;
-  bool beyond(int a, int b, double threshold) const;
-  // After any change of the obstacles: recounts the moving ones.
+  // True when the geometry bounds prove the pair's signed distance exceeds `threshold`: the
+  // sphere (no square roots when threshold + radii >= 0), then the capsule.
+  bool beyond(int g, int o, double threshold);
+  bool beyond_self(int pair, double threshold);
+  // After any change of the obstacles: recounts the moving ones and resizes the link bounds.
   void obstacles_changed();
   int find_index(int id) const;
   // Fills `out` with the pair's signed distance if it is at most max_distance.
   bool robot_obstacle(int g, const ObstacleEntry& o, double max_distance, Proximity& out);
   bool robot_robot(int a, int b, double max_distance, Proximity& out);
-  // A lower bound of the pair's signed distance from bounding spheres and boxes.
-  double lower_bound(int g, const ObstacleEntry& o) const;
-  double lower_bound(int a, int b) const;
+  // Lower bounds of the pair's signed distance: from the link bound and the geometry's bounding
+  // sphere (and box), and the tighter one that adds the geometry's capsule.
+  double lower_bound(int g, int o);
+  double lower_bound_self(int pair);
+  double capsule_bound(int g, int o);
+  double capsule_bound_self(int pair);
+  // Link-level lower bounds, made at most once per query: body and obstacle (body capsule
+  // against the obstacle's sphere and box), and the i-th self body pair.
+  double body_bound(int body, int o);
+  double body_pair_bound(int i);
+  // Sets body_obstacle_near_ and body_pair_near_: false where the link bounds prove the pair
+  // farther apart than threshold.
+  void mark_near_bodies(double threshold);
   // Robot geometry indices that take part in obstacle pairs.
   bool checks_obstacles(int g) const { return options_.base_vs_obstacles || robot_[g].body >= 0; }
 
@@ -132,6 +161,15 @@ class CollisionWorld {
   CollisionWorldOptions options_;
   std::vector<RobotGeom> robot_;
   std::vector<std::pair<int, int>> self_pairs_;  // robot geometry index pairs
+  std::vector<int> self_body_pair_;              // per self pair: its index in body_pairs_
+  std::vector<std::pair<int, int>> body_pairs_;  // body indices (+1) of the self pairs
+  std::vector<double> body_pair_bound_;          // per body pair: link-level lower bound
+  std::vector<uint64_t> body_pair_stamp_;        // pose_stamp_ when body_pair_bound_ was made
+  std::vector<char> body_pair_near_;             // per body pair: not culled by mark_near_bodies
+  std::vector<BodyBound> bodies_;                // per body + 1
+  std::vector<double> body_obstacle_bound_;      // [(body + 1) * obstacles + o]: lower bound
+  std::vector<uint64_t> body_obstacle_stamp_;    // pose_stamp_ when it was made
+  std::vector<char> body_obstacle_near_;         // [(body + 1) * obstacles + o]: not culled
   std::vector<ObstacleEntry> obstacles_;
   int moving_ = 0;  // obstacles with a trajectory
   std::vector<Proximity> out_;

@@ -158,6 +158,45 @@ TEST_F(CollisionFastPath, PairsExactlyAtTheCutOff) {
   EXPECT_GT(checked, 100);
 }
 
+// Self pairs and the floor (a 100 m slab whose bounding sphere says nothing; the link and
+// geometry capsules decide) with the query distance exactly at each near pair's distance and one
+// double below, and the cut-off 1 mm either side: the culled world reports exactly the pairs
+// (and bits) of a world that runs GJK on every pair.
+TEST_F(CollisionFastPath, SelfPairsAndTheFloorAtTheCutOff) {
+  CollisionWorldOptions opts;
+  opts.self_collision = true;
+  opts.self_collision_excluded = {{4, 6}};  // the iiwa's wrist pair, as its SRDF
+  CollisionWorldOptions brute_opts = opts;
+  brute_opts.cull = false;
+  CollisionWorld fast(model, opts), brute(model, brute_opts);
+  Obstacle floor = box_at(-7, 100, 100, 1, 0, 0, -0.5);
+  ASSERT_TRUE(fast.add_obstacle(floor));
+  ASSERT_TRUE(brute.add_obstacle(floor));
+  std::mt19937 rng(13);
+  int self_checked = 0, floor_checked = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    dynamics::forward_kinematics(model, data, random_q(rng));
+    const std::vector<Proximity> all(brute.query(data, 0, kInf).begin(),
+                                     brute.query(data, 0, kInf).end());
+    for (const Proximity& p : all) {
+      if (p.distance > 0.1) continue;
+      for (const double cut :
+           {p.distance, std::nextafter(p.distance, -kInf), p.distance + 1e-3, p.distance - 1e-3}) {
+        const std::vector<Proximity> ref(brute.query(data, 0, cut).begin(),
+                                         brute.query(data, 0, cut).end());
+        expect_same(fast.query(data, 0, cut), ref, "trial " + std::to_string(trial));
+      }
+      (p.is_self_collision() ? self_checked : floor_checked)++;
+    }
+    const Proximity a = fast.closest(data), b = brute.closest(data);
+    EXPECT_EQ(a.distance, b.distance);
+    EXPECT_EQ(a.robot_geom, b.robot_geom);
+    EXPECT_EQ(a.other_geom, b.other_geom);
+  }
+  EXPECT_GT(self_checked, 100);
+  EXPECT_GT(floor_checked, 20);
+}
+
 // closest() visits pairs in order of their bounds; it must give the brute-force minimum and,
 // among equals, the same pair as the brute-force order.
 TEST_F(CollisionFastPath, ClosestMatchesBruteForce) {

@@ -48,12 +48,12 @@ class ClearanceTest {
     self_threshold_ = std::min(self_threshold_, 0.9 * floor_and_self_->closest(data_, 0).distance);
   }
 
-  // No pair within its threshold: query() culls the far pairs and reports the near ones, which
-  // is cheaper than finding the closest.
+  // No pair within its threshold: any_within() culls the far pairs and stops at the first near
+  // one, which is cheaper than finding the closest.
   bool clear(const Eigen::VectorXd& q) {
     dynamics::forward_kinematics(model_, data_, q);
-    if (obstacles_ && !obstacles_->query(data_, 0, obstacle_threshold_).empty()) return false;
-    return floor_and_self_->query(data_, 0, self_threshold_).empty();
+    if (obstacles_ && obstacles_->any_within(data_, 0, obstacle_threshold_)) return false;
+    return !floor_and_self_->any_within(data_, 0, self_threshold_);
   }
 
   // The segment a → b, sampled every `resolution` (b included, a assumed clear).

@@ -12,12 +12,13 @@ namespace kinograph::planning {
 
 CollisionContext::CollisionContext(std::shared_ptr<const dynamics::Model> m,
                                    const std::vector<collision::Obstacle>& obstacles,
-                                   double query_dist, const SelfPairs* self)
+                                   double query_dist, const SelfPairs* self, bool cull)
     : model(std::move(m)),
       world(*model,
             [&] {
               collision::CollisionWorldOptions o;
               o.query_distance = query_dist;
+              o.cull = cull;
               if (self != nullptr) {
                 o.self_collision = true;
                 o.self_collision_excluded = self->allowed;
@@ -131,7 +132,8 @@ std::string collision_pair(const CollisionContext& ctx, int row) {
       if (ctx.row_of[g][slot] != row) continue;
       const int id = ctx.obstacle_ids[slot];
       return "link " + link(g) +
-             (id == kFloorId ? std::string(" and the floor") : " and obstacle " + std::to_string(id));
+             (id == kFloorId ? std::string(" and the floor")
+                             : " and obstacle " + std::to_string(id));
     }
   }
   for (size_t a = 0; a < ctx.self_row_of.size(); ++a) {

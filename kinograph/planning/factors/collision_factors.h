@@ -27,9 +27,10 @@ struct SelfPairs {
 /// self pair.
 struct CollisionContext {
   /// Builds the world; throws std::invalid_argument if an obstacle id repeats or a shape is bad.
+  /// `cull` false runs GJK on every pair: the reference the culled world must match exactly.
   CollisionContext(std::shared_ptr<const dynamics::Model> model,
                    const std::vector<collision::Obstacle>& obstacles, double query_distance,
-                   const SelfPairs* self = nullptr);
+                   const SelfPairs* self = nullptr, bool cull = true);
 
   std::shared_ptr<const dynamics::Model> model;
   collision::CollisionWorld world;
