@@ -682,7 +682,7 @@ TEST_F(NodeFixture, AReplanWhileAnExecutorFollowsJoinsTheMotion) {
   const joint_command_t command = messages::command_to_message(setpoint, model);
   lcm_.publish("RR_COMMAND", &command);
   send_state(1'200'000, {at_state.q[0] + 0.01, at_state.q[1]}, {at_state.qd[0], at_state.qd[1]});
-  send_obstacle("ball", obstacle_t::ADD_OR_MOVE, 0.05, {0, 0, 1.85}, false, 1'200'000);
+  send_obstacle("ball", obstacle_t::ADD_OR_MOVE, 0.05, {0, 0, 1.85}, false, "", 1'200'000);
   plans = listener_->wait_plans(2);
   ASSERT_EQ(plans.size(), 2u);
   const plan_t& replan = plans[1];
@@ -721,7 +721,7 @@ TEST_F(LatencyNodeFixture, TheTakeOverLatencyIsTheOptionsValue) {
   const joint_command_t command = messages::command_to_message(setpoint, model);
   lcm_.publish("RR_COMMAND", &command);
   send_state(1'100'000, {-0.8, 0.4});
-  send_obstacle("ball", obstacle_t::ADD_OR_MOVE, 0.05, {0, 0, 1.85}, false, 1'100'000);
+  send_obstacle("ball", obstacle_t::ADD_OR_MOVE, 0.05, {0, 0, 1.85}, false, "", 1'100'000);
   plans = listener_->wait_plans(2);
   ASSERT_EQ(plans.size(), 2u);
   ASSERT_EQ(plans[1].status, plan_t::SUCCESS) << plans[1].status_message;
@@ -741,7 +741,7 @@ TEST_F(NodeFixture, AfterAStopTheReplanStartsAtTheMeasuredState) {
   const joint_command_t command = messages::command_to_message(hold, model);
   lcm_.publish("RR_COMMAND", &command);
   send_state(1'200'000, {-0.7, 0.3});
-  send_obstacle("ball", obstacle_t::ADD_OR_MOVE, 0.05, {0, 0, 1.85}, false, 1'200'000);
+  send_obstacle("ball", obstacle_t::ADD_OR_MOVE, 0.05, {0, 0, 1.85}, false, "", 1'200'000);
   plans = listener_->wait_plans(2);
   ASSERT_EQ(plans.size(), 2u);
   ASSERT_EQ(plans[1].status, plan_t::SUCCESS) << plans[1].status_message;
@@ -757,7 +757,7 @@ TEST_F(NodeFixture, AnObstacleUpdateChecksTheStatesAge) {
   send_goal(15, {0.8, -0.4}, 1'000'000);
   auto plans = listener_->wait_plans(1);
   ASSERT_EQ(plans[0].status, plan_t::SUCCESS) << plans[0].status_message;
-  send_obstacle("ball", obstacle_t::ADD_OR_MOVE, 0.05, {0, 0, 1.85}, false, 1'700'000);
+  send_obstacle("ball", obstacle_t::ADD_OR_MOVE, 0.05, {0, 0, 1.85}, false, "", 1'700'000);
   plans = listener_->wait_plans(2);
   ASSERT_EQ(plans.size(), 2u);
   EXPECT_EQ(plans[1].goal_id, 15);

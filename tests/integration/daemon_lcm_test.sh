@@ -78,12 +78,14 @@ n=$(ls "$WORK/plans" | wc -l)
 [ "$n" -ge 3 ] || fail "expected >= 3 plans in the log, found $n"
 grep -q "for goal 3: INVALID_GOAL" "$WORK/log-plans.txt" || fail "goal 3 not answered INVALID_GOAL"
 
-# Replay the recorded goals and obstacles into a fresh daemon; it must answer them again.
+# Replay the recorded goals and obstacles into a fresh daemon; it must answer them again. At the
+# recorded pace a busy machine can still let goal 2 arrive before goal 1 is taken up, and the
+# daemon then rightly answers goal 1 SUPERSEDED: answered either way, the newest planned.
 lcm-logger -f --lcm-url="$URL2" "$WORK/replay.lcmlog" >/dev/null 2>&1 &
 LOGGER2=$!
 PIDS+=($LOGGER2)
 start_daemon "$URL2" "$WORK/daemon2.log"
-lcm-logplayer --speed=4 --regexp="^RR_(GOAL|OBSTACLES)$" --lcm-url="$URL2" "$WORK/session.lcmlog"
+lcm-logplayer --speed=1 --regexp="^RR_(GOAL|OBSTACLES)$" --lcm-url="$URL2" "$WORK/session.lcmlog"
 for _ in $(seq 300); do
   grep -q "goal 2: plan" "$WORK/daemon2.log" && break
   sleep 0.1
@@ -93,6 +95,6 @@ kill -INT "$LOGGER2"
 wait "$LOGGER2" || true
 "$KG" log-plans "$WORK/replay.lcmlog" --channel RR_PLAN --scene "$SCENE" --out-dir "$WORK/replayed" \
   | tee "$WORK/replayed.txt"
-grep -q "for goal 1: SUCCESS" "$WORK/replayed.txt" || fail "replayed goal 1 not planned"
+grep -Eq "for goal 1: (SUCCESS|SUPERSEDED)" "$WORK/replayed.txt" || fail "replayed goal 1 not answered"
 grep -q "for goal 2: SUCCESS" "$WORK/replayed.txt" || fail "replayed goal 2 not planned"
 echo "1 passed, 0 failed"
