@@ -50,15 +50,9 @@ PlannerNode::PlannerNode(planning::Scene scene, PlannerNodeOptions options, lcm:
       motion_join_(robot_of(scene_), options_.takeover_latency_s),
       replanner_(options_.replanning) {
   identity_.model_name = scene_.problem.model->name;
-  identity_.channel_prefix = options_.channel_prefix.empty()
-                                 ? messages::default_channel_prefix(identity_.model_name)
-                                 : options_.channel_prefix;
-  if (shared) {
-    lcm_ = shared;
-  } else {
-    owned_lcm_ = messages::open_lcm(options_.lcm_url);
-    lcm_ = owned_lcm_.get();
-  }
+  identity_.channel_prefix =
+      messages::channel_prefix_or_default(options_.channel_prefix, identity_.model_name);
+  lcm_ = messages::shared_or_open(shared, options_.lcm_url, owned_lcm_);
   next_obstacle_id_ = static_cast<int>(scene_.problem.obstacles.size());
   for (const auto& o : scene_.problem.obstacles) {
     next_obstacle_id_ = std::max(next_obstacle_id_, o.id + 1);

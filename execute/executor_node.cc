@@ -68,15 +68,9 @@ std::string unfit(const plan_t& msg, const dynamics::Model& model) {
 ExecutorNode::ExecutorNode(planning::Scene scene, ExecutorNodeOptions options, lcm::LCM* shared)
     : scene_(std::move(scene)), options_(checked(options)), schedule_(*scene_.problem.model) {
   identity_.model_name = scene_.problem.model->name;
-  identity_.channel_prefix = options_.channel_prefix.empty()
-                                 ? messages::default_channel_prefix(identity_.model_name)
-                                 : options_.channel_prefix;
-  if (shared) {
-    lcm_ = shared;
-  } else {
-    owned_lcm_ = messages::open_lcm(options_.lcm_url);
-    lcm_ = owned_lcm_.get();
-  }
+  identity_.channel_prefix =
+      messages::channel_prefix_or_default(options_.channel_prefix, identity_.model_name);
+  lcm_ = messages::shared_or_open(shared, options_.lcm_url, owned_lcm_);
   subscriptions_ = {lcm_->subscribe(channel("PLAN"), &ExecutorNode::on_plan, this),
                     lcm_->subscribe(channel("STATE"), &ExecutorNode::on_state, this),
                     lcm_->subscribe(channel("STOP"), &ExecutorNode::on_stop, this)};

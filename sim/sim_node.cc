@@ -71,9 +71,8 @@ SimNode::SimNode(planning::Scene scene, SimNodeOptions options, lcm::LCM* shared
       noise_(options_.position_noise, options_.velocity_noise, options_.seed) {
   const dynamics::Model& model = *scene_.problem.model;
   identity_.model_name = model.name;
-  identity_.channel_prefix = options_.channel_prefix.empty()
-                                 ? messages::default_channel_prefix(model.name)
-                                 : options_.channel_prefix;
+  identity_.channel_prefix =
+      messages::channel_prefix_or_default(options_.channel_prefix, model.name);
   data_ = std::make_unique<dynamics::Data>(model);
   sim_ = std::make_unique<RigidBodySim>(plant_);
   state_ = {scene_.problem.start_q, scene_.problem.start_qd};
@@ -81,12 +80,7 @@ SimNode::SimNode(planning::Scene scene, SimNodeOptions options, lcm::LCM* shared
   // gains are shaped by the mass matrix at each new setpoint.
   gains_ = gains_for(model, *data_, state_.q, kPdFrequencyHz, kDampingRatio);
   setpoint_ = hold_setpoint(model, *data_, state_.q);
-  if (shared) {
-    lcm_ = shared;
-  } else {
-    owned_lcm_ = messages::open_lcm(options_.lcm_url);
-    lcm_ = owned_lcm_.get();
-  }
+  lcm_ = messages::shared_or_open(shared, options_.lcm_url, owned_lcm_);
   subscription_ = lcm_->subscribe(channel("COMMAND"), &SimNode::on_command, this);
 }
 

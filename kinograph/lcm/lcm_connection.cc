@@ -24,4 +24,15 @@ std::string default_channel_prefix(const std::string& robot_name) {
   return s;
 }
 
+std::string channel_prefix_or_default(const std::string& prefix, const std::string& robot_name) {
+  return prefix.empty() ? default_channel_prefix(robot_name) : prefix;
+}
+
+lcm::LCM* shared_or_open(lcm::LCM* shared, const std::string& url,
+                         std::unique_ptr<lcm::LCM>& owned) {
+  if (shared != nullptr) return shared;
+  owned = open_lcm(url);
+  return owned.get();
+}
+
 }  // namespace kinograph::messages
