@@ -21,6 +21,7 @@
 #include "kinograph/planning/io/scene.h"
 #include "kinograph/planning/validate.h"
 #include "lcmtypes/safe_decode.h"
+#include "tests/daemon/node_listener.h"
 
 namespace kinograph::daemon {
 namespace {
@@ -44,51 +45,6 @@ constexpr char kPayloadYaml[] =
 constexpr char kBallYaml[] =
     "obstacles:\n  - {id: ball, shape: sphere, size: [0.1], position: [0, 0.3, 1.8]}\n";
 
-// Records the node's plans and heartbeats for the test thread to wait on.
-class Answers {
- public:
-  explicit Answers(lcm::LCM& lcm) {
-    lcm.subscribe("RR_PLAN", &Answers::on_plan, this)->setQueueCapacity(1000);
-    lcm.subscribe("RR_PLANNER_STATUS", &Answers::on_status, this)->setQueueCapacity(1000);
-  }
-  void on_plan(const lcm::ReceiveBuffer* rbuf, const std::string&) {
-    plan_t msg;
-    ASSERT_TRUE(lcmtypes::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), msg).ok);
-    std::lock_guard lock(mutex_);
-    plans_.push_back(std::move(msg));
-    cv_.notify_all();
-  }
-  void on_status(const lcm::ReceiveBuffer* rbuf, const std::string&) {
-    planner_status_t msg;
-    ASSERT_TRUE(lcmtypes::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), msg).ok);
-    std::lock_guard lock(mutex_);
-    messages_.push_back(msg.message);
-    cv_.notify_all();
-  }
-  // The plans once `count` have arrived (bounded wait; fewer on a timeout).
-  std::vector<plan_t> wait_plans(size_t count, double timeout_s = 120) {
-    std::unique_lock lock(mutex_);
-    cv_.wait_for(lock, std::chrono::duration<double>(timeout_s),
-                 [&] { return plans_.size() >= count; });
-    return plans_;
-  }
-  // Whether a heartbeat's message says `text` (bounded wait).
-  bool wait_status_containing(const std::string& text, double timeout_s = 30) {
-    std::unique_lock lock(mutex_);
-    return cv_.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] {
-      for (const auto& m : messages_)
-        if (m.find(text) != std::string::npos) return true;
-      return false;
-    });
-  }
-
- private:
-  std::mutex mutex_;
-  std::condition_variable cv_;
-  std::vector<plan_t> plans_;
-  std::vector<std::string> messages_;
-};
-
 class SceneMessages : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -108,7 +64,7 @@ class SceneMessages : public ::testing::Test {
     options.channel_prefix = "RR";
     options.status_period_s = 0.2;
     node_ = std::make_unique<PlannerNode>(planning::parse_scene(yaml, scene_path()), options, &lcm_);
-    answers_ = std::make_unique<Answers>(lcm_);
+    answers_ = std::make_unique<Listener>(lcm_);
     thread_ = std::thread([this] { node_->run(stop_); });
   }
   std::string scene_path() const { return dir_ + "/scene.yaml"; }
@@ -168,7 +124,7 @@ class SceneMessages : public ::testing::Test {
   std::string dir_;
   std::atomic<bool> stop_{false};
   std::unique_ptr<PlannerNode> node_;
-  std::unique_ptr<Answers> answers_;
+  std::unique_ptr<Listener> answers_;
   std::thread thread_;
 };
 

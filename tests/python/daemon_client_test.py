@@ -31,7 +31,9 @@ def urdf_joint_names(path):
             if j.get("type") != "fixed"]
 
 
-class PythonClientAgainstDaemon(unittest.TestCase):
+class DaemonTestCase(unittest.TestCase):
+    """One client for the tests of a class."""
+
     @classmethod
     def setUpClass(cls):
         cls.client = PlannerClient(PREFIX, URL)
@@ -39,6 +41,9 @@ class PythonClientAgainstDaemon(unittest.TestCase):
     @classmethod
     def tearDownClass(cls):
         cls.client.close()
+
+
+class PythonClientAgainstDaemon(DaemonTestCase):
 
     def test_joint_goal_is_planned(self):
         plan = self.client.plan(joint_goal(GOAL, goal_id=2), timeout_s=TIMEOUT_S)
@@ -92,16 +97,8 @@ class PythonClientAgainstDaemon(unittest.TestCase):
         self.assertIn("3", plan.status_message)
 
 
-class PythonClientSceneMessages(unittest.TestCase):
+class PythonClientSceneMessages(DaemonTestCase):
     """Runs after PythonClientAgainstDaemon (class names in order): goal ids 6, 7, ..."""
-
-    @classmethod
-    def setUpClass(cls):
-        cls.client = PlannerClient(PREFIX, URL)
-
-    @classmethod
-    def tearDownClass(cls):
-        cls.client.close()
 
     def plan(self, goal):
         plan = self.client.plan(goal, timeout_s=TIMEOUT_S)
