@@ -1,6 +1,7 @@
 # Optional: the LCM message types as a Java jar for lcm-spy, built when a JDK (openjdk-17-jdk)
 # and LCM's Java library (liblcm-java) are present; `kinograph-spy` starts lcm-spy with it.
-# Expects KINOGRAPH_LCM_TYPES (type names) and LCM_GEN; makes target kinograph_lcmtypes_jar.
+# Expects KINOGRAPH_LCM_TYPES and KINOGRAPH_DRAKE_LCM_TYPES (type names) and LCM_GEN; makes
+# target kinograph_lcmtypes_jar holding both packages, so lcm-spy decodes Drake's channels too.
 find_package(Java 1.8 COMPONENTS Development QUIET)
 find_file(KINOGRAPH_LCM_JAR lcm.jar PATHS /usr/share/java NO_DEFAULT_PATH)
 if(NOT Java_FOUND OR NOT KINOGRAPH_LCM_JAR)
@@ -15,6 +16,10 @@ set(lcm_files)
 foreach(type ${KINOGRAPH_LCM_TYPES})
   list(APPEND java_sources ${java_dir}/kinograph/${type}.java)
   list(APPEND lcm_files ${CMAKE_CURRENT_SOURCE_DIR}/${type}.lcm)
+endforeach()
+foreach(type ${KINOGRAPH_DRAKE_LCM_TYPES})
+  list(APPEND java_sources ${java_dir}/drake/${type}.java)
+  list(APPEND lcm_files ${CMAKE_CURRENT_SOURCE_DIR}/drake/${type}.lcm)
 endforeach()
 add_custom_command(OUTPUT ${java_sources}
   COMMAND ${CMAKE_COMMAND} -E make_directory ${java_dir}

@@ -7,12 +7,16 @@
 #include <cmath>
 #include <csignal>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
+#include <functional>
 #include <lcm/lcm-cpp.hpp>
 #include <stdexcept>
 #include <string_view>
+#include <utility>
 #include <thread>
 
+#include "daemon/robot_payload.h"
 #include "daemon/state_file.h"
 #include "daemon/state_limits.h"
 #include "daemon/wire_strings.h"
@@ -20,6 +24,7 @@
 #include "kinograph/lcm/drake_convert.h"
 #include "kinograph/lcm/lcm_connection.h"
 #include "kinograph/planner_status_t.hpp"
+#include "kinograph/payload_t.hpp"
 #include "lcmtypes/safe_decode.h"
 
 namespace kinograph::daemon {
@@ -65,8 +70,10 @@ PlannerNode::PlannerNode(planning::Scene scene, PlannerNodeOptions options, lcm:
   subscriptions_.push_back(
       lcm_->subscribe(channel("PLANNER_STATUS"), &PlannerNode::on_heartbeat, this));
   subscriptions_.push_back(lcm_->subscribe(channel("COMMAND"), &PlannerNode::on_command, this));
-  std::vector<int> capacities = {kGoalQueueCapacity, kObstacleQueueCapacity, kStateQueueCapacity,
-                                 kHeartbeatQueueCapacity, kStateQueueCapacity};
+  subscriptions_.push_back(lcm_->subscribe(channel("PAYLOAD"), &PlannerNode::on_payload, this));
+  std::vector<int> capacities = {kGoalQueueCapacity,      kObstacleQueueCapacity,
+                                 kStateQueueCapacity,     kHeartbeatQueueCapacity,
+                                 kStateQueueCapacity,     kPayloadQueueCapacity};
   if (!options_.iiwa_status_channel.empty()) {
     subscriptions_.push_back(
         lcm_->subscribe(options_.iiwa_status_channel, &PlannerNode::on_iiwa_status, this));
@@ -271,7 +278,7 @@ void PlannerNode::answer_superseded(const Intake& taken) {
 
 namespace {
 
-// Bounds the names of a decoded goal of either version, then converts it.
+// Bounds the names of a decoded goal of any version, then converts it.
 template <typename GoalMessage>
 Check convert_goal(const GoalMessage& msg, const dynamics::Model& model,
                    const RobotIdentity& identity, GoalRequest& request) {
@@ -280,25 +287,49 @@ Check convert_goal(const GoalMessage& msg, const dynamics::Model& model,
   return messages::goal_from_message(msg, model, identity, request);
 }
 
+// A goal of one of the versions sharing the channel, decoded: its id (-1 when it did not
+// decode) and its conversion, run once the goal is counted.
+struct DecodedGoal {
+  std::string malformed;  // why it did not decode, or empty
+  int64_t goal_id = -1;
+  std::function<Check(const dynamics::Model&, const RobotIdentity&, GoalRequest&)> convert;
+};
+
+template <typename GoalMessage>
+DecodedGoal decode_goal(const char* type, const lcm::ReceiveBuffer* rbuf) {
+  auto msg = std::make_shared<GoalMessage>();
+  DecodedGoal out;
+  if (auto s = lcmtypes::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), *msg); !s.ok) {
+    out.malformed = std::string("malformed ") + type + ": " + s.reason;
+    return out;
+  }
+  out.goal_id = msg->goal_id;
+  out.convert = [msg](const dynamics::Model& model, const RobotIdentity& identity,
+                      GoalRequest& request) { return convert_goal(*msg, model, identity, request); };
+  return out;
+}
+
 }  // namespace
 
 void PlannerNode::on_goal(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
-  // Both goal versions share the channel; the fingerprint says which one came.
+  // The goal versions share the channel; the fingerprint says which one came.
   const int size = static_cast<int>(rbuf->data_size);
-  goal_v2_t v2;
-  goal_t v1;
-  const bool is_v1 = lcmtypes::has_fingerprint<goal_t>(rbuf->data, size);
-  if (!is_v1 && !lcmtypes::has_fingerprint<goal_v2_t>(rbuf->data, size)) {
-    reject(channel, channel + ": malformed goal_t (or goal_v2_t): its fingerprint is neither's");
+  DecodedGoal decoded;
+  if (lcmtypes::has_fingerprint<goal_t>(rbuf->data, size)) {
+    decoded = decode_goal<goal_t>("goal_t", rbuf);
+  } else if (lcmtypes::has_fingerprint<goal_v2_t>(rbuf->data, size)) {
+    decoded = decode_goal<goal_v2_t>("goal_v2_t", rbuf);
+  } else if (lcmtypes::has_fingerprint<goal_v3_t>(rbuf->data, size)) {
+    decoded = decode_goal<goal_v3_t>("goal_v3_t", rbuf);
+  } else {
+    decoded.malformed =
+        "malformed goal: its fingerprint is none of goal_t's, goal_v2_t's or goal_v3_t's";
+  }
+  if (!decoded.malformed.empty()) {
+    reject(channel, channel + ": " + decoded.malformed);
     return;
   }
-  const auto s = is_v1 ? lcmtypes::safe_decode(rbuf->data, size, v1)
-                       : lcmtypes::safe_decode(rbuf->data, size, v2);
-  if (!s.ok) {
-    reject(channel, channel + ": malformed " + (is_v1 ? "goal_t" : "goal_v2_t") + ": " + s.reason);
-    return;
-  }
-  const int64_t goal_id = is_v1 ? v1.goal_id : v2.goal_id;
+  const int64_t goal_id = decoded.goal_id;
   if (goal_id >= 0) {
     std::optional<LostGoals> lost;
     if (options_.answer_goal_id_gaps) lost = goal_ids_.next(goal_id);
@@ -311,9 +342,7 @@ void PlannerNode::on_goal(const lcm::ReceiveBuffer* rbuf, const std::string& cha
     }
   }
   GoalRequest request;
-  const dynamics::Model& model = *scene_.problem.model;
-  const Check c = is_v1 ? convert_goal(v1, model, identity_, request)
-                        : convert_goal(v2, model, identity_, request);
+  const Check c = decoded.convert(*scene_.problem.model, identity_, request);
   if (!c.ok) {
     reject(channel, channel + ": " + c.reason);
     // The sender named a goal: answer it, so no goal ever goes unanswered.
@@ -328,6 +357,10 @@ void PlannerNode::on_goal(const lcm::ReceiveBuffer* rbuf, const std::string& cha
 void PlannerNode::on_obstacles(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
   obstacle_list_t msg;
   const int size = static_cast<int>(rbuf->data_size);
+  if (lcmtypes::has_fingerprint<mesh_obstacle_list_t>(rbuf->data, size)) {
+    on_mesh_obstacles(rbuf, channel);
+    return;
+  }
   if (auto s = lcmtypes::safe_decode(rbuf->data, size, msg); !s.ok) {
     // A version-1 sender (no source) is the unnamed source "".
     obstacle_list_v1_t v1;
@@ -349,6 +382,65 @@ void PlannerNode::on_obstacles(const lcm::ReceiveBuffer* rbuf, const std::string
   if (msg.replace_all) arrived.replaced_sources.insert(msg.source);
   arrived.obstacles_utime = msg.utime;
   intake_.absorb(std::move(arrived));
+}
+
+void PlannerNode::on_mesh_obstacles(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+  mesh_obstacle_list_t msg;
+  if (auto s = lcmtypes::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), msg); !s.ok) {
+    reject(channel, channel + ": malformed mesh_obstacle_list_t: " + s.reason);
+    return;
+  }
+  if (std::string overlong = overlong_name(msg); !overlong.empty()) {
+    reject(channel, channel + ": " + overlong);
+    return;
+  }
+  Intake arrived;
+  const std::string anchor = std::filesystem::path(scene_.source).parent_path().string();
+  if (Check c = messages::mesh_obstacles_from_message(msg, anchor, arrived.obstacles); !c.ok) {
+    reject(channel, channel + ": " + c.reason);
+    return;
+  }
+  arrived.obstacles_utime = msg.utime;
+  intake_.absorb(std::move(arrived));
+}
+
+void PlannerNode::on_payload(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+  payload_t msg;
+  if (auto s = lcmtypes::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), msg); !s.ok) {
+    reject(channel, channel + ": malformed payload_t: " + s.reason);
+    return;
+  }
+  if (std::string overlong = overlong_name(msg); !overlong.empty()) {
+    reject(channel, channel + ": " + overlong);
+    return;
+  }
+  messages::PayloadChange change;
+  if (Check c = messages::payload_from_message(msg, *scene_.problem.model, identity_, change);
+      !c.ok) {
+    reject(channel, channel + ": " + c.reason);
+    return;
+  }
+  RobotWithPayload robot;
+  try {
+    robot = robot_with_payload(scene_, change.payload);
+  } catch (const planning::SceneError& e) {
+    reject(channel, channel + ": payload_t cannot be attached: " + e.what());
+    return;
+  }
+  spdlog::info("{}: {}", channel,
+               change.payload ? "payload of " + std::to_string(change.payload->mass) +
+                                    " kg attached to '" + change.payload->frame + "'"
+                              : std::string("payload detached"));
+  std::lock_guard lock(mutex_);
+  // Taken by the worker with the goals handed over after it, so they are planned with it.
+  pending_robot_ = std::move(robot);
+  ++counters_.payload_changes;
+}
+
+void PlannerNode::take_robot(RobotWithPayload robot) {
+  robot_ = std::move(robot);
+  // The incremental planner's graph is of the old robot.
+  replanner_.reset();
 }
 
 void PlannerNode::on_state(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
@@ -559,6 +651,10 @@ bool PlannerNode::apply_obstacles(const std::vector<ObstacleUpdate>& updates,
 
 void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t trigger_utime) {
   planning::Problem problem = scene_.problem;
+  if (robot_) {  // a payload_t changed the robot
+    problem.model = robot_->model;
+    problem.self_and_floor = robot_->self_and_floor;
+  }
   bool new_state = false;
   std::optional<int64_t> state_utime;  // of the measured state the plan starts from
   std::optional<JoinPoint> join;       // where it joins the motion under way, if it does
@@ -713,6 +809,7 @@ void PlannerNode::worker_loop(const std::atomic<bool>& stop) {
   graph::CancellationScope cancellation(cancel_);
   while (true) {
     Intake taken;
+    std::optional<RobotWithPayload> robot;
     bool stopping;
     {
       std::unique_lock lock(mutex_);
@@ -720,7 +817,9 @@ void PlannerNode::worker_loop(const std::atomic<bool>& stop) {
                      [&] { return stop.load() || !pending_.empty(); });
       stopping = stop.load();
       std::swap(taken, pending_);
+      std::swap(robot, pending_robot_);
     }
+    if (robot) take_robot(*std::move(robot));
     if (stopping) {
       answer_at_shutdown(taken);
       return;

@@ -24,6 +24,7 @@
 #include "daemon/log_limiter.h"
 #include "daemon/motion_join.h"
 #include "daemon/own_heartbeats.h"
+#include "daemon/robot_payload.h"
 #include "kinograph/lcm/message_convert.h"
 #include "kinograph/planning/io/scene.h"
 #include "kinograph/planning/replanner.h"
@@ -98,6 +99,7 @@ struct NodeCounters {
   int64_t goals_cancelled = 0;     ///< goals answered CANCELLED: planning or pending at shutdown
   int64_t joined = 0;              ///< plans that join the motion under way (take over later)
   int64_t late_takeovers = 0;      ///< of which published after their take-over time had passed
+  int64_t payload_changes = 0;     ///< payload_t attaches and detaches taken
 };
 
 /// The planner daemon's node: scene (robot, defaults, fixed obstacles) + LCM + worker thread.
@@ -112,6 +114,8 @@ class PlannerNode {
   /// Heartbeats read back from the daemon's own status channel (to find a second daemon);
   /// dropping some only delays finding it.
   static constexpr int kHeartbeatQueueCapacity = 100;
+  /// Payload changes are rare; each rebuilds the robot.
+  static constexpr int kPayloadQueueCapacity = 100;
   /// Own heartbeats remembered to tell them from another daemon's (over an hour at 1 Hz).
   static constexpr std::size_t kOwnHeartbeatMemory = 4096;
   /// Log lines about rejected messages allowed per second and channel; the rest are counted
@@ -148,6 +152,13 @@ class PlannerNode {
   void on_goal(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   void on_obstacles(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   void on_state(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  /// A mesh_obstacle_list_t on the obstacle channel: its meshes resolved and read, then taken
+  /// as obstacle changes (LCM thread).
+  void on_mesh_obstacles(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  /// A payload_t: the robot rebuilt with the payload (or without) for the plans that follow.
+  void on_payload(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  /// Plans with `robot` from now on (worker thread).
+  void take_robot(RobotWithPayload robot);
   void on_iiwa_status(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   /// An executor's setpoint: which of this daemon's plans it follows (MotionJoin).
   void on_command(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
@@ -250,11 +261,13 @@ class PlannerNode {
   // Set when run() ends: the worker's solver loops poll it (graph/cancellation.h).
   std::atomic<bool> cancel_{false};
   MotionJoin motion_join_;  // the newest valid plan and the executor following it
+  std::optional<RobotWithPayload> pending_robot_;  // after a payload_t, not yet taken
 
   // Owned by the worker thread.
   std::map<ObstacleKey, collision::Obstacle> live_obstacles_;  // by (source, id)
   int next_obstacle_id_ = 0;
   std::optional<GoalRequest> current_goal_;
+  std::optional<RobotWithPayload> robot_;  // the robot since the last payload_t; unset: the scene's
   planning::Replanner replanner_;
   std::uint64_t used_state_count_ = 0;  // state_count_ when the planner's start was last set
 };

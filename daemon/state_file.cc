@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "kinograph/collision/convex_shape.h"
 #include "kinograph/collision/obstacle.h"
 #include "kinograph/planning/io/scene.h"
 
@@ -25,12 +26,18 @@ constexpr int kVersion = 1;
 json obstacle_to_json(const messages::ObstacleUpdate& o) {
   const Eigen::Vector3d p = o.pose.translation();
   const Eigen::Quaterniond r(o.pose.rotation());
-  return {{"source", o.source},
-          {"id", o.id},
-          {"shape", planning::shape_kind_name(o.shape.kind)},
-          {"size", {o.shape.size.x(), o.shape.size.y(), o.shape.size.z()}},
-          {"position", {p.x(), p.y(), p.z()}},
-          {"quaternion", {r.w(), r.x(), r.y(), r.z()}}};
+  json j = {{"source", o.source},
+            {"id", o.id},
+            {"shape", planning::shape_kind_name(o.shape.kind)},
+            {"size", {o.shape.size.x(), o.shape.size.y(), o.shape.size.z()}},
+            {"position", {p.x(), p.y(), p.z()}},
+            {"quaternion", {r.w(), r.x(), r.y(), r.z()}}};
+  if (o.shape.kind == collision::ShapeKind::kMesh) {
+    const Eigen::Vector3d& k = o.shape.mesh_scale;
+    j["mesh"] = o.shape.mesh_path;  // resolved when it arrived
+    j["scale"] = {k.x(), k.y(), k.z()};
+  }
+  return j;
 }
 
 // The numbers of array `key` of obstacle `where` (exactly `n`, finite).
@@ -62,9 +69,9 @@ messages::ObstacleUpdate obstacle_from_json(const std::string& path, std::size_t
   where += " (\"" + id + "\")";
   if (!o.contains("shape") || !o.at("shape").is_string()) fail(path, where + ".shape missing");
   const auto kind = planning::shape_kind_from_name(o.at("shape").get<std::string>());
-  if (!kind || *kind == collision::ShapeKind::kMesh) {
+  if (!kind) {
     fail(path, where + ".shape \"" + o.at("shape").get<std::string>() +
-                   "\" is not box, sphere, cylinder or capsule");
+                   "\" is not box, sphere, cylinder, capsule or mesh");
   }
   const std::vector<double> s = numbers(path, o, "size", 3, where);
   const std::vector<double> p = numbers(path, o, "position", 3, where);
@@ -74,6 +81,18 @@ messages::ObstacleUpdate obstacle_from_json(const std::string& path, std::size_t
   u.id = id;
   u.shape.kind = *kind;
   u.shape.size = Eigen::Vector3d(s[0], s[1], s[2]);
+  if (*kind == collision::ShapeKind::kMesh) {
+    if (!o.contains("mesh") || !o.at("mesh").is_string()) fail(path, where + ".mesh missing");
+    const std::vector<double> k = numbers(path, o, "scale", 3, where);
+    u.shape.mesh_path = o.at("mesh").get<std::string>();
+    u.shape.mesh_scale = Eigen::Vector3d(k[0], k[1], k[2]);
+    // Read again now, as when it arrived: a mesh gone since is refused here, not mid-plan.
+    try {
+      collision::ConvexShape hull(u.shape);
+    } catch (const std::exception& e) {
+      fail(path, where + ".mesh: " + e.what());
+    }
+  }
   if (std::string e = collision::range_error(u.shape); !e.empty()) fail(path, where + ": " + e);
   const Eigen::Vector3d position(p[0], p[1], p[2]);
   if (std::string e = collision::position_range_error(position); !e.empty()) {

@@ -19,10 +19,14 @@
 #include "drake/lcmt_robot_state.hpp"
 #include "kinograph/goal_t.hpp"
 #include "kinograph/goal_v2_t.hpp"
+#include "kinograph/goal_v3_t.hpp"
 #include "kinograph/joint_command_t.hpp"
+#include "kinograph/mesh_obstacle_list_t.hpp"
+#include "kinograph/mesh_obstacle_t.hpp"
 #include "kinograph/obstacle_list_t.hpp"
 #include "kinograph/obstacle_list_v1_t.hpp"
 #include "kinograph/obstacle_t.hpp"
+#include "kinograph/payload_t.hpp"
 #include "kinograph/plan_t.hpp"
 #include "kinograph/plan_v1_t.hpp"
 #include "kinograph/planner_status_t.hpp"
@@ -172,22 +176,61 @@ inline bool check_fields(WireReader& r, const task_constraint_t*) {
 }
 constexpr int64_t kMinTaskConstraintBytes = kMinStringBytes + 1 + 8 * 8;
 
-inline bool check_fields(WireReader& r, const goal_v2_t*) {
+// goal_v3_t is goal_v2_t's members followed by the tolerances; `type` names the fields.
+inline bool check_named_goal_fields(WireReader& r, const std::string& type, bool has_tolerances) {
+  const auto f = [&](const char* field) { return type + "." + field; };
   int64_t i64 = 0;
   int32_t n = 0, constraints = 0;
-  if (!(r.read_i64(i64, "goal_v2_t.utime") && r.read_i64(i64, "goal_v2_t.goal_id") &&
-        r.string("goal_v2_t.robot") && r.skip(1, 1, "goal_v2_t.kind") &&
-        r.count(n, kMinStringBytes + 8, "goal_v2_t.num_joints")))
+  // Per joint: a name, a position and (version 3) a tolerance.
+  const int64_t per_joint = kMinStringBytes + (has_tolerances ? 16 : 8);
+  if (!(r.read_i64(i64, f("utime").c_str()) && r.read_i64(i64, f("goal_id").c_str()) &&
+        r.string(f("robot").c_str()) && r.skip(1, 1, f("kind").c_str()) &&
+        r.count(n, per_joint, f("num_joints").c_str())))
     return false;
   for (int32_t i = 0; i < n; ++i)
-    if (!r.string("goal_v2_t.joint_name")) return false;
-  if (!(r.skip(n, 8, "goal_v2_t.joint_position") && r.string("goal_v2_t.ee_frame") &&
-        r.skip(3 + 4, 8, "goal_v2_t.ee_position/ee_quaternion") &&
-        r.boolean("goal_v2_t.position_only") && r.skip(1, 8, "goal_v2_t.duration_s") &&
-        r.count(constraints, kMinTaskConstraintBytes, "goal_v2_t.num_task_constraints")))
+    if (!r.string(f("joint_name").c_str())) return false;
+  if (!(r.skip(n, 8, f("joint_position").c_str()) && r.string(f("ee_frame").c_str()) &&
+        r.skip(3 + 4, 8, f("ee_position/ee_quaternion").c_str()) &&
+        r.boolean(f("position_only").c_str()) && r.skip(1, 8, f("duration_s").c_str()) &&
+        r.count(constraints, kMinTaskConstraintBytes, f("num_task_constraints").c_str())))
     return false;
   for (int32_t i = 0; i < constraints; ++i)
     if (!check_fields(r, static_cast<const task_constraint_t*>(nullptr))) return false;
+  return !has_tolerances ||
+         (r.skip(n, 8, f("joint_tolerance").c_str()) &&
+          r.skip(2, 8, f("position_tolerance_m/orientation_tolerance_rad").c_str()));
+}
+inline bool check_fields(WireReader& r, const goal_v2_t*) {
+  return check_named_goal_fields(r, "goal_v2_t", /*has_tolerances=*/false);
+}
+inline bool check_fields(WireReader& r, const goal_v3_t*) {
+  return check_named_goal_fields(r, "goal_v3_t", /*has_tolerances=*/true);
+}
+
+inline bool check_fields(WireReader& r, const payload_t*) {
+  int64_t i64 = 0;
+  return r.read_i64(i64, "payload_t.utime") && r.string("payload_t.robot") &&
+         r.skip(1, 1, "payload_t.action") && r.string("payload_t.frame") &&
+         r.skip(1 + 3 + 3, 8, "payload_t.mass_kg/size/offset");
+}
+
+// A mesh obstacle inside a list carries no fingerprint of its own.
+inline bool check_fields(WireReader& r, const mesh_obstacle_t*) {
+  return r.string("mesh_obstacle_t.id") && r.skip(1, 1, "mesh_obstacle_t.action") &&
+         r.string("mesh_obstacle_t.mesh") &&
+         r.skip(3 + 3 + 4, 8, "mesh_obstacle_t.scale/position/quaternion");
+}
+constexpr int64_t kMinMeshObstacleBytes = 2 * kMinStringBytes + 1 + 10 * 8;
+
+inline bool check_fields(WireReader& r, const mesh_obstacle_list_t*) {
+  int64_t i64 = 0;
+  int32_t n = 0;
+  if (!(r.read_i64(i64, "mesh_obstacle_list_t.utime") &&
+        r.string("mesh_obstacle_list_t.source") &&
+        r.count(n, kMinMeshObstacleBytes, "mesh_obstacle_list_t.num_obstacles")))
+    return false;
+  for (int32_t i = 0; i < n; ++i)
+    if (!check_fields(r, static_cast<const mesh_obstacle_t*>(nullptr))) return false;
   return true;
 }
 

@@ -1,23 +1,33 @@
 // LCM verbs of the CLI: talk to a running kinographd.
 //   kinograph send-goal     --prefix IIWA (--q ... | --joint NAME=V ... | --frame F
 //                           --position ... (--quaternion ... | --position-only)) [--utime US]
+//                           [--joint-tolerance NAME=T ... | --position-tolerance M
+//                           --orientation-tolerance RAD]
 //   kinograph send-obstacle --prefix IIWA --id box --shape box --size ... --position ...
-//                           [--utime US]
+//                           [--utime US] [--source S]; --shape mesh --mesh FILE [--scale ...]
+//   kinograph send-payload  --prefix IIWA (--frame F --mass KG --size ... [--offset ...] |
+//                           --detach)
 //   kinograph send-state    --prefix IIWA --scene S --q ... [--qd ...] [--utime US]
 //   kinograph send-raw      CHANNEL --text BYTES
 //   kinograph log-plans     LOG.lcmlog --channel IIWA_PLAN --scene S --out-dir DIR
+//                           [--obstacles-channel IIWA_OBSTACLES]
 // send-goal and send-obstacle can wait for the answering plan (--wait) and write it (--out).
 // --utime stamps a message on the robot's clock (e.g. sim time) instead of the wall clock.
 #include <chrono>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <sstream>
 
 #include "kinograph/goal_t.hpp"
 #include "kinograph/goal_v2_t.hpp"
+#include "kinograph/goal_v3_t.hpp"
 #include "kinograph/lcm/message_convert.h"
+#include "kinograph/mesh_obstacle_list_t.hpp"
 #include "kinograph/obstacle_list_t.hpp"
+#include "kinograph/obstacle_list_v1_t.hpp"
+#include "kinograph/payload_t.hpp"
 #include "kinograph/planning/io/plan_json.h"
 #include "kinograph/planning/io/scene.h"
 #include "kinograph/robot_state_t.hpp"
@@ -138,6 +148,13 @@ struct Common {
   }
 };
 
+// Adds an obstacle received over LCM to the scene a plan file is written for.
+void add_obstacle(planning::Scene& scene, const std::string& name, collision::Obstacle obstacle) {
+  obstacle.id = static_cast<int>(scene.problem.obstacles.size());
+  scene.obstacle_names.push_back(name);
+  scene.problem.obstacles.push_back(std::move(obstacle));
+}
+
 // Waits for the plan answering goal_id, prints it, writes it to c.out for `scene` if asked;
 // returns the exit code. `extra` is an obstacle this command sent, written into the plan file
 // with the scene's own.
@@ -153,11 +170,7 @@ int finish(PlanWaiter& waiter, const Common& c, int64_t goal_id,
   }
   std::cout << summarize(*plan) << "\n";
   if (scene) {
-    if (extra) {
-      scene->obstacle_names.push_back(extra->first);
-      scene->problem.obstacles.push_back(extra->second);
-      scene->problem.obstacles.back().id = static_cast<int>(scene->problem.obstacles.size()) - 1;
-    }
+    if (extra) add_obstacle(*scene, extra->first, extra->second);
     if (plan->num_steps == 0)
       throw CommandFailure("plan has no trajectory to write", kExitInvalidPlan);
     write_plan_json(messages::plan_from_message(*plan), *scene, c.out);
@@ -176,16 +189,88 @@ std::pair<std::string, double> parse_named_joint(const std::string& item) {
   return {name, parse_number_list(item.substr(eq + 1), "--joint " + name, 1)[0]};
 }
 
+// What send-goal's options say about a goal of version 2 or later.
+struct NamedGoalOptions {
+  std::vector<std::string> joints;
+  std::string frame, position, quaternion;
+  bool position_only = false;
+};
+
+// Fills the members goal_v2_t and goal_v3_t share from the options. @throws CommandFailure for
+// an incomplete pose goal or a malformed value.
+template <class GoalMessage>
+void fill_named_goal(const NamedGoalOptions& o, GoalMessage& g) {
+  g.ee_quaternion[0] = 1;
+  if (!o.joints.empty()) {
+    g.kind = GoalMessage::KIND_JOINT_CONFIGURATION;
+    for (const std::string& item : o.joints) {
+      const auto [name, value] = parse_named_joint(item);
+      g.joint_name.push_back(name);
+      g.joint_position.push_back(value);
+    }
+    g.num_joints = static_cast<int32_t>(g.joint_name.size());
+    return;
+  }
+  if (o.frame.empty() || o.position.empty() || (o.quaternion.empty() && !o.position_only)) {
+    throw CommandFailure(
+        "send-goal: a pose goal needs --frame, --position and --quaternion "
+        "(--quaternion 1,0,0,0 keeps the world's axes; --position-only ignores it)");
+  }
+  if (o.position_only && !o.quaternion.empty()) {
+    throw CommandFailure("send-goal: --position-only ignores the orientation: drop --quaternion");
+  }
+  g.kind = GoalMessage::KIND_END_EFFECTOR_POSE;
+  g.ee_frame = o.frame;
+  g.position_only = o.position_only;
+  auto p = parse_number_list(o.position, "--position", 3);
+  std::copy(p.begin(), p.end(), g.ee_position);
+  if (!o.quaternion.empty()) {
+    auto r = parse_number_list(o.quaternion, "--quaternion", 4);
+    std::copy(r.begin(), r.end(), g.ee_quaternion);
+  }
+}
+
+// What send-goal's tolerance options say.
+struct ToleranceOptions {
+  std::vector<std::string> joints;  // NAME=VALUE
+  double position = 0, orientation = 0;
+  bool given() const { return !joints.empty() || position != 0 || orientation != 0; }
+};
+
+// The goal_v3_t tolerances of a goal filled by fill_named_goal. @throws CommandFailure for a
+// joint tolerance of a joint the goal does not name, or tolerances of the other goal kind.
+void fill_tolerances(const ToleranceOptions& t, goal_v3_t& g) {
+  const bool joint_goal = g.kind == goal_v3_t::KIND_JOINT_CONFIGURATION;
+  if (joint_goal && (t.position != 0 || t.orientation != 0)) {
+    throw CommandFailure("send-goal: --position-tolerance and --orientation-tolerance are for "
+                         "pose goals; a joint goal takes --joint-tolerance NAME=VALUE");
+  }
+  if (!joint_goal && !t.joints.empty()) {
+    throw CommandFailure("send-goal: --joint-tolerance is for joint goals (--joint)");
+  }
+  g.joint_tolerance.assign(g.joint_name.size(), 0.0);
+  for (const std::string& item : t.joints) {
+    const auto [name, value] = parse_named_joint(item);
+    const auto it = std::find(g.joint_name.begin(), g.joint_name.end(), name);
+    if (it == g.joint_name.end()) {
+      throw CommandFailure("send-goal: --joint-tolerance " + name +
+                           " names a joint the goal does not move (give it with --joint)");
+    }
+    g.joint_tolerance[static_cast<std::size_t>(it - g.joint_name.begin())] = value;
+  }
+  g.position_tolerance_m = t.position;
+  g.orientation_tolerance_rad = t.orientation;
+}
+
 const bool kSendGoal = register_command([](CLI::App& root) {
   auto* sub = root.add_subcommand(
-      "send-goal", "publish a goal to a kinographd (goal_t for --q, goal_v2_t otherwise)");
+      "send-goal",
+      "publish a goal to a kinographd (goal_t for --q, goal_v3_t with tolerances, goal_v2_t "
+      "otherwise)");
   auto c = std::make_shared<Common>();
   auto q = std::make_shared<std::string>();
-  auto joints = std::make_shared<std::vector<std::string>>();
-  auto frame = std::make_shared<std::string>();
-  auto position = std::make_shared<std::string>();
-  auto quaternion = std::make_shared<std::string>();
-  auto position_only = std::make_shared<bool>(false);
+  auto named = std::make_shared<NamedGoalOptions>();
+  auto tolerance = std::make_shared<ToleranceOptions>();
   auto goal_id = std::make_shared<int64_t>(-1);
   auto duration = std::make_shared<double>(0);
   auto robot = std::make_shared<std::string>();
@@ -197,21 +282,32 @@ const bool kSendGoal = register_command([](CLI::App& root) {
   sub->add_option("--q", *q,
                   "joint goal (rad), every joint in URDF order, comma-separated; angles may "
                   "use pi");
-  sub->add_option("--joint", *joints,
+  sub->add_option("--joint", named->joints,
                   "joint goal by name, NAME=VALUE (rad), repeatable; joints not named are held "
                   "at their start");
-  sub->add_option("--frame", *frame, "end-effector frame for a pose goal");
-  sub->add_option("--position", *position, "pose goal position x,y,z (m)");
-  sub->add_option("--quaternion", *quaternion,
+  sub->add_option("--frame", named->frame, "end-effector frame for a pose goal");
+  sub->add_option("--position", named->position, "pose goal position x,y,z (m)");
+  sub->add_option("--quaternion", named->quaternion,
                   "pose goal orientation w,x,y,z (required with --frame unless --position-only; "
                   "1,0,0,0 = the world's axes)");
-  sub->add_flag("--position-only", *position_only,
+  sub->add_flag("--position-only", named->position_only,
                 "pose goal: reach --position in any orientation");
+  sub->add_option("--joint-tolerance", tolerance->joints,
+                  "joint goal: how far joint NAME may end from its goal, NAME=VALUE (rad), "
+                  "repeatable (default 0.01)");
+  sub->add_option("--position-tolerance", tolerance->position,
+                  "pose goal: how far the frame may end from --position (m, default 0.01)")
+      ->check(CLI::NonNegativeNumber);
+  sub->add_option("--orientation-tolerance", tolerance->orientation,
+                  "pose goal: how far its orientation may end from --quaternion (rad, default "
+                  "0.01)")
+      ->check(CLI::NonNegativeNumber);
   sub->add_option("--duration", *duration, "plan duration (s), 0 = the daemon's default");
   sub->add_option("--robot", *robot, "robot name in the message (default: empty = any)");
   sub->callback([=] {
-    const bool pose = !frame->empty() || !position->empty() || !quaternion->empty();
-    const int kinds = !q->empty() + !joints->empty() + pose;
+    const bool pose = !named->frame.empty() || !named->position.empty() ||
+                      !named->quaternion.empty();
+    const int kinds = !q->empty() + !named->joints.empty() + pose;
     if (kinds > 1) {
       throw CommandFailure(
           "send-goal: give one goal: --q, --joint, or a pose goal (--frame, --position, "
@@ -221,78 +317,86 @@ const bool kSendGoal = register_command([](CLI::App& root) {
       throw CommandFailure(
           "send-goal needs --q, --joint, or --frame with --position and --quaternion");
     }
-    if (*position_only && !pose) throw CommandFailure("--position-only is for pose goals");
+    if (named->position_only && !pose) throw CommandFailure("--position-only is for pose goals");
+    if (!q->empty() && tolerance->given()) {
+      throw CommandFailure("send-goal: --q sends goal_t, which has no tolerances: name the "
+                           "joints with --joint NAME=VALUE and give --joint-tolerance");
+    }
     const int64_t id = *goal_id >= 0 ? *goal_id : now_utime();
     const int64_t when = *utime >= 0 ? *utime : now_utime();
-    // Every joint in URDF order is what the first goal type says; names need version 2.
+    // Every joint in URDF order is what the first goal type says; names need version 2, and
+    // tolerances version 3.
+    const auto header = [&](auto& g) {
+      g.utime = when;
+      g.goal_id = id;
+      g.robot = *robot;
+      g.duration_s = *duration;
+    };
     goal_t v1{};
     goal_v2_t v2{};
+    goal_v3_t v3{};
+    const char* type = "goal_v2_t";
     if (!q->empty()) {
-      v1.utime = when;
-      v1.goal_id = id;
-      v1.robot = *robot;
-      v1.duration_s = *duration;
+      header(v1);
       v1.ee_quaternion[0] = 1;
       v1.kind = goal_t::KIND_JOINT_CONFIGURATION;
       v1.joint_position = parse_number_list(*q, "--q");
       v1.num_joints = static_cast<int32_t>(v1.joint_position.size());
+      type = "goal_t";
+    } else if (tolerance->given()) {
+      header(v3);
+      fill_named_goal(*named, v3);
+      fill_tolerances(*tolerance, v3);
+      type = "goal_v3_t";
     } else {
-      v2.utime = when;
-      v2.goal_id = id;
-      v2.robot = *robot;
-      v2.duration_s = *duration;
-      v2.ee_quaternion[0] = 1;
-      if (!joints->empty()) {
-        v2.kind = goal_v2_t::KIND_JOINT_CONFIGURATION;
-        for (const std::string& item : *joints) {
-          const auto [name, value] = parse_named_joint(item);
-          v2.joint_name.push_back(name);
-          v2.joint_position.push_back(value);
-        }
-        v2.num_joints = static_cast<int32_t>(v2.joint_name.size());
-      } else {
-        if (frame->empty() || position->empty() || (quaternion->empty() && !*position_only)) {
-          throw CommandFailure(
-              "send-goal: a pose goal needs --frame, --position and --quaternion "
-              "(--quaternion 1,0,0,0 keeps the world's axes; --position-only ignores it)");
-        }
-        if (*position_only && !quaternion->empty()) {
-          throw CommandFailure("send-goal: --position-only ignores the orientation: drop "
-                               "--quaternion");
-        }
-        v2.kind = goal_v2_t::KIND_END_EFFECTOR_POSE;
-        v2.ee_frame = *frame;
-        v2.position_only = *position_only;
-        auto p = parse_number_list(*position, "--position", 3);
-        std::copy(p.begin(), p.end(), v2.ee_position);
-        if (!quaternion->empty()) {
-          auto r = parse_number_list(*quaternion, "--quaternion", 4);
-          std::copy(r.begin(), r.end(), v2.ee_quaternion);
-        }
-      }
+      header(v2);
+      fill_named_goal(*named, v2);
     }
     std::optional<planning::Scene> scene = c->output_scene();
     lcm::LCM& lcm = open_lcm(c->url);
     PlanWaiter waiter(lcm, c->prefix + "_PLAN");
-    if (!q->empty()) {
+    if (type == std::string("goal_t")) {
       lcm.publish(c->prefix + "_GOAL", &v1);
+    } else if (type == std::string("goal_v3_t")) {
+      lcm.publish(c->prefix + "_GOAL", &v3);
     } else {
       lcm.publish(c->prefix + "_GOAL", &v2);
     }
-    std::cout << "sent goal " << id << " on " << c->prefix << "_GOAL ("
-              << (q->empty() ? "goal_v2_t" : "goal_t") << ")\n";
+    std::cout << "sent goal " << id << " on " << c->prefix << "_GOAL (" << type << ")\n";
     if (int code = finish(waiter, *c, id, std::move(scene)); code != 0) {
       throw CommandFailure("", code);
     }
   });
 });
 
+// The mesh_obstacle_list_t of send-obstacle --shape mesh.
+mesh_obstacle_list_t mesh_obstacle_message(const std::string& id, bool remove,
+                                           const std::string& mesh, const std::string& scale,
+                                           const std::vector<double>& position,
+                                           const std::vector<double>& quaternion) {
+  mesh_obstacle_t o{};
+  o.id = id;
+  o.action = remove ? mesh_obstacle_t::REMOVE : mesh_obstacle_t::ADD_OR_MOVE;
+  o.mesh = mesh;
+  const std::vector<double> k = parse_number_list(scale, "--scale", 3);
+  std::copy(k.begin(), k.end(), o.scale);
+  std::copy(position.begin(), position.end(), o.position);
+  std::copy(quaternion.begin(), quaternion.end(), o.quaternion);
+  mesh_obstacle_list_t msg{};
+  msg.num_obstacles = 1;
+  msg.obstacles.push_back(o);
+  return msg;
+}
+
 const bool kSendObstacle = register_command([](CLI::App& root) {
   auto* sub = root.add_subcommand("send-obstacle", "add, move or remove one obstacle");
   auto c = std::make_shared<Common>();
   auto id = std::make_shared<std::string>();
+  auto source = std::make_shared<std::string>();
   auto shape = std::make_shared<std::string>("box");
   auto size = std::make_shared<std::string>();
+  auto mesh = std::make_shared<std::string>();
+  auto scale = std::make_shared<std::string>("1,1,1");
   auto position = std::make_shared<std::string>("0,0,0");
   auto quaternion = std::make_shared<std::string>("1,0,0,0");
   auto remove = std::make_shared<bool>(false);
@@ -300,58 +404,131 @@ const bool kSendObstacle = register_command([](CLI::App& root) {
   auto utime = std::make_shared<int64_t>(-1);
   c->add(sub, true);
   sub->add_option("--id", *id, "obstacle name")->required();
+  sub->add_option("--source", *source,
+                  "who sends it (obstacle ids are per source), e.g. perception (default: \"\")");
   sub->add_option("--utime", *utime,
                   "the update's time on the robot's clock, µs (default: the wall clock); the "
                   "daemon replans only from a state at most --max-state-age older");
-  sub->add_option("--shape", *shape, "box, sphere, cylinder or capsule")
-      ->check(CLI::IsMember({"box", "sphere", "cylinder", "capsule"}));
+  sub->add_option("--shape", *shape, "box, sphere, cylinder, capsule or mesh")
+      ->check(CLI::IsMember({"box", "sphere", "cylinder", "capsule", "mesh"}));
   sub->add_option("--size", *size, "box: x,y,z; sphere: r; cylinder/capsule: r,length");
-  sub->add_option("--position", *position, "centre x,y,z (m)");
+  sub->add_option("--mesh", *mesh,
+                  "mesh: the file as the daemon's machine sees it (absolute, or relative to the "
+                  "daemon's scene, then its data directories)");
+  sub->add_option("--scale", *scale, "mesh: per-axis scale x,y,z (default 1,1,1)");
+  sub->add_option("--position", *position, "centre (a mesh: its origin) x,y,z (m)");
   sub->add_option("--quaternion", *quaternion, "orientation w,x,y,z");
   sub->add_flag("--remove", *remove, "remove the obstacle instead");
   sub->add_option("--goal-id", *goal_id, "with --wait: the goal whose replan to wait for");
   sub->callback([=] {
-    obstacle_t o;
-    o.id = *id;
-    o.action = *remove ? obstacle_t::REMOVE : obstacle_t::ADD_OR_MOVE;
-    o.shape = *shape == "box"        ? obstacle_t::BOX
-              : *shape == "sphere"   ? obstacle_t::SPHERE
-              : *shape == "cylinder" ? obstacle_t::CYLINDER
-                                     : obstacle_t::CAPSULE;
-    std::fill(std::begin(o.size), std::end(o.size), 0.0);
-    if (!*remove) {
-      auto s = parse_number_list(*size, "--size");
-      if (s.empty() || s.size() > 3) throw CommandFailure("--size needs 1 to 3 numbers");
-      std::copy(s.begin(), s.end(), o.size);
-    }
-    auto p = parse_number_list(*position, "--position", 3);
-    auto r = parse_number_list(*quaternion, "--quaternion", 4);
-    std::copy(p.begin(), p.end(), o.position);
-    std::copy(r.begin(), r.end(), o.quaternion);
-    obstacle_list_t msg;
-    msg.utime = *utime >= 0 ? *utime : now_utime();
-    msg.num_obstacles = 1;
-    msg.obstacles.push_back(o);
-    msg.replace_all = false;
+    const bool is_mesh = *shape == "mesh";
+    if (is_mesh && !*remove && mesh->empty()) throw CommandFailure("--shape mesh needs --mesh");
+    if (!is_mesh && !mesh->empty()) throw CommandFailure("--mesh needs --shape mesh");
+    if (is_mesh && !size->empty()) throw CommandFailure("a mesh takes --scale, not --size");
     if (c->wait_s > 0 && *goal_id < 0) throw CommandFailure("--wait needs --goal-id");
+    const auto p = parse_number_list(*position, "--position", 3);
+    const auto r = parse_number_list(*quaternion, "--quaternion", 4);
+    const int64_t when = *utime >= 0 ? *utime : now_utime();
+    obstacle_list_t msg{};
+    mesh_obstacle_list_t mesh_msg{};
+    if (is_mesh) {
+      mesh_msg = mesh_obstacle_message(*id, *remove, *mesh, *scale, p, r);
+      mesh_msg.utime = when;
+      mesh_msg.source = *source;
+    } else {
+      obstacle_t o{};
+      o.id = *id;
+      o.action = *remove ? obstacle_t::REMOVE : obstacle_t::ADD_OR_MOVE;
+      o.shape = *shape == "box"        ? obstacle_t::BOX
+                : *shape == "sphere"   ? obstacle_t::SPHERE
+                : *shape == "cylinder" ? obstacle_t::CYLINDER
+                                       : obstacle_t::CAPSULE;
+      if (!*remove) {
+        auto s = parse_number_list(*size, "--size");
+        if (s.empty() || s.size() > 3) throw CommandFailure("--size needs 1 to 3 numbers");
+        std::copy(s.begin(), s.end(), o.size);
+      }
+      std::copy(p.begin(), p.end(), o.position);
+      std::copy(r.begin(), r.end(), o.quaternion);
+      msg.utime = when;
+      msg.source = *source;
+      msg.num_obstacles = 1;
+      msg.obstacles.push_back(o);
+      msg.replace_all = false;
+    }
     std::optional<planning::Scene> scene = c->output_scene();
+    // The obstacle as the plan file (--out) must hold it: converted as the daemon does.
+    std::optional<std::pair<std::string, collision::Obstacle>> extra;
+    if (!*remove && scene) {
+      std::vector<messages::ObstacleUpdate> updates;
+      const std::string anchor = std::filesystem::path(scene->source).parent_path().string();
+      const messages::Check check = is_mesh
+                                        ? messages::mesh_obstacles_from_message(mesh_msg, anchor,
+                                                                                updates)
+                                        : messages::obstacles_from_message(msg, updates);
+      if (!check.ok) throw CommandFailure("send-obstacle: " + check.reason + " (nothing sent)");
+      collision::Obstacle obstacle;
+      obstacle.shape = updates[0].shape;
+      obstacle.pose = updates[0].pose;
+      extra.emplace(*id, obstacle);
+    }
     lcm::LCM& lcm = open_lcm(c->url);
     PlanWaiter waiter(lcm, c->prefix + "_PLAN");
-    lcm.publish(c->prefix + "_OBSTACLES", &msg);
-    std::cout << "sent obstacle \"" << o.id << "\" on " << c->prefix << "_OBSTACLES\n";
-    std::optional<std::pair<std::string, collision::Obstacle>> extra;
-    if (!*remove) {
-      std::vector<messages::ObstacleUpdate> updates;
-      if (messages::obstacles_from_message(msg, updates).ok) {
-        collision::Obstacle obstacle;
-        obstacle.shape = updates[0].shape;
-        obstacle.pose = updates[0].pose;
-        extra.emplace(o.id, obstacle);
-      }
+    if (is_mesh) {
+      lcm.publish(c->prefix + "_OBSTACLES", &mesh_msg);
+    } else {
+      lcm.publish(c->prefix + "_OBSTACLES", &msg);
     }
+    std::cout << "sent obstacle \"" << *id << "\" on " << c->prefix << "_OBSTACLES ("
+              << (is_mesh ? "mesh_obstacle_list_t" : "obstacle_list_t") << ")\n";
     if (int code = finish(waiter, *c, *goal_id, std::move(scene), extra); code != 0) {
       throw CommandFailure("", code);
     }
+  });
+});
+
+const bool kSendPayload = register_command([](CLI::App& root) {
+  auto* sub = root.add_subcommand(
+      "send-payload", "attach a box payload to a link of the daemon's robot, or detach it");
+  auto c = std::make_shared<Common>();
+  auto frame = std::make_shared<std::string>();
+  auto mass = std::make_shared<double>(-1);
+  auto size = std::make_shared<std::string>();
+  auto offset = std::make_shared<std::string>("0,0,0");
+  auto detach = std::make_shared<bool>(false);
+  auto robot = std::make_shared<std::string>();
+  auto utime = std::make_shared<int64_t>(-1);
+  c->add(sub, false);
+  sub->add_option("--frame", *frame, "link or frame the box is fixed in");
+  sub->add_option("--mass", *mass, "kg, uniform density")->check(CLI::NonNegativeNumber);
+  sub->add_option("--size", *size, "full extents x,y,z in --frame (m)");
+  sub->add_option("--offset", *offset, "box centre in --frame x,y,z (m, default 0,0,0)");
+  sub->add_flag("--detach", *detach, "carry no payload from now on");
+  sub->add_option("--robot", *robot, "robot name in the message (default: empty = any)");
+  sub->add_option("--utime", *utime, "the change's time on the robot's clock, µs");
+  sub->callback([=] {
+    payload_t msg{};
+    msg.utime = *utime >= 0 ? *utime : now_utime();
+    msg.robot = *robot;
+    if (*detach) {
+      if (!frame->empty() || *mass >= 0 || !size->empty())
+        throw CommandFailure("send-payload: --detach takes no --frame, --mass or --size");
+      msg.action = payload_t::DETACH;
+    } else {
+      if (frame->empty() || *mass < 0 || size->empty())
+        throw CommandFailure("send-payload needs --frame, --mass and --size (or --detach)");
+      msg.action = payload_t::ATTACH;
+      msg.frame = *frame;
+      msg.mass_kg = *mass;
+      const auto s = parse_number_list(*size, "--size", 3);
+      const auto o = parse_number_list(*offset, "--offset", 3);
+      std::copy(s.begin(), s.end(), msg.size);
+      std::copy(o.begin(), o.end(), msg.offset);
+    }
+    open_lcm(c->url).publish(c->prefix + "_PAYLOAD", &msg);
+    std::cout << "sent " << (*detach ? "detach" : "payload on '" + *frame + "'") << " on "
+              << c->prefix << "_PAYLOAD (the daemon's next plans carry it; a refusal is on "
+              << c->prefix << "_PLANNER_STATUS)\n";
   });
 });
 
@@ -399,14 +576,82 @@ const bool kSendRaw = register_command([](CLI::App& root) {
   });
 });
 
+// The obstacles a daemon received over LCM, replayed from a log in order: ids per source, a
+// replace_all empties its source first (as kinographd applies them).
+class LoggedObstacles {
+ public:
+  explicit LoggedObstacles(std::string mesh_anchor) : mesh_anchor_(std::move(mesh_anchor)) {}
+
+  /// Applies one message of the obstacle channel; false (with `why`) when it is none of the
+  /// obstacle list types or fails their checks.
+  bool apply(const lcm::LogEvent& event, std::string& why) {
+    std::vector<messages::ObstacleUpdate> updates;
+    obstacle_list_t list;
+    obstacle_list_v1_t v1;
+    mesh_obstacle_list_t meshes;
+    messages::Check check;
+    if (lcmtypes::has_fingerprint<mesh_obstacle_list_t>(event.data, event.datalen)) {
+      const auto decoded = lcmtypes::safe_decode(event.data, event.datalen, meshes);
+      check = decoded.ok ? messages::mesh_obstacles_from_message(meshes, mesh_anchor_, updates)
+                         : messages::Check::fail(decoded.reason);
+    } else {
+      const auto decoded = lcmtypes::safe_decode(event.data, event.datalen, list);
+      if (!decoded.ok && lcmtypes::safe_decode(event.data, event.datalen, v1).ok) {
+        list = messages::obstacle_list_from_v1(v1);
+      } else if (!decoded.ok) {
+        why = decoded.reason;
+        return false;
+      }
+      check = messages::obstacles_from_message(list, updates);
+      if (check.ok && list.replace_all) {
+        std::erase_if(world_, [&](const auto& entry) { return entry.first.first == list.source; });
+      }
+    }
+    if (!check.ok) {
+      why = check.reason;
+      return false;
+    }
+    for (messages::ObstacleUpdate& u : updates) {
+      const messages::ObstacleKey key{u.source, u.id};
+      if (u.remove) {
+        world_.erase(key);
+      } else {
+        world_[key] = std::move(u);
+      }
+    }
+    return true;
+  }
+  /// The obstacles now, each named by its id (and source, when it has one).
+  std::vector<std::pair<std::string, collision::Obstacle>> now() const {
+    std::vector<std::pair<std::string, collision::Obstacle>> out;
+    for (const auto& [key, u] : world_) {
+      collision::Obstacle o;
+      o.shape = u.shape;
+      o.pose = u.pose;
+      out.emplace_back(key.first.empty() ? key.second : key.first + "/" + key.second, o);
+    }
+    return out;
+  }
+
+ private:
+  std::string mesh_anchor_;
+  std::map<messages::ObstacleKey, messages::ObstacleUpdate> world_;
+};
+
 const bool kLogPlans = register_command([](CLI::App& root) {
-  auto* sub = root.add_subcommand("log-plans", "write the plans in an LCM log as plan JSON files");
+  auto* sub = root.add_subcommand(
+      "log-plans",
+      "write the plans in an LCM log as plan JSON files, with the obstacles received over LCM");
   auto log = std::make_shared<std::string>();
   auto channel = std::make_shared<std::string>();
+  auto obstacles_channel = std::make_shared<std::string>();
   auto scene = std::make_shared<std::string>();
   auto out_dir = std::make_shared<std::string>(".");
   sub->add_option("log", *log, "LCM log file (lcm-logger)")->required();
   sub->add_option("--channel", *channel, "plan channel, e.g. IIWA_PLAN")->required();
+  sub->add_option("--obstacles-channel", *obstacles_channel,
+                  "the daemon's obstacle channel, whose updates each plan file carries "
+                  "(default: --channel with _PLAN replaced by _OBSTACLES; \"none\" = ignore)");
   sub->add_option("--scene", *scene, "the daemon's scene (robot for the JSON)")->required();
   sub->add_option("--out-dir", *out_dir, "folder for plan_<goal>_<plan>.json");
   sub->callback([=] {
@@ -416,6 +661,14 @@ const bool kLogPlans = register_command([](CLI::App& root) {
     } catch (const std::exception& e) {
       throw CommandFailure(e.what());
     }
+    std::string obstacle_channel = *obstacles_channel;
+    const std::string plan_suffix = "_PLAN";
+    if (obstacle_channel.empty() && channel->size() > plan_suffix.size() &&
+        channel->compare(channel->size() - plan_suffix.size(), plan_suffix.size(), plan_suffix) ==
+            0) {
+      obstacle_channel = channel->substr(0, channel->size() - plan_suffix.size()) + "_OBSTACLES";
+    }
+    if (obstacle_channel == "none") obstacle_channel.clear();
     std::vector<std::string> joints;
     for (const auto& b : s.problem.model->bodies) joints.push_back(b.joint_name);
     lcm::LogFile file(*log, "r");
@@ -425,9 +678,11 @@ const bool kLogPlans = register_command([](CLI::App& root) {
     struct Found {
       std::string path;
       planning::Plan plan;
+      std::vector<std::pair<std::string, collision::Obstacle>> obstacles;  // received over LCM
     };
     std::vector<Found> plans;
-    int rejected = 0, old = 0;
+    LoggedObstacles world(std::filesystem::path(s.source).parent_path().string());
+    int rejected = 0, old = 0, obstacle_updates = 0, bad_updates = 0;
     // Prints a decoded plan of either version and keeps it when it has a trajectory.
     auto take = [&](const auto& msg) {
       std::cout << summarize(msg) << "\n";
@@ -441,9 +696,20 @@ const bool kLogPlans = register_command([](CLI::App& root) {
       }
       plans.push_back({*out_dir + "/plan_" + std::to_string(msg.goal_id) + "_" +
                            std::to_string(msg.plan_id) + ".json",
-                       messages::plan_from_message(msg)});
+                       messages::plan_from_message(msg), world.now()});
     };
     while (const lcm::LogEvent* event = file.readNextEvent()) {
+      if (!obstacle_channel.empty() && event->channel == obstacle_channel) {
+        std::string why;
+        if (world.apply(*event, why)) {
+          ++obstacle_updates;
+        } else {
+          std::cerr << "kinograph: " << obstacle_channel << " message at " << event->timestamp
+                    << " us not applied: " << why << "\n";
+          ++bad_updates;
+        }
+        continue;
+      }
       if (event->channel != *channel) continue;
       // The fingerprint says which version of plan_t a message is (lcmtypes/README.md).
       plan_t msg;
@@ -461,10 +727,19 @@ const bool kLogPlans = register_command([](CLI::App& root) {
       }
     }
     std::filesystem::create_directories(*out_dir);
-    for (const Found& f : plans) write_plan_json(f.plan, s, f.path);
+    for (const Found& f : plans) {
+      planning::Scene with_lcm = s;
+      for (const auto& [name, obstacle] : f.obstacles) add_obstacle(with_lcm, name, obstacle);
+      write_plan_json(f.plan, with_lcm, f.path);
+    }
     std::cout << plans.size() << " plans written to " << *out_dir;
     if (old) std::cout << ", " << old << " of version 1 (no clock)";
     if (rejected) std::cout << ", " << rejected << " messages that are not plans skipped";
+    if (!obstacle_channel.empty()) {
+      std::cout << "; " << obstacle_updates << " obstacle updates from " << obstacle_channel
+                << " applied";
+      if (bad_updates) std::cout << ", " << bad_updates << " not applied";
+    }
     std::cout << "\n";
   });
 });

@@ -5,6 +5,9 @@
 #include <cmath>
 #include <unordered_map>
 
+#include "kinograph/collision/convex_shape.h"
+#include "kinograph/planning/io/data_dir.h"
+
 namespace kinograph::messages {
 namespace {
 
@@ -48,6 +51,13 @@ bool RobotIdentity::matches(const std::string& robot) const {
 }
 
 namespace {
+
+// Model index of each joint, by name.
+std::unordered_map<std::string, int> joint_index_map(const dynamics::Model& model) {
+  std::unordered_map<std::string, int> index;
+  for (int j = 0; j < model.nq(); ++j) index[model.bodies[j].joint_name] = j;
+  return index;
+}
 
 bool is_frame(const dynamics::Model& model, const std::string& name) {
   return std::any_of(model.frames.begin(), model.frames.end(),
@@ -134,52 +144,104 @@ Check goal_from_message(const goal_t& msg, const dynamics::Model& model,
   return {};
 }
 
-Check goal_from_message(const goal_v2_t& msg, const dynamics::Model& model,
-                        const RobotIdentity& identity, GoalRequest& out) {
+namespace {
+
+// A goal of version 2 or later (joints by name, position only, task constraints): `type` names
+// the message in the reasons.
+template <class GoalMessage>
+Check named_goal(const std::string& type, const GoalMessage& msg, const dynamics::Model& model,
+                 const RobotIdentity& identity, GoalRequest& out) {
   GoalRequest request;
-  if (Check c = goal_header("goal_v2_t", msg, identity, request); !c.ok) return c;
+  if (Check c = goal_header(type, msg, identity, request); !c.ok) return c;
   if (msg.kind == goal_v2_t::KIND_JOINT_CONFIGURATION) {
-    if (msg.joint_name.empty()) return Check::fail("goal_v2_t.joint_name names no joint");
-    std::unordered_map<std::string, int> index;
-    for (int j = 0; j < model.nq(); ++j) index[model.bodies[j].joint_name] = j;
+    if (msg.joint_name.empty()) return Check::fail(type + ".joint_name names no joint");
+    const std::unordered_map<std::string, int> index = joint_index_map(model);
     request.goal.kind = planning::Goal::Kind::kJoint;
     request.goal.q.setZero(model.nq());
     request.joint_named.assign(model.nq(), false);
     for (std::size_t i = 0; i < msg.joint_name.size(); ++i) {
-      const std::string field = "goal_v2_t.joint_name[" + std::to_string(i) + "] \"" +
+      const std::string field = type + ".joint_name[" + std::to_string(i) + "] \"" +
                                 msg.joint_name[i] + "\"";
       const auto it = index.find(msg.joint_name[i]);
       if (it == index.end()) return Check::fail(field + " is not a joint of " + model.name);
       if (request.joint_named[it->second]) return Check::fail(field + " appears twice");
       if (!std::isfinite(msg.joint_position[i])) {
-        return Check::fail("goal_v2_t.joint_position of \"" + msg.joint_name[i] +
+        return Check::fail(type + ".joint_position of \"" + msg.joint_name[i] +
                            "\" is not finite");
       }
       request.joint_named[it->second] = true;
       request.goal.q[it->second] = msg.joint_position[i];
     }
   } else if (msg.kind == goal_v2_t::KIND_END_EFFECTOR_POSE) {
-    if (Check c = pose_goal("goal_v2_t", model, msg.ee_frame, msg.ee_position,
+    if (Check c = pose_goal(type, model, msg.ee_frame, msg.ee_position,
                             msg.ee_quaternion, request.goal);
         !c.ok) {
       return c;
     }
     request.goal.position_only = msg.position_only;
   } else {
-    return Check::fail("goal_v2_t.kind " + std::to_string(msg.kind) + " is unknown");
+    return Check::fail(type + ".kind " + std::to_string(msg.kind) + " is unknown");
   }
   if (msg.task_constraint.size() > static_cast<std::size_t>(kMaxTaskConstraintsPerGoal)) {
-    return Check::fail("goal_v2_t.num_task_constraints is " +
+    return Check::fail(type + ".num_task_constraints is " +
                        std::to_string(msg.task_constraint.size()) + ", more than the " +
                        std::to_string(kMaxTaskConstraintsPerGoal) + " one goal may carry");
   }
   for (std::size_t i = 0; i < msg.task_constraint.size(); ++i) {
     planning::TaskConstraint task;
-    const std::string field = "goal_v2_t.task_constraint[" + std::to_string(i) + "]";
+    const std::string field = type + ".task_constraint[" + std::to_string(i) + "]";
     if (Check c = task_constraint_from(msg.task_constraint[i], field, model, task); !c.ok) {
       return c;
     }
     request.task_constraints.push_back(std::move(task));
+  }
+  out = std::move(request);
+  return {};
+}
+
+// A goal tolerance from the wire: finite and >= 0 (0 = the validator's default).
+Check tolerance_from(double value, const std::string& field, double& out) {
+  if (!std::isfinite(value) || value < 0) {
+    return Check::fail(field + " must be >= 0 (0 = the default)");
+  }
+  out = value;
+  return {};
+}
+
+}  // namespace
+
+Check goal_from_message(const goal_v2_t& msg, const dynamics::Model& model,
+                        const RobotIdentity& identity, GoalRequest& out) {
+  return named_goal("goal_v2_t", msg, model, identity, out);
+}
+
+Check goal_from_message(const goal_v3_t& msg, const dynamics::Model& model,
+                        const RobotIdentity& identity, GoalRequest& out) {
+  GoalRequest request;
+  if (Check c = named_goal("goal_v3_t", msg, model, identity, request); !c.ok) return c;
+  planning::Goal& goal = request.goal;
+  if (goal.kind == planning::Goal::Kind::kJoint) {
+    // named_goal has checked every name is a joint, once.
+    const std::unordered_map<std::string, int> index = joint_index_map(model);
+    goal.joint_tolerance.setZero(model.nq());
+    for (std::size_t i = 0; i < msg.joint_name.size(); ++i) {
+      const int j = index.at(msg.joint_name[i]);
+      const std::string field = "goal_v3_t.joint_tolerance of \"" + msg.joint_name[i] + "\"";
+      if (Check c = tolerance_from(msg.joint_tolerance[i], field, goal.joint_tolerance[j]); !c.ok)
+        return c;
+    }
+  } else if (!msg.joint_tolerance.empty()) {
+    return Check::fail("goal_v3_t.joint_tolerance is for joint goals; a pose goal has none");
+  }
+  if (Check c = tolerance_from(msg.position_tolerance_m, "goal_v3_t.position_tolerance_m",
+                               goal.position_tolerance);
+      !c.ok) {
+    return c;
+  }
+  if (Check c = tolerance_from(msg.orientation_tolerance_rad,
+                               "goal_v3_t.orientation_tolerance_rad", goal.orientation_tolerance);
+      !c.ok) {
+    return c;
   }
   out = std::move(request);
   return {};
@@ -203,6 +265,24 @@ obstacle_list_t obstacle_list_from_v1(const obstacle_list_v1_t& msg) {
   out.replace_all = msg.replace_all;
   return out;
 }
+
+namespace {
+
+// An obstacle's pose from the wire: a position within the collision engine's range and a unit
+// quaternion; `field` is the entry's key, `named` the same with its id.
+Check obstacle_pose(const std::string& field, const std::string& named, const double* position,
+                    const double* quaternion, Eigen::Isometry3d& pose) {
+  const Eigen::Vector3d p(position[0], position[1], position[2]);
+  if (std::string e = collision::position_range_error(p); !e.empty()) {
+    return Check::fail(named + ": " + e);
+  }
+  Eigen::Quaterniond rotation;
+  if (Check c = quaternion_from(quaternion, field + ".quaternion", rotation); !c.ok) return c;
+  pose = Eigen::Translation3d(p) * rotation;
+  return {};
+}
+
+}  // namespace
 
 Check obstacles_from_message(const obstacle_list_t& msg, std::vector<ObstacleUpdate>& out) {
   if (msg.obstacles.size() > static_cast<size_t>(kMaxObstaclesPerMessage)) {
@@ -251,18 +331,101 @@ Check obstacles_from_message(const obstacle_list_t& msg, std::vector<ObstacleUpd
     if (std::string e = collision::range_error(u.shape); !e.empty()) {
       return Check::fail(named + ".size: " + e);
     }
-    const Eigen::Vector3d position(o.position[0], o.position[1], o.position[2]);
-    if (std::string e = collision::position_range_error(position); !e.empty()) {
-      return Check::fail(named + ": " + e);
-    }
-    Eigen::Quaterniond rotation;
-    if (Check ch = quaternion_from(o.quaternion, field + ".quaternion", rotation); !ch.ok) {
-      return ch;
-    }
-    u.pose = Eigen::Translation3d(o.position[0], o.position[1], o.position[2]) * rotation;
+    if (Check ch = obstacle_pose(field, named, o.position, o.quaternion, u.pose); !ch.ok) return ch;
     updates.push_back(std::move(u));
   }
   out = std::move(updates);
+  return {};
+}
+
+Check mesh_obstacles_from_message(const mesh_obstacle_list_t& msg, const std::string& anchor_dir,
+                                  std::vector<ObstacleUpdate>& out) {
+  if (msg.obstacles.size() > static_cast<size_t>(kMaxMeshObstaclesPerMessage)) {
+    return Check::fail("mesh_obstacle_list_t.num_obstacles is " +
+                       std::to_string(msg.obstacles.size()) + ", more than the " +
+                       std::to_string(kMaxMeshObstaclesPerMessage) + " one message may carry");
+  }
+  std::vector<ObstacleUpdate> updates;
+  for (size_t i = 0; i < msg.obstacles.size(); ++i) {
+    const mesh_obstacle_t& o = msg.obstacles[i];
+    const std::string field = "mesh_obstacle_list_t.obstacles[" + std::to_string(i) + "]";
+    if (o.id.empty()) return Check::fail(field + ".id is empty");
+    ObstacleUpdate u;
+    u.source = msg.source;
+    u.id = o.id;
+    if (o.action == mesh_obstacle_t::REMOVE) {
+      u.remove = true;
+      updates.push_back(std::move(u));
+      continue;
+    }
+    if (o.action != mesh_obstacle_t::ADD_OR_MOVE) {
+      return Check::fail(field + ".action " + std::to_string(o.action) + " is unknown");
+    }
+    const std::string named = field + " (\"" + o.id + "\")";
+    if (!all_finite(o.scale, o.scale + 3) || !all_finite(o.position, o.position + 3)) {
+      return Check::fail(named + " has a non-finite scale or position");
+    }
+    const Eigen::Vector3d scale(o.scale[0], o.scale[1], o.scale[2]);
+    if (scale.minCoeff() <= 0) return Check::fail(named + ".scale must be > 0");
+    const std::optional<std::string> path = planning::resolve_scene_path(o.mesh, anchor_dir);
+    if (!path) {
+      return Check::fail(named + ".mesh: file '" + o.mesh + "' not found (looked next to the " +
+                         "daemon's scene and in " + planning::describe_data_dirs() + ")");
+    }
+    u.shape = collision::Shape::mesh(*path, scale);
+    if (std::string e = collision::range_error(u.shape); !e.empty()) {
+      return Check::fail(named + ".scale: " + e);
+    }
+    if (Check c = obstacle_pose(field, named, o.position, o.quaternion, u.pose); !c.ok) return c;
+    // Read here, once: a file that is no mesh is refused now, not when a plan needs it.
+    try {
+      collision::ConvexShape hull(u.shape);
+    } catch (const std::exception& e) {
+      return Check::fail(named + ".mesh: " + e.what());
+    }
+    updates.push_back(std::move(u));
+  }
+  out = std::move(updates);
+  return {};
+}
+
+Check payload_from_message(const payload_t& msg, const dynamics::Model& model,
+                           const RobotIdentity& identity, PayloadChange& out) {
+  if (Check c = robot_field(msg.robot, identity, "payload_t"); !c.ok) return c;
+  PayloadChange change;
+  change.utime = msg.utime;
+  if (msg.action == payload_t::DETACH) {
+    out = std::move(change);
+    return {};
+  }
+  if (msg.action != payload_t::ATTACH) {
+    return Check::fail("payload_t.action " + std::to_string(msg.action) + " is unknown");
+  }
+  if (!is_frame(model, msg.frame)) {
+    return Check::fail("payload_t.frame \"" + msg.frame + "\" is not a frame of " + model.name);
+  }
+  if (!std::isfinite(msg.mass_kg) || msg.mass_kg < 0 || msg.mass_kg > kMaxPayloadMassKg) {
+    return Check::fail("payload_t.mass_kg must be in [0, " + std::to_string(kMaxPayloadMassKg) +
+                       "] kg");
+  }
+  if (!all_finite(msg.size, msg.size + 3) || !all_finite(msg.offset, msg.offset + 3)) {
+    return Check::fail("payload_t has a non-finite size or offset");
+  }
+  planning::PayloadSpec spec;
+  spec.frame = msg.frame;
+  spec.mass = msg.mass_kg;
+  spec.size = Eigen::Vector3d(msg.size[0], msg.size[1], msg.size[2]);
+  spec.offset = Eigen::Vector3d(msg.offset[0], msg.offset[1], msg.offset[2]);
+  if (spec.size.minCoeff() <= 0) return Check::fail("payload_t.size must be > 0");
+  const collision::Shape box = collision::Shape::box(spec.size.x(), spec.size.y(), spec.size.z());
+  if (std::string e = collision::range_error(box); !e.empty()) {
+    return Check::fail("payload_t.size: " + e);
+  }
+  if (std::string e = collision::position_range_error(spec.offset); !e.empty()) {
+    return Check::fail("payload_t.offset: " + e);
+  }
+  change.payload = std::move(spec);
+  out = std::move(change);
   return {};
 }
 
@@ -273,8 +436,7 @@ namespace {
 Check joint_indices(const std::vector<std::string>& names, const dynamics::Model& model,
                     const std::string& type, std::vector<int>& out) {
   const int n = model.nq();
-  std::unordered_map<std::string, int> index;
-  for (int j = 0; j < n; ++j) index[model.bodies[j].joint_name] = j;
+  const std::unordered_map<std::string, int> index = joint_index_map(model);
   std::vector<bool> seen(n, false);
   std::vector<int> indices(names.size());
   for (size_t i = 0; i < names.size(); ++i) {
@@ -309,8 +471,7 @@ Check state_from_message(const robot_state_t& msg, const dynamics::Model& model,
     return Check::fail("robot_state_t.position or velocity is not finite");
   }
   const int n = model.nq();
-  std::unordered_map<std::string, int> index;
-  for (int j = 0; j < n; ++j) index[model.bodies[j].joint_name] = j;
+  const std::unordered_map<std::string, int> index = joint_index_map(model);
   MeasuredState state;
   state.utime = msg.utime;
   state.q.setZero(n);

@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -13,11 +14,15 @@
 #include "kinograph/dynamics/model.h"
 #include "kinograph/goal_t.hpp"
 #include "kinograph/goal_v2_t.hpp"
+#include "kinograph/goal_v3_t.hpp"
 #include "kinograph/joint_command_t.hpp"
+#include "kinograph/mesh_obstacle_list_t.hpp"
 #include "kinograph/obstacle_list_t.hpp"
 #include "kinograph/obstacle_list_v1_t.hpp"
+#include "kinograph/payload_t.hpp"
 #include "kinograph/plan_t.hpp"
 #include "kinograph/plan_v1_t.hpp"
+#include "kinograph/planning/io/scene.h"
 #include "kinograph/planning/plan.h"
 #include "kinograph/planning/problem.h"
 #include "kinograph/robot_state_t.hpp"
@@ -88,6 +93,11 @@ inline constexpr int kMaxTaskConstraintsPerGoal = 16;
 Check goal_from_message(const goal_v2_t& msg, const dynamics::Model& model,
                         const RobotIdentity& identity, GoalRequest& out);
 
+/// Checks a goal_v3_t as a goal_v2_t, then its tolerances (finite, >= 0; 0 = the validator's
+/// default), which become the goal's: per named joint, or position and orientation.
+Check goal_from_message(const goal_v3_t& msg, const dynamics::Model& model,
+                        const RobotIdentity& identity, GoalRequest& out);
+
 /// The goal to plan from `start_q`: a joint goal's joints the request does not name are held
 /// at their start position.
 planning::Goal goal_for_start(const GoalRequest& request, const Eigen::VectorXd& start_q);
@@ -106,6 +116,30 @@ obstacle_list_t obstacle_list_from_v1(const obstacle_list_v1_t& msg);
 /// and any shape or position outside the collision engine's faithful range (collision/shape.h),
 /// naming the obstacle.
 Check obstacles_from_message(const obstacle_list_t& msg, std::vector<ObstacleUpdate>& out);
+
+/// Most mesh obstacles one mesh_obstacle_list_t may carry (each is read from disk on arrival).
+inline constexpr int kMaxMeshObstaclesPerMessage = 16;
+
+/// Checks a mesh_obstacle_list_t and converts it, each update carrying the list's source. Mesh
+/// paths resolve as a scene's do: absolute, else against `anchor_dir` (the daemon's scene
+/// directory), else the data directories; each mesh is read here, so a file that is missing or
+/// no mesh is refused naming it, as are a scale or position beyond the collision engine's range.
+Check mesh_obstacles_from_message(const mesh_obstacle_list_t& msg, const std::string& anchor_dir,
+                                  std::vector<ObstacleUpdate>& out);
+
+/// Heaviest payload a payload_t may attach (kg).
+inline constexpr double kMaxPayloadMassKg = 1e4;
+
+/// A payload change from a payload_t: the box to carry (a scene's robot.payload), or none.
+struct PayloadChange {
+  int64_t utime = 0;
+  std::optional<planning::PayloadSpec> payload;  ///< nullopt = detach
+};
+
+/// Checks a payload_t against the model (a known frame; mass, size and offset finite and in
+/// range) and converts it. Whether the box can be attached there is the scene reader's check.
+Check payload_from_message(const payload_t& msg, const dynamics::Model& model,
+                           const RobotIdentity& identity, PayloadChange& out);
 
 /// Checks a robot_state_t and converts it to model order. Its joints may come in any order,
 /// and joints the model does not have (a gripper's) are ignored; a model joint it does not

@@ -22,6 +22,11 @@ struct Goal {
   std::string frame;  ///< kPose: a frame name of the Model (e.g. "iiwa_link_ee_kuka")
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  ///< kPose: desired world pose
   bool position_only = false;  ///< kPose: ignore the orientation of `pose`
+  /// How far from the goal the plan may end and still validate; 0 (or empty) = the validator's
+  /// ValidationThresholds::goal. kJoint: per joint, nq entries or empty (rad, or m).
+  Eigen::VectorXd joint_tolerance;
+  double position_tolerance = 0;     ///< kPose: m
+  double orientation_tolerance = 0;  ///< kPose: rad (unused with position_only)
 };
 
 /// Keeps a frame's orientation (or full pose) at `target` at every step, e.g. to keep a carried

@@ -112,6 +112,26 @@ std::string check_goal_holding(const Problem& p) {
   return "";
 }
 
+// A goal's tolerances must be finite and non-negative (0: the validator's default), one per
+// joint for a joint goal.
+std::string check_goal_tolerance(const Problem& p) {
+  const Goal& g = p.goal;
+  const dynamics::Model& model = *p.model;
+  if (g.joint_tolerance.size() != 0) {
+    if (g.kind != Goal::Kind::kJoint) return "a pose goal takes no joint tolerances";
+    if (g.joint_tolerance.size() != model.nq()) return "joint goal tolerance has the wrong size";
+    for (int j = 0; j < model.nq(); ++j) {
+      if (!(g.joint_tolerance[j] >= 0) || !std::isfinite(g.joint_tolerance[j]))
+        return "the goal tolerance of " + joint_label(model, j) + " must be a number >= 0";
+    }
+  }
+  for (const double t : {g.position_tolerance, g.orientation_tolerance}) {
+    if (!(t >= 0) || !std::isfinite(t))
+      return "the goal's position and orientation tolerances must be numbers >= 0";
+  }
+  return "";
+}
+
 // Why configuration q (the start or the goal) is in collision, naming the pair and the depth;
 // empty when it is clear of obstacles, the floor and its own links.
 std::string collision_at(const Problem& problem, const Eigen::VectorXd& q, const char* what) {
@@ -162,6 +182,8 @@ std::string check_problem(const Problem& p) {
       return "goal frame '" + p.goal.frame + "' is not in the model";
     }
   }
+  r = check_goal_tolerance(p);
+  if (!r.empty()) return r;
   r = check_horizon(p);
   if (!r.empty()) return r;
   r = check_goal_holding(p);

@@ -235,39 +235,55 @@ void check_start_and_goal(const Problem& problem, const Plan& plan,
                        thresholds.final_velocity) +
                        " (" + final_worst + " at " + at_time(t_end) + ")");
   const Eigen::VectorXd q_final = plan.q.row(N).transpose();
+  // A goal's own tolerance (> 0) replaces the default threshold; the worst error relative to
+  // its tolerance is the one reported.
+  const auto tolerance_or_default = [&](double t) { return t > 0 ? t : thresholds.goal; };
   std::string goal_worst;
-  if (problem.goal.kind == Goal::Kind::kJoint) {
-    if (problem.goal.q.size() != n) {
+  double worst_ratio = 0, worst_error = 0, worst_tolerance = thresholds.goal;
+  const auto weigh = [&](double error, double tolerance, std::string what) {
+    if (error / tolerance <= worst_ratio) return;
+    worst_ratio = error / tolerance;
+    worst_error = error;
+    worst_tolerance = tolerance;
+    goal_worst = std::move(what);
+  };
+  const Goal& goal = problem.goal;
+  if (goal.kind == Goal::Kind::kJoint) {
+    if (goal.q.size() != n) {
       add_failure(v, "joint goal has the wrong size");
+    } else if (goal.joint_tolerance.size() != 0 && goal.joint_tolerance.size() != n) {
+      add_failure(v, "joint goal tolerance has the wrong size");
     } else {
       for (int j = 0; j < n; ++j) {
-        const double e = std::abs(q_final[j] - problem.goal.q[j]);
-        if (e <= v.goal_error) continue;
-        v.goal_error = e;
-        goal_worst = joint_label(model, j) + " ends at " + number(q_final[j]) + " " +
-                     joint_unit(model, j, 0) + ", its goal is " + number(problem.goal.q[j]);
+        const double e = std::abs(q_final[j] - goal.q[j]);
+        v.goal_error = std::max(v.goal_error, e);
+        weigh(e, tolerance_or_default(goal.joint_tolerance.size() ? goal.joint_tolerance[j] : 0),
+              joint_label(model, j) + " ends at " + number(q_final[j]) + " " +
+                  joint_unit(model, j, 0) + ", its goal is " + number(goal.q[j]));
       }
     }
   } else {
     int frame = -1;
     try {
-      frame = model.frame_index(problem.goal.frame);
+      frame = model.frame_index(goal.frame);
     } catch (const std::out_of_range&) {
-      add_failure(v, "goal frame '" + problem.goal.frame + "' is not in the model");
+      add_failure(v, "goal frame '" + goal.frame + "' is not in the model");
     }
     if (frame >= 0) {
       dynamics::forward_kinematics(model, data, q_final);
-      const PoseError e = pose_error(dynamics::frame_pose(model, data, frame), problem.goal.pose);
-      v.goal_error = problem.goal.position_only ? e.position : std::max(e.position, e.rotation);
-      goal_worst = "frame '" + problem.goal.frame + "' ends " + number(e.position) +
-                   " m from its goal position" +
-                   (problem.goal.position_only
-                        ? ""
-                        : " and " + number(e.rotation) + " rad from its goal orientation");
+      const PoseError e = pose_error(dynamics::frame_pose(model, data, frame), goal.pose);
+      v.goal_error = goal.position_only ? e.position : std::max(e.position, e.rotation);
+      const std::string where = "frame '" + goal.frame + "' ends ";
+      weigh(e.position, tolerance_or_default(goal.position_tolerance),
+            where + number(e.position) + " m from its goal position");
+      if (!goal.position_only) {
+        weigh(e.rotation, tolerance_or_default(goal.orientation_tolerance),
+              where + number(e.rotation) + " rad from its goal orientation");
+      }
     }
   }
-  if (v.goal_error > thresholds.goal)
-    add_failure(v, fmt("goal error", v.goal_error, thresholds.goal) + " (" + goal_worst + " at " +
+  if (worst_ratio > 1)
+    add_failure(v, fmt("goal error", worst_error, worst_tolerance) + " (" + goal_worst + " at " +
                        at_time(t_end) + ")");
 }
 

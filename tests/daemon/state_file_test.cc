@@ -79,6 +79,26 @@ TEST_F(StateFileTest, WhatIsWrittenIsReadBack) {
   EXPECT_EQ(again.obstacles.size(), 1u);
 }
 
+// A mesh obstacle received over LCM keeps its resolved file and scale across a restart.
+TEST_F(StateFileTest, AMeshObstacleIsReadBackWithItsFileAndScale) {
+  const std::string mesh = (dir_ / "tetra.obj").string();
+  std::ofstream(mesh) << "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nv 0 0 0.1\nf 1 2 3\nf 1 2 4\n";
+  DaemonState s = sample();
+  messages::ObstacleUpdate part;
+  part.source = "perception";
+  part.id = "part";
+  part.shape = collision::Shape::mesh(mesh, Eigen::Vector3d(2, 1, 0.5));
+  part.pose = Eigen::Isometry3d(Eigen::Translation3d(0.5, 0, 1));
+  s.obstacles[{"perception", "part"}] = part;
+  write_state_file(path_, s);
+  const DaemonState back = read_state_file(path_, "rr", "RR");
+  const auto& read = back.obstacles.at({"perception", "part"});
+  EXPECT_EQ(read.shape.kind, collision::ShapeKind::kMesh);
+  EXPECT_EQ(read.shape.mesh_path, mesh);
+  EXPECT_EQ(read.shape.mesh_scale, Eigen::Vector3d(2, 1, 0.5));
+  EXPECT_TRUE(read.pose.isApprox(part.pose, 1e-12));
+}
+
 TEST_F(StateFileTest, ACorruptFileIsRefusedWithItsNameAndLine) {
   write(
       "{\n \"format\": \"kinographd state\",\n \"version\": 1,\n \"robot\": \"rr\" \"prefix\"\n}");
@@ -123,7 +143,18 @@ TEST_F(StateFileTest, BadFieldsAreRefusedByName) {
         "\"plan_ids_below\": 5, \"obstacles\": [{\"source\": \"\", \"id\": \"b\", \"shape\": "
         "\"mesh\", \"size\": [0.1, 0, 0], \"position\": [0, 0, 0], \"quaternion\": [1, 0, 0, "
         "0]}]}");
-  EXPECT_NE(refusal().find("is not box, sphere, cylinder or capsule"), std::string::npos);
+  EXPECT_NE(refusal().find("obstacles[0] (\"b\").mesh missing"), std::string::npos) << refusal();
+  write(head +
+        "\"plan_ids_below\": 5, \"obstacles\": [{\"source\": \"\", \"id\": \"b\", \"shape\": "
+        "\"mesh\", \"size\": [0, 0, 0], \"mesh\": \"" + (dir_ / "gone.obj").string() +
+        "\", \"scale\": [1, 1, 1], \"position\": [0, 0, 0], \"quaternion\": [1, 0, 0, 0]}]}");
+  EXPECT_NE(refusal().find("obstacles[0] (\"b\").mesh: collision mesh"), std::string::npos)
+      << refusal();
+  write(head +
+        "\"plan_ids_below\": 5, \"obstacles\": [{\"source\": \"\", \"id\": \"b\", \"shape\": "
+        "\"torus\", \"size\": [0.1, 0, 0], \"position\": [0, 0, 0], \"quaternion\": [1, 0, 0, "
+        "0]}]}");
+  EXPECT_NE(refusal().find("is not box, sphere, cylinder, capsule or mesh"), std::string::npos);
   const std::string ball =
       "{\"source\": \"p\", \"id\": \"b\", \"shape\": \"sphere\", \"size\": [0.1, 0, 0], "
       "\"position\": [0, 0, 0], \"quaternion\": [1, 0, 0, 0]}";

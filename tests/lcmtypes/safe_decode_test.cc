@@ -57,6 +57,9 @@ TEST(SafeDecode, AcceptsWellFormedMessagesOfEveryType) {
   joint_goal.num_joints = 3;
   expect_accepts(joint_goal);
   expect_accepts(make_goal_v2());
+  expect_accepts(make_goal_v3());
+  expect_accepts(make_payload());
+  expect_accepts(make_mesh_obstacle_list());
   expect_accepts(make_obstacle("o", obstacle_t::CYLINDER));
   expect_accepts(make_obstacle_list());
   expect_accepts(make_obstacle_list_v1());
@@ -87,6 +90,9 @@ TEST(SafeDecode, RejectsEveryTruncation) {
   expect_prefixes_rejected(make_robot_state());
   expect_prefixes_rejected(make_goal());
   expect_prefixes_rejected(make_goal_v2());
+  expect_prefixes_rejected(make_goal_v3());
+  expect_prefixes_rejected(make_payload());
+  expect_prefixes_rejected(make_mesh_obstacle_list());
   expect_prefixes_rejected(make_obstacle_list());
   expect_prefixes_rejected(make_obstacle_list_v1());
   expect_prefixes_rejected(make_plan(3));
@@ -109,6 +115,21 @@ TEST(SafeDecode, TellsTheGoalVersionsApart) {
   EXPECT_FALSE(has_fingerprint<goal_t>(v1.data(), 7));  // shorter than a fingerprint
   goal_t as_v1;
   EXPECT_FALSE(decode_bytes(v2, as_v1).ok);
+}
+
+// The three goal versions and the two obstacle list kinds share channels: each fingerprint is
+// its own, so none is taken for another.
+TEST(SafeDecode, TellsTheNewerGoalAndMeshListApart) {
+  const std::vector<uint8_t> v2 = encode(make_goal_v2()), v3 = encode(make_goal_v3());
+  const std::vector<uint8_t> meshes = encode(make_mesh_obstacle_list());
+  EXPECT_TRUE(has_fingerprint<goal_v3_t>(v3.data(), static_cast<int>(v3.size())));
+  EXPECT_FALSE(has_fingerprint<goal_v2_t>(v3.data(), static_cast<int>(v3.size())));
+  EXPECT_FALSE(has_fingerprint<goal_v3_t>(v2.data(), static_cast<int>(v2.size())));
+  EXPECT_TRUE(has_fingerprint<mesh_obstacle_list_t>(meshes.data(), static_cast<int>(meshes.size())));
+  obstacle_list_t as_list;
+  EXPECT_FALSE(decode_bytes(meshes, as_list).ok);
+  goal_v2_t as_v2;
+  EXPECT_FALSE(decode_bytes(v3, as_v2).ok);
 }
 
 // The two versions of plan_t have their own fingerprints: neither decodes as the other.
@@ -250,6 +271,9 @@ TEST(SafeDecode, SurvivesRandomCorruption) {
   fuzz(make_robot_state(), engine, 2000);
   fuzz(make_goal(), engine, 2000);
   fuzz(make_goal_v2(), engine, 2000);
+  fuzz(make_goal_v3(), engine, 2000);
+  fuzz(make_payload(), engine, 2000);
+  fuzz(make_mesh_obstacle_list(), engine, 2000);
   fuzz(make_obstacle_list(), engine, 2000);
   fuzz(make_plan(3), engine, 2000);
   fuzz(make_planner_status(), engine, 2000);

@@ -9,10 +9,13 @@
 #include "drake/lcmt_robot_plan.hpp"
 #include "kinograph/goal_t.hpp"
 #include "kinograph/goal_v2_t.hpp"
+#include "kinograph/goal_v3_t.hpp"
 #include "kinograph/joint_command_t.hpp"
+#include "kinograph/mesh_obstacle_list_t.hpp"
 #include "kinograph/obstacle_list_t.hpp"
 #include "kinograph/obstacle_list_v1_t.hpp"
 #include "kinograph/obstacle_t.hpp"
+#include "kinograph/payload_t.hpp"
 #include "kinograph/plan_t.hpp"
 #include "kinograph/plan_v1_t.hpp"
 #include "kinograph/planner_status_t.hpp"
@@ -23,6 +26,10 @@ namespace kinograph::lcmtypes::testing {
 
 using kinograph::goal_t;
 using kinograph::goal_v2_t;
+using kinograph::goal_v3_t;
+using kinograph::mesh_obstacle_list_t;
+using kinograph::mesh_obstacle_t;
+using kinograph::payload_t;
 using kinograph::task_constraint_t;
 using kinograph::joint_command_t;
 using kinograph::obstacle_list_t;
@@ -110,6 +117,65 @@ inline goal_v2_t make_goal_v2() {
     m.task_constraint.push_back(t);
   }
   m.num_task_constraints = 2;
+  return m;
+}
+
+// goal_v2_t's sample as a goal_v3_t, with a tolerance per joint and for a pose.
+inline goal_v3_t make_goal_v3() {
+  const goal_v2_t v2 = make_goal_v2();
+  goal_v3_t m;
+  m.utime = v2.utime;
+  m.goal_id = v2.goal_id;
+  m.robot = v2.robot;
+  m.kind = v2.kind;
+  m.num_joints = v2.num_joints;
+  m.joint_name = v2.joint_name;
+  m.joint_position = v2.joint_position;
+  m.ee_frame = v2.ee_frame;
+  std::copy(std::begin(v2.ee_position), std::end(v2.ee_position), m.ee_position);
+  std::copy(std::begin(v2.ee_quaternion), std::end(v2.ee_quaternion), m.ee_quaternion);
+  m.position_only = v2.position_only;
+  m.duration_s = v2.duration_s;
+  m.num_task_constraints = v2.num_task_constraints;
+  m.task_constraint = v2.task_constraint;
+  m.joint_tolerance.assign(v2.joint_name.size(), 1e-3);
+  m.position_tolerance_m = 0.02;
+  m.orientation_tolerance_rad = 0.03;
+  return m;
+}
+
+inline payload_t make_payload() {
+  payload_t m;
+  m.utime = 44;
+  m.robot = "iiwa14";
+  m.action = payload_t::ATTACH;
+  m.frame = "iiwa_link_ee_kuka";
+  m.mass_kg = 2.0;
+  for (int i = 0; i < 3; ++i) {
+    m.size[i] = 0.1 * (i + 1);
+    m.offset[i] = 0.01 * i;
+  }
+  return m;
+}
+
+inline mesh_obstacle_list_t make_mesh_obstacle_list() {
+  mesh_obstacle_list_t m;
+  m.utime = 45;
+  m.source = "perception";
+  for (const char* id : {"part", "fixture"}) {
+    mesh_obstacle_t o;
+    o.id = id;
+    o.action = mesh_obstacle_t::ADD_OR_MOVE;
+    o.mesh = std::string("meshes/") + id + ".obj";
+    for (int i = 0; i < 3; ++i) {
+      o.scale[i] = 1.0;
+      o.position[i] = random_double();
+    }
+    const double q[4] = {1, 0, 0, 0};
+    std::copy(q, q + 4, o.quaternion);
+    m.obstacles.push_back(o);
+  }
+  m.num_obstacles = 2;
   return m;
 }
 

@@ -11,8 +11,10 @@ import time
 import unittest
 
 import kinograph
-from kinograph import goal_t, goal_v2_t, plan_t
-from kinograph_client import Lcm, LcmError, PlannerClient, joint_goal, pose_goal
+from kinograph import (goal_t, goal_v2_t, goal_v3_t, mesh_obstacle_list_t, mesh_obstacle_t,
+                       payload_t, plan_t)
+from kinograph_client import (Lcm, LcmError, PlannerClient, detach_payload, joint_goal,
+                              mesh_obstacle, payload, pose_goal)
 
 LCMTYPES_DIR = sys.argv.pop(1)
 
@@ -80,6 +82,56 @@ class GeneratedTypes(unittest.TestCase):
             pose_goal("ee", [0, 0], (1, 0, 0, 0))
         with self.assertRaisesRegex(ValueError, "quaternion has 3 values"):
             pose_goal("ee", [0, 0, 1], (1, 0, 0))
+
+
+class SceneMessages(unittest.TestCase):
+    """Goals with tolerances, payloads and mesh obstacles, encoded as the daemon reads them."""
+
+    def test_joint_tolerances_make_a_goal_v3(self):
+        goal = joint_goal({"joint1": 0.5, "joint2": -0.2}, goal_id=45,
+                          tolerance={"joint2": 1e-4})
+        back = goal_v3_t.decode(goal.encode())
+        self.assertEqual(list(back.joint_name), ["joint1", "joint2"])
+        self.assertEqual(list(back.joint_tolerance), [0.0, 1e-4])
+        with self.assertRaisesRegex(ValueError, "'elbow', a joint the goal does not name"):
+            joint_goal({"joint1": 0.5}, tolerance={"elbow": 0.1})
+        with self.assertRaisesRegex(ValueError, "tolerances need the joints by name"):
+            joint_goal([0.5, 0.2], tolerance={"joint1": 0.1})
+
+    def test_pose_tolerances_make_a_goal_v3(self):
+        goal = pose_goal("ee", (0, 0, 1.5), position_only=True, position_tolerance=0.03)
+        back = goal_v3_t.decode(goal.encode())
+        self.assertEqual(back.position_tolerance_m, 0.03)
+        self.assertEqual(back.orientation_tolerance_rad, 0.0)
+        self.assertTrue(back.position_only)
+        # Without tolerances it stays a goal_v2_t.
+        goal_v2_t.decode(pose_goal("ee", (0, 0, 1.5), position_only=True).encode())
+
+    def test_payload_and_detach(self):
+        back = payload_t.decode(payload("ee", 1.5, (0.1, 0.2, 0.3), (0, 0, 0.05)).encode())
+        self.assertEqual(back.action, payload_t.ATTACH)
+        self.assertEqual(back.frame, "ee")
+        self.assertEqual(back.mass_kg, 1.5)
+        self.assertEqual(list(back.size), [0.1, 0.2, 0.3])
+        self.assertEqual(list(back.offset), [0.0, 0.0, 0.05])
+        self.assertEqual(payload_t.decode(detach_payload().encode()).action, payload_t.DETACH)
+        with self.assertRaisesRegex(ValueError, "payload: size has 2 values"):
+            payload("ee", 1.0, (0.1, 0.2))
+
+    def test_mesh_obstacle(self):
+        msg = mesh_obstacle("part", "meshes/part.obj", (0.5, 0, 1), scale=(2, 2, 2),
+                            source="perception")
+        back = mesh_obstacle_list_t.decode(msg.encode())
+        self.assertEqual(back.source, "perception")
+        self.assertEqual(back.num_obstacles, 1)
+        o = back.obstacles[0]
+        self.assertEqual((o.id, o.mesh, o.action), ("part", "meshes/part.obj",
+                                                    mesh_obstacle_t.ADD_OR_MOVE))
+        self.assertEqual(list(o.scale), [2.0, 2.0, 2.0])
+        self.assertEqual(list(o.quaternion), [1.0, 0.0, 0.0, 0.0])
+        gone = mesh_obstacle_list_t.decode(mesh_obstacle("part", "", (0, 0, 0),
+                                                         remove=True).encode())
+        self.assertEqual(gone.obstacles[0].action, mesh_obstacle_t.REMOVE)
 
 
 class Binding(unittest.TestCase):

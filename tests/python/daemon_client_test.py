@@ -2,7 +2,8 @@
 robots/scenes/rr_reach.yaml): a joint goal sent from Python is answered by a valid plan that
 ends at the goal, decoded with the generated types; goals by joint name (goal_v2_t) and a
 position-only pose goal are planned; an unknown joint name and a goal with the wrong number of
-joints are answered INVALID_GOAL with their reason. The daemon takes goal ids 1, 2, 3, ... as a
+joints are answered INVALID_GOAL with their reason; a payload attached from Python changes the
+torque the arm holds at the goal, detached it does not; a tight goal tolerance is met. The daemon takes goal ids 1, 2, 3, ... as a
 sequence (gaps are losses), so the ids follow the tests' (alphabetical) order.
 Usage: daemon_client_test.py URL PREFIX URDF, with share/kinograph/python on PYTHONPATH."""
 
@@ -12,7 +13,8 @@ import unittest
 import xml.etree.ElementTree as ET
 
 from kinograph import plan_t
-from kinograph_client import STATUS_NAMES, PlannerClient, joint_goal, pose_goal
+from kinograph_client import (STATUS_NAMES, PlannerClient, detach_payload, joint_goal, payload,
+                              pose_goal)
 
 URL, PREFIX, URDF = sys.argv[1:4]
 del sys.argv[1:4]
@@ -29,7 +31,9 @@ def urdf_joint_names(path):
             if j.get("type") != "fixed"]
 
 
-class PythonClientAgainstDaemon(unittest.TestCase):
+class DaemonTestCase(unittest.TestCase):
+    """One client for the tests of a class."""
+
     @classmethod
     def setUpClass(cls):
         cls.client = PlannerClient(PREFIX, URL)
@@ -37,6 +41,9 @@ class PythonClientAgainstDaemon(unittest.TestCase):
     @classmethod
     def tearDownClass(cls):
         cls.client.close()
+
+
+class PythonClientAgainstDaemon(DaemonTestCase):
 
     def test_joint_goal_is_planned(self):
         plan = self.client.plan(joint_goal(GOAL, goal_id=2), timeout_s=TIMEOUT_S)
@@ -88,6 +95,33 @@ class PythonClientAgainstDaemon(unittest.TestCase):
         self.assertEqual(plan.status, plan_t.INVALID_GOAL, STATUS_NAMES.get(plan.status))
         self.assertEqual(plan.num_steps, 0)
         self.assertIn("3", plan.status_message)
+
+
+class PythonClientSceneMessages(DaemonTestCase):
+    """Runs after PythonClientAgainstDaemon (class names in order): goal ids 6, 7, ..."""
+
+    def plan(self, goal):
+        plan = self.client.plan(goal, timeout_s=TIMEOUT_S)
+        self.assertEqual(plan.status, plan_t.SUCCESS,
+                         f"{STATUS_NAMES.get(plan.status)}: {plan.status_message}")
+        return plan
+
+    def test_a_payload_is_carried_until_detached(self):
+        bare = self.plan(joint_goal(GOAL, goal_id=6))
+        # 1 kg at the tip of the 0.8 m link: at the goal, joint 2 holds its weight too.
+        self.client.send_payload(payload("ee", 1.0, (0.05, 0.05, 0.05)))
+        carried = self.plan(joint_goal(GOAL, goal_id=7))
+        lever = 0.8 * math.sin(GOAL[0] + GOAL[1])
+        self.assertAlmostEqual(abs(carried.tau[-1][1] - bare.tau[-1][1]), 1.0 * 9.81 * abs(lever),
+                               delta=0.05)
+        self.client.send_payload(detach_payload())
+        detached = self.plan(joint_goal(GOAL, goal_id=8))
+        self.assertAlmostEqual(detached.tau[-1][1], bare.tau[-1][1], delta=1e-3)
+
+    def test_b_a_tight_goal_tolerance_is_met(self):
+        plan = self.plan(joint_goal({"joint1": 0.9, "joint2": 0.2}, goal_id=9,
+                                    tolerance={"joint1": 1e-4, "joint2": 1e-4}))
+        self.assertLessEqual(plan.goal_error, 1e-4)
 
 
 if __name__ == "__main__":
