@@ -113,8 +113,8 @@ DaemonState read_state_file(const std::string& path, const std::string& robot,
   json j;
   try {
     j = json::parse(in);
-  } catch (const json::parse_error& e) {
-    // e.what() gives the line and column ("at line 3, column 5").
+  } catch (const json::exception& e) {
+    // parse_error (its what() gives the line and column), or out_of_range for 1e309.
     fail(path, std::string("is not valid JSON: ") + e.what());
   }
   if (!j.is_object() || j.value("format", json()) != kFormat) {

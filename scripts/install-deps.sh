@@ -29,6 +29,8 @@ PACKAGES=(
   doxygen
   # network namespaces for LCM multicast tests
   iproute2 util-linux
+  # fuzz targets (fuzz/, ctest fuzz.short_runs): clang with libFuzzer, ASan and UBSan
+  clang-14 libfuzzer-14-dev
 )
 
 missing=()

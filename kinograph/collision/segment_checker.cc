@@ -151,6 +151,12 @@ PathCheckResult SegmentChecker::check_path(CollisionWorld& world, dynamics::Data
       u = 0;
       if (i == m - 1 || budget <= 0 || time_budget <= 0) break;
     }
+    if (result.samples >= options_.max_path_samples) {
+      result.complete = false;
+      result.stopped_segment = i;
+      result.stopped_s = u;
+      break;
+    }
     const double next = sample(i, u);
     result.lower_bound = std::min(result.lower_bound, 0.5 * (d + next - swept));
     d = next;

@@ -24,6 +24,9 @@ struct SegmentCheckOptions {
   // Largest time between samples (s) when the world has moving obstacles, whose own motion
   // the sweep bound does not cover. Default 0.02.
   double max_time_step = 0.02;
+  // Most configurations check_path queries. A path that sweeps kilometres (a plan file with
+  // q = 1e308) would otherwise take forever; the walk stops there and says so. Default 200,000.
+  int max_path_samples = 200000;
 };
 
 // The smallest signed distance found along a segment.
@@ -53,6 +56,11 @@ struct PathCheckResult {
   Proximity closest;
   // Number of configurations checked.
   int samples = 0;
+  // False when the walk stopped at max_path_samples: the distances cover only the path up to
+  // segment `stopped_segment`, fraction `stopped_s`.
+  bool complete = true;
+  int stopped_segment = 0;
+  double stopped_s = 0;
 };
 
 // Checks straight segments q(s) = q0 + s (q1 − q0), s ∈ [0, 1], with obstacle time
@@ -74,7 +82,7 @@ class SegmentChecker {
   // the robot could come closer than `clearance` is skipped, yet clear stretches cost one
   // query. With self-collision pairs in the world the budget is halved: both geometries of a
   // pair move, so their distance changes up to twice the sweep. Allocates nothing after the
-  // first call with a given joint count.
+  // first call with a given joint count. Stops after max_path_samples queries (complete false).
   PathCheckResult check_path(CollisionWorld& world, dynamics::Data& data,
                              const Eigen::Ref<const Eigen::MatrixXd>& path,
                              const std::vector<double>& times = {}, double clearance = 0);

@@ -294,7 +294,10 @@ class Loader {
   // urdfdom skips some elements it cannot read without an error; every <collision> and <visual>
   // the text holds must have become a shape.
   void check_nothing_dropped() const {
-    for (const auto& [name, link] : outline_.links) {
+    for (const auto& entry : outline_.links) {
+      // Not a structured binding: clang 14 (the fuzz build) cannot capture one in a lambda.
+      const std::string& name = entry.first;
+      const UrdfOutline::Link& link = entry.second;
       const urdf::LinkConstSharedPtr l = urdf_->getLink(name);
       if (!l) fail("link '" + name + "'" + outline_.link_line(name) + " was not read by urdfdom");
       const auto check = [&](size_t read, const std::vector<int>& lines, const char* kind) {

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "kinograph/dynamics/urdf_error.h"
+#include "kinograph/dynamics/xml_depth.h"
 
 namespace kinograph::dynamics {
 namespace {
@@ -72,6 +73,10 @@ class Outliner {
   explicit Outliner(std::string source) : source_(std::move(source)) {}
 
   UrdfOutline run(const std::string& xml) {
+    if (const XmlDepth deep = find_nesting_beyond(xml, kMaxUrdfNesting); deep.exceeded) {
+      fail(deep.line, "elements nested deeper than " + std::to_string(kMaxUrdfNesting) +
+                          " levels; a URDF needs a handful");
+    }
     TiXmlDocument doc;
     doc.Parse(xml.c_str());
     if (doc.Error()) {

@@ -23,8 +23,13 @@ struct UrdfOutline {
   std::string joint_line(const std::string& joint) const;
 };
 
+/// Deepest element nesting a URDF may have (robot, link, collision, geometry, box is 5): the
+/// XML parsers under urdfdom recurse per level, so deeper text is refused before they run.
+inline constexpr int kMaxUrdfNesting = 100;
+
 /// Reads the XML of a URDF. `source` names it in messages (a path or "<urdf string>").
-/// @throws UrdfError for XML that does not parse (with its line), a xacro file ("expand it with
+/// @throws UrdfError for XML nested deeper than kMaxUrdfNesting or that does not parse (with its
+/// line), a xacro file ("expand it with
 ///   xacro first"), a root that is not `<robot>`, or a numeric attribute that is not a list of the
 ///   right number of finite numbers (sizes must also be > 0), naming the link or joint, the
 ///   element path and the line.

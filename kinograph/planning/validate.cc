@@ -354,6 +354,15 @@ void check_collision(const Problem& problem, const Plan& plan,
   const collision::PathCheckResult r =
       checker.check_path(*world, data, path, times, thresholds.min_clearance);
   v.min_clearance = std::min(v.min_clearance, r.min_distance);
+  if (!r.complete) {
+    const size_t at = std::min(static_cast<size_t>(r.stopped_segment), times.size() - 1);
+    const double t =
+        at + 1 < times.size() ? times[at] + r.stopped_s * (times[at + 1] - times[at]) : times[at];
+    std::ostringstream os;
+    os << "collision: not checked after t = " << t << " s: the path sweeps too far for "
+       << r.samples << " collision queries (q or q̇ far beyond what the robot can move)";
+    add_failure(v, os.str());
+  }
   if (r.min_distance < thresholds.min_clearance) {
     const size_t at = std::min(static_cast<size_t>(r.segment), times.size() - 1);
     const double t =

@@ -32,12 +32,35 @@ start_daemon() {
   fail "daemon did not start"
 }
 
+# Waits (bounded) until the lcm-logger on URL $1 writing $2 has recorded a probe message: it
+# is subscribed, so nothing sent from now on is missed.
+logger_ready() {
+  for _ in $(seq 100); do
+    "$KG" send-raw RR_LOGGER_PROBE --text probe --lcm-url "$1" >/dev/null
+    grep -aq RR_LOGGER_PROBE "$2" 2>/dev/null && return 0
+    sleep 0.1
+  done
+  fail "lcm-logger writing $2 did not start"
+}
+
+# Waits (bounded) until the log $1 holds an answer log-plans reports as matching $2, so the
+# logger is stopped only once the plan is written (it flushes every 100 ms).
+logged_answer() {
+  for _ in $(seq 300); do
+    rm -rf "$WORK/snapshot"
+    cp "$1" "$WORK/snapshot.lcmlog"
+    "$KG" log-plans "$WORK/snapshot.lcmlog" --channel RR_PLAN --scene "$SCENE" \
+      --out-dir "$WORK/snapshot" 2>/dev/null | grep -Eq "$2" && return 0
+    sleep 0.1
+  done
+  fail "no answer matching '$2' in $1"
+}
+
 # lcm-logger 1.3.1 lists -l in its help but rejects it: the long option works.
 lcm-logger -f --lcm-url="$URL" "$WORK/session.lcmlog" >"$WORK/logger.log" 2>&1 &
 LOGGER=$!
 PIDS+=($LOGGER)
-sleep 0.3
-kill -0 "$LOGGER" 2>/dev/null || { cat "$WORK/logger.log"; fail "lcm-logger did not start"; }
+logger_ready "$URL" "$WORK/session.lcmlog"
 start_daemon "$URL" "$WORK/daemon1.log"
 DAEMON=${PIDS[-1]}
 
@@ -69,6 +92,7 @@ grep -q '"elbow" is not a joint of rr' "$WORK/daemon1.log" || fail "unknown join
 
 kill -TERM "$DAEMON"
 wait "$DAEMON" || fail "daemon did not exit cleanly on SIGTERM"
+logged_answer "$WORK/session.lcmlog" "for goal 5: "
 kill -INT "$LOGGER"
 wait "$LOGGER" || true
 
@@ -84,13 +108,10 @@ grep -q "for goal 3: INVALID_GOAL" "$WORK/log-plans.txt" || fail "goal 3 not ans
 lcm-logger -f --lcm-url="$URL2" "$WORK/replay.lcmlog" >/dev/null 2>&1 &
 LOGGER2=$!
 PIDS+=($LOGGER2)
+logger_ready "$URL2" "$WORK/replay.lcmlog"
 start_daemon "$URL2" "$WORK/daemon2.log"
 lcm-logplayer --speed=1 --regexp="^RR_(GOAL|OBSTACLES)$" --lcm-url="$URL2" "$WORK/session.lcmlog"
-for _ in $(seq 300); do
-  grep -q "goal 2: plan" "$WORK/daemon2.log" && break
-  sleep 0.1
-done
-sleep 0.5
+logged_answer "$WORK/replay.lcmlog" "for goal 2: SUCCESS"
 kill -INT "$LOGGER2"
 wait "$LOGGER2" || true
 "$KG" log-plans "$WORK/replay.lcmlog" --channel RR_PLAN --scene "$SCENE" --out-dir "$WORK/replayed" \

@@ -201,7 +201,7 @@ json read_json_file(const std::string& path) {
   if (!in) throw PlanFileError("cannot open plan file '" + path + "'");
   try {
     return json::parse(in);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // parse_error, and out_of_range for a number like 1e309
     throw PlanFileError("plan '" + path + "' is not valid JSON: " + e.what());
   }
 }

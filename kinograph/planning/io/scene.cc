@@ -215,6 +215,9 @@ class SceneParser {
     const YAML::Node steps = r_.required(root, "", "steps");
     problem.steps = r_.integer(steps, "steps");
     if (problem.steps < 1) r_.fail(steps, "steps", "must be at least 1");
+    if (problem.steps > kMaxSceneSteps) {
+      r_.fail(steps, "steps", "must be at most " + std::to_string(kMaxSceneSteps));
+    }
 
     const YAML::Node start = r_.required(root, "", "start");
     r_.expect_map(start, "start", {"q", "qd"});
@@ -592,11 +595,19 @@ class SceneParser {
       if (o.collision_substeps < 0) {
         r_.fail(node["collision_substeps"], "objectives.collision_substeps", "must be >= 0");
       }
+      if (o.collision_substeps > kMaxSceneSubsteps) {
+        r_.fail(node["collision_substeps"], "objectives.collision_substeps",
+                "must be at most " + std::to_string(kMaxSceneSubsteps));
+      }
     }
     if (node["limit_substeps"]) {
       o.limit_substeps = r_.integer(node["limit_substeps"], "objectives.limit_substeps");
       if (o.limit_substeps < 0) {
         r_.fail(node["limit_substeps"], "objectives.limit_substeps", "must be >= 0");
+      }
+      if (o.limit_substeps > kMaxSceneSubsteps) {
+        r_.fail(node["limit_substeps"], "objectives.limit_substeps",
+                "must be at most " + std::to_string(kMaxSceneSubsteps));
       }
     }
   }

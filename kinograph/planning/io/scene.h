@@ -81,6 +81,12 @@ struct Scene {
   Problem problem;
 };
 
+/// Most intervals a scene may ask for (key `steps`): beyond it a plan's arrays alone would take
+/// gigabytes, so the file is refused before anything is allocated.
+inline constexpr int kMaxSceneSteps = 10000;
+/// Most sub-steps per interval (keys objectives.collision_substeps and limit_substeps).
+inline constexpr int kMaxSceneSubsteps = 100;
+
 /// Reads a scene file. Relative paths inside (URDF, meshes, warm-start plan) resolve against
 /// the scene file's directory first, then the data directories (data_dir.h). Throws SceneError.
 Scene load_scene(const std::string& path);

@@ -1,0 +1,40 @@
+// Fuzz target: the change-file reader of `kinograph replan`, for the RR arm's and the iiwa's
+// shipped scenes (the corpus holds changes for both). An accepted change is applied, and the
+// changed problem goes through the planner's pre-solve check. Findings: a crash, a hang, a
+// sanitizer report, or an exception other than SceneError (or one not naming the file).
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+#include "fuzz/fuzz_data.h"
+#include "kinograph/planning/io/replan_change.h"
+#include "kinograph/planning/problem_check.h"
+
+namespace {
+
+void try_change(const std::string& text, const kinograph::planning::Scene& scene) {
+  using namespace kinograph;
+  static const std::string source = fuzz::source_path("robots/scenes/changes/fuzz.yaml");
+  planning::SceneChange change;
+  try {
+    change = planning::parse_change(text, scene, source);
+  } catch (const planning::SceneError& e) {
+    fuzz::expect_names(e.what(), source);
+    return;
+  }
+  (void)planning::check_problem(planning::apply_change(scene, change).problem);
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  using namespace kinograph;
+  static const planning::Scene rr =
+      planning::load_scene(fuzz::source_path("robots/scenes/rr_reach.yaml"));
+  static const planning::Scene iiwa =
+      planning::load_scene(fuzz::source_path("robots/scenes/iiwa_desk.yaml"));
+  const std::string text(reinterpret_cast<const char*>(data), size);
+  try_change(text, rr);
+  try_change(text, iiwa);
+  return 0;
+}
