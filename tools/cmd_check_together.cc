@@ -9,6 +9,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -101,9 +102,9 @@ void run_check_together(const CheckTogetherArgs& args) {
   }
   std::cout << "closest approach: " << fleet::describe(c) << "\n";
   if (!c.clear(args.clearance)) {
-    throw CommandFailure("the robots do not keep " + std::to_string(args.clearance) +
-                             " m apart: " + fleet::describe(c),
-                         kExitInvalidPlan);
+    std::ostringstream why;
+    why << "the robots do not keep " << args.clearance << " m apart: " << fleet::describe(c);
+    throw CommandFailure(why.str(), kExitInvalidPlan);
   }
   std::cout << "clear (required clearance " << args.clearance << " m)\n";
 }
