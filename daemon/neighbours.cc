@@ -52,6 +52,7 @@ NeighbourSpec neighbour_from_option(const std::string& text) {
   }
   const planning::Scene scene = planning::load_scene(scene_path);
   spec.model = scene.problem.model;
+  spec.start_q = scene.problem.start_q;
   spec.base = Eigen::Isometry3d::Identity();  // BASE-PENDING scene.base
   return spec;
 }
@@ -278,6 +279,9 @@ void Neighbours::add_obstacles(const fleet::Decision& decision, std::int64_t ori
       // Heard a plan but no state: it comes to rest where the plan ends.
       bodies = fleet::bodies_at(n, h.plan->q.row(h.plan->q.rows() - 1).transpose(),
                                 kFirstObstacleId + slot);
+    } else if (specs_[i].start_q.size() == specs_[i].model->nq()) {
+      // Nothing heard yet: it stands at its scene's start.
+      bodies = fleet::bodies_at(n, specs_[i].start_q, kFirstObstacleId + slot);
     }
     for (fleet::NeighbourBody& b : bodies) {
       body_names_[b.obstacle.id] = b.name;
@@ -320,8 +324,8 @@ std::string Neighbours::summary() const {
     } else if (h.plan) {
       os << "plan " << h.plan_id;
       const auto it = planned_.find(specs_[i].name);
-      os << (it != planned_.end() && it->second != fleet::kHeldMark ? ", followed"
-                                                                       : ", held at its state");
+      os << (it != planned_.end() && it->second == h.generation ? ", followed"
+                                                                   : ", held at its state");
     } else {
       os << "no plan, held at its state";
     }

@@ -35,6 +35,8 @@ struct NeighbourSpec {
   /// Its robot placed at its base, payload attached (from its scene file).
   std::shared_ptr<const dynamics::Model> model;
   Eigen::Isometry3d base = Eigen::Isometry3d::Identity();  ///< where its scene puts its base
+  /// Its scene's start: where it stands until a state or plan of it is heard (empty: nowhere).
+  Eigen::VectorXd start_q;
 };
 
 /// Reads kinographd's `--neighbour NAME=SCENE[@PREFIX]`: the neighbour's own scene file gives its
@@ -83,8 +85,9 @@ class Neighbours {
   /// `text` with "obstacle <id>" of a neighbour body replaced by its name ("neighbour 'right'
   /// link 'iiwa_link_4'").
   std::string name_bodies(std::string text) const;
-  /// One line per neighbour for the heartbeat: how it is seen ("right: plan 3 of goal at
-  /// 5.2 s, followed"; "silent 4.1 s, held at its last state"; a model or base mismatch).
+  /// One entry per neighbour for the heartbeat, "; "-separated: how it is seen ("right: plan 3,
+  /// followed" when the current plan was made around its plan 3; "right: plan 3, held at its
+  /// state"; "silent for 4.1 s, held at its last state"; a model or base mismatch in brackets).
   std::string summary() const;
   /// Number of neighbours.
   std::size_t size() const { return specs_.size(); }

@@ -613,10 +613,11 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t
   for (const auto& [name, obstacle] : live_obstacles_) problem.obstacles.push_back(obstacle);
   // Neighbours' bodies on this plan's clock: knot 0 is the state, the take-over, or now.
   std::optional<fleet::Decision> around;
+  std::optional<int64_t> origin;  // without a state, the plan then starts when planning began
   if (neighbours_) {
     around = neighbours_->decide({goal.utime, ""}, !replan);
-    const int64_t origin = join ? join->takeover_utime : state_utime.value_or(wall_utime());
-    neighbours_->add_obstacles(*around, origin, problem.obstacles);
+    origin = join ? join->takeover_utime : state_utime.value_or(wall_utime());
+    neighbours_->add_obstacles(*around, *origin, problem.obstacles);
   }
   // Joints a goal does not name stay where this plan starts.
   problem.goal = messages::goal_for_start(goal, problem.start_q);
@@ -673,9 +674,11 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t
   }
   if (around && !threw && plan.success()) neighbours_->planned(*around);
   // Knot 0 is the measured state, at its own time, or where the motion under way will be at
-  // the take-over; without a state the plan starts when it is published.
+  // the take-over; without a state the plan starts when it is published (with neighbours, when
+  // planning began: the time their bodies were placed on).
   time.state_utime = state_utime.value_or(-1);
-  time.start_utime = join ? join->takeover_utime : state_utime.value_or(time.utime);
+  time.start_utime =
+      join ? join->takeover_utime : state_utime.value_or(origin.value_or(time.utime));
   time.takeover_utime = time.start_utime;
   plan_t msg;
   if (threw) {
