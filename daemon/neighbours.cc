@@ -53,7 +53,7 @@ NeighbourSpec neighbour_from_option(const std::string& text) {
   const planning::Scene scene = planning::load_scene(scene_path);
   spec.model = scene.problem.model;
   spec.start_q = scene.problem.start_q;
-  spec.base = Eigen::Isometry3d::Identity();  // BASE-PENDING scene.base
+  spec.base = scene.base;
   return spec;
 }
 

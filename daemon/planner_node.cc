@@ -806,9 +806,8 @@ void PlannerNode::publish_status() {
     msg.num_goals_superseded = counters_.goals_superseded;
     msg.num_goals_dropped = counters_.goals_dropped;
     msg.model_id = model_id_;
-    const Eigen::Isometry3d world_from_base = Eigen::Isometry3d::Identity();  // BASE-PENDING
-    const Eigen::Vector3d base = world_from_base.translation();
-    const Eigen::Quaterniond turn(world_from_base.linear());
+    const Eigen::Vector3d base = scene_.base.translation();
+    const Eigen::Quaterniond turn(scene_.base.linear());
     for (int i = 0; i < 3; ++i) msg.base_position[i] = base[i];
     msg.base_quaternion[0] = turn.w();
     msg.base_quaternion[1] = turn.x();
