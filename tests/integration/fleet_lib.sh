@@ -37,11 +37,13 @@ start_robot() {
   wait_for_line "$WORK/$name.log" "on channels ${prefix}_" || fail "$name did not start"
 }
 
-# send_goal NAME ID Q SCENE: a joint goal, awaited (its first answer must be a valid plan).
+# send_goal NAME ID Q SCENE [UTIME]: a joint goal, awaited (its first answer must be a valid
+# plan); UTIME stamps it (its priority, docs/multi_robot.md), default now.
 send_goal() {
-  local prefix
+  local prefix utime=${5:-$(date +%s%6N)}
   prefix=$(echo "$1" | tr '[:lower:]' '[:upper:]')
   "$KG" send-goal --prefix "$prefix" --lcm-url "$URL" --id "$2" --q "$3" --wait 120 \
+    --utime "$utime" \
     --scene "$4" --out "$WORK/$1_first.json" >"$WORK/$1_goal_$2.out" 2>&1 \
     || fail "goal $2 of $1 not answered with a valid plan: $(tail -3 "$WORK/$1_goal_$2.out")"
 }
@@ -62,6 +64,15 @@ await_settled() {
 
 # The current plan id of robot PREFIX in the last probe report.
 current_plan() { sed -n "s/^$1: plan \([0-9]*\).*/\1/p" "$WORK/probe.out"; }
+
+# with_goal SCENE Q NAME: a copy of the scene (paths made absolute) whose goal is Q, for
+# validating a plan of a goal sent over LCM; prints its path.
+with_goal() {
+  local out="$WORK/$3.yaml"
+  sed -e "s|: \.\./|: $(dirname "$1")/../|" \
+      -e "/^goal:/,/^[a-z]/ s|^  q: .*|  q: [$2]|" "$1" >"$out"
+  echo "$out"
+}
 
 # check_plans NAME=SCENE ...: each plan validates against its scene, and together they keep
 # clear at and between the knots.

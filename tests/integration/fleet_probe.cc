@@ -6,7 +6,10 @@
 //   plan that its heartbeat names as current, planned around the current plan of every
 //   higher-priority robot (its heartbeat says "name: plan N, followed", name = PREFIX
 //   lower-cased), and with --newer a current plan id above ID. Then writes each robot's current
-//   plan as DIR/<prefix>.json (with start_utime) and prints per robot its plans and replans.
+//   plan as DIR/<prefix>.json (with start_utime and plan_id; a file of an earlier run with the
+//   current plan's id is kept) and prints per robot its plans and replans.
+//   fleet_probe heartbeat --url URL --prefix PREFIX --contains TEXT [--timeout S]
+//   waits for a heartbeat of PREFIX whose neighbours field contains TEXT, and prints that field.
 // Prints "ready" once subscribed.
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -40,6 +43,7 @@ struct Robot {
   int received = 0;                            // plan_t messages, any status
   std::optional<kinograph::planner_status_t> heartbeat;
   int64_t newer_than = -1;
+  int64_t kept_plan_id = -1;  // plan_id of the plan file an earlier run left in the out dir
 };
 
 std::string lower(std::string s) {
@@ -59,12 +63,21 @@ std::tuple<int64_t, std::string> key(const Robot& r) {
 }
 
 // Why the fleet has not settled yet, or empty.
+// The "plan_id" of the plan file `path`, -1 when there is none.
+int64_t kept_plan_id(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return -1;
+  const nlohmann::json json = nlohmann::json::parse(in, nullptr, false);
+  return json.is_object() && json.contains("plan_id") ? json["plan_id"].get<int64_t>() : -1;
+}
+
 std::string unsettled(const std::vector<Robot>& robots) {
   for (const Robot& r : robots) {
     if (!r.heartbeat) return r.prefix + ": no heartbeat";
     const auto& hb = *r.heartbeat;
     if (hb.state != kinograph::planner_status_t::IDLE) return r.prefix + ": planning";
-    if (hb.valid_plan_id < 0 || r.plans.count(hb.valid_plan_id) == 0) {
+    if (hb.valid_plan_id < 0 ||
+        (r.plans.count(hb.valid_plan_id) == 0 && r.kept_plan_id != hb.valid_plan_id)) {
       return r.prefix + ": current plan " + std::to_string(hb.valid_plan_id) + " not received";
     }
     if (hb.valid_plan_id <= r.newer_than) return r.prefix + ": no plan newer than asked";
@@ -97,7 +110,16 @@ int main(int argc, char** argv) {
   settle->add_option("--newer", newer_args, "PREFIX=ID: its current plan must be above ID");
   settle->add_option("--out-dir", out_dir);
   settle->add_option("--timeout", timeout_s);
+  std::string prefix, contains;
+  CLI::App* beat = app.add_subcommand("heartbeat", "wait for a heartbeat saying TEXT");
+  beat->add_option("--url", url)->required();
+  beat->add_option("--prefix", prefix)->required();
+  beat->add_option("--contains", contains)->required();
+  beat->add_option("--timeout", timeout_s);
   CLI11_PARSE(app, argc, argv);
+  if (beat->parsed()) {
+    robot_args = {prefix + "=-"};
+  }
 
   std::vector<Robot> robots;
   for (const std::string& a : robot_args) {
@@ -110,6 +132,7 @@ int main(int argc, char** argv) {
       if (r.prefix == prefix) r.newer_than = std::stoll(id);
     }
   }
+  for (Robot& r : robots) r.kept_plan_id = kept_plan_id(out_dir + "/" + r.name + ".json");
   lcm::LCM lcm(url);
   if (!lcm.good()) {
     std::cerr << "fleet_probe: LCM did not start on " << url << "\n";
@@ -153,6 +176,19 @@ int main(int argc, char** argv) {
   }
   std::cout << "ready" << std::endl;
   const auto deadline = Clock::now() + std::chrono::duration<double>(timeout_s);
+  if (beat->parsed()) {
+    const Robot& r = robots.front();
+    while (!r.heartbeat || r.heartbeat->neighbours.find(contains) == std::string::npos) {
+      if (Clock::now() > deadline) {
+        std::cerr << "fleet_probe: no heartbeat of " << prefix << " says '" << contains
+                  << "' within " << timeout_s << " s\n";
+        return 1;
+      }
+      lcm.handleTimeout(50);
+    }
+    std::cout << r.heartbeat->neighbours << "\n";
+    return 0;
+  }
   std::string why = "nothing heard";
   while (!(why = unsettled(robots)).empty()) {
     if (Clock::now() > deadline) {
@@ -162,11 +198,18 @@ int main(int argc, char** argv) {
     lcm.handleTimeout(50);
   }
   for (const Robot& r : robots) {
+    if (r.plans.count(r.heartbeat->valid_plan_id) == 0) {  // unchanged since the earlier run
+      std::cout << r.prefix << ": plan " << r.kept_plan_id << " (kept), " << r.received
+                << " plans received, " << r.heartbeat->num_neighbour_replans
+                << " neighbour replans; neighbours: " << r.heartbeat->neighbours << "\n";
+      continue;
+    }
     const kinograph::plan_t& msg = r.plans.at(r.heartbeat->valid_plan_id);
     const kinograph::planning::Scene scene = kinograph::planning::load_scene(r.scene);
     nlohmann::json json =
         kinograph::planning::plan_to_json(kinograph::messages::plan_from_message(msg), scene);
     json["start_utime"] = msg.start_utime;
+    json["plan_id"] = msg.plan_id;
     const std::string path = out_dir + "/" + r.name + ".json";
     std::ofstream(path) << json.dump(1) << "\n";
     std::cout << r.prefix << ": plan " << msg.plan_id << " (" << msg.method << "), "
