@@ -93,6 +93,7 @@ void Neighbours::subscribe(lcm::LCM& lcm, std::function<void()> changed) {
     void (Neighbours::*handler)(std::size_t, const lcm::ReceiveBuffer*);
     int capacity;
   } kinds[] = {{"_PLAN", &Neighbours::on_plan, 20},
+               {"_PLAN_CURRENT", &Neighbours::on_plan, 20},
                {"_STATE", &Neighbours::on_state, 2000},
                {"_PLANNER_STATUS", &Neighbours::on_heartbeat, 100}};
   for (std::size_t i = 0; i < specs_.size(); ++i) {
@@ -141,6 +142,8 @@ void Neighbours::on_plan(std::size_t i, const lcm::ReceiveBuffer* rbuf) {
   {
     std::lock_guard lock(mutex_);
     Heard& h = heard_[i];
+    // The current plan sent again (for a robot that joined late) is no change.
+    if (h.plan && h.plan_id == msg.plan_id && h.plan_start_utime == msg.start_utime) return;
     h.plan = std::move(plan);
     h.plan_start_utime = msg.start_utime;
     h.plan_id = msg.plan_id;
@@ -205,6 +208,7 @@ void Neighbours::on_heartbeat(std::size_t i, const lcm::ReceiveBuffer* rbuf) {
       spdlog::warn("neighbour '{}': {}", specs_[i].name, mismatch);
     }
     h.mismatch = mismatch;
+    if (!h.last_heard || h.silent) joined_ = true;
     h.last_heard = std::chrono::steady_clock::now();
     changed = h.silent || h.goal_utime != goal_utime;
     h.silent = false;
@@ -234,6 +238,13 @@ bool Neighbours::take_changed() {
   const bool changed = changed_ || silence;
   changed_ = false;
   return changed;
+}
+
+bool Neighbours::take_joined() {
+  std::lock_guard lock(mutex_);
+  const bool joined = joined_;
+  joined_ = false;
+  return joined;
 }
 
 fleet::Decision Neighbours::decide(const fleet::PriorityKey& own, bool own_goal_changed) {

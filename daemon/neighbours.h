@@ -65,7 +65,8 @@ class Neighbours {
   /// std::invalid_argument for a neighbour without model, beyond the limits, or named twice.
   Neighbours(std::vector<NeighbourSpec> specs, std::string own_prefix, NeighboursOptions options);
 
-  /// Subscribes to every neighbour's PLAN, STATE and PLANNER_STATUS channels; `changed` is called
+  /// Subscribes to every neighbour's PLAN, PLAN_CURRENT (its current plan again, for a robot
+  /// that joined late), STATE and PLANNER_STATUS channels; `changed` is called
   /// (LCM thread) whenever what the rule sees may have changed. The LCM must outlive this.
   void subscribe(lcm::LCM& lcm, std::function<void()> changed);
   /// Unsubscribes (before the LCM goes).
@@ -80,6 +81,9 @@ class Neighbours {
   /// (the own plan's knot 0 on the common clock), to `obstacles`.
   void add_obstacles(const fleet::Decision& decision, std::int64_t origin_utime,
                      std::vector<collision::Obstacle>& obstacles);
+  /// True once when a neighbour was heard for the first time or after being silent (a started
+  /// or restarted daemon, which has missed this robot's current plan). Worker thread.
+  bool take_joined();
   /// Records that a valid plan was made as `decision` says (what later changes are judged by).
   void planned(const fleet::Decision& decision);
   /// `text` with "obstacle <id>" of a neighbour body replaced by its name ("neighbour 'right'
@@ -128,6 +132,7 @@ class Neighbours {
   mutable std::mutex mutex_;
   std::vector<Heard> heard_;
   bool changed_ = false;
+  bool joined_ = false;
   fleet::PlannedAround planned_;
   std::int64_t rebuilds_ = 0;               // obstacle sets made (moving bodies get new ids)
   std::map<int, std::string> body_names_;   // obstacle id -> name, of the last set made

@@ -714,6 +714,7 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t
         {plan_id, time.start_utime, time.takeover_utime, time.state_utime, plan});
   }
   publish(channel("PLAN"), msg);
+  if (msg.status == plan_t::SUCCESS) current_plan_msg_ = msg;
   if (!options_.drake_plan_channel.empty() && msg.status == plan_t::SUCCESS) {
     drake::lcmt_robot_plan drake_plan = messages::robot_plan_from_plan(msg);
     publish(options_.drake_plan_channel, drake_plan);
@@ -763,7 +764,12 @@ void PlannerNode::worker_loop(const std::atomic<bool>& stop) {
     } else if (neighbours_ && current_goal_ && neighbours_->take_changed()) {
       replan_for_neighbours();
     }
+    if (neighbours_ && neighbours_->take_joined()) republish_current_plan();
   }
+}
+
+void PlannerNode::republish_current_plan() {
+  if (current_plan_msg_) publish(channel("PLAN_CURRENT"), *current_plan_msg_);
 }
 
 void PlannerNode::replan_for_neighbours() {

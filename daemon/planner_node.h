@@ -208,6 +208,9 @@ class PlannerNode {
   /// Replans the current goal when the coordination rule says a neighbour's change calls for
   /// it (worker thread).
   void replan_for_neighbours();
+  /// Sends the current valid plan again on PREFIX_PLAN_CURRENT, for a neighbour that joined
+  /// after it was published (worker thread).
+  void republish_current_plan();
   /// Takes the next plan id; first writes a new reservation to the state file when the
   /// reserved ids run out. Caller holds mutex_.
   int64_t take_plan_id_locked();
@@ -265,6 +268,7 @@ class PlannerNode {
   int64_t valid_plan_id_ = -1;
   int64_t valid_goal_utime_ = -1;
   std::unique_ptr<Neighbours> neighbours_;  // null without neighbours
+  std::optional<plan_t> current_plan_msg_;  // the last SUCCESS plan_t sent (worker thread)
 
   // Owned by the worker thread.
   std::map<ObstacleKey, collision::Obstacle> live_obstacles_;  // by (source, id)

@@ -59,10 +59,12 @@ unset 'PID[right]'
 "$PROBE" heartbeat --url "$URL" --prefix LEFT --contains "right: silent" --timeout 60 \
   >"$WORK/silent.out" 2>&1 || fail "left does not report right silent: $(cat "$WORK/silent.out")"
 grep -q "held at its last state" "$WORK/silent.out" || fail "silent right is not held still"
-start_robot right "$RIGHT" --neighbour "left=$LEFT"
 watch --robot "LEFT=$LEFT" --robot "RIGHT=$RIGHT"
+start_robot right "$RIGHT" --neighbour "left=$LEFT"
 send_goal right 2 "0.6,0.7,0,-1.3,0,0.8,0" "$RIGHT"
 await_settled
 check_plans "left=$LEFT" "right=$(with_goal "$RIGHT" "0.6,0.7,0,-1.3,0,0.8,0" right2)"
+grep -q "^RIGHT: .*neighbours: left: plan [0-9]*, followed" "$WORK/probe.out" \
+  || fail "the restarted right does not follow left's current plan"
 echo "PASS: a neighbour restarted"
 echo "4 passed, 0 failed"

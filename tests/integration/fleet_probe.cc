@@ -141,15 +141,17 @@ int main(int argc, char** argv) {
   struct Route {
     Robot* robot;
     bool plan;
+    std::string suffix;
   };
   std::vector<Route> routes;
-  routes.reserve(2 * robots.size());
+  routes.reserve(3 * robots.size());
   for (Robot& r : robots) {
-    routes.push_back({&r, true});
-    routes.push_back({&r, false});
+    routes.push_back({&r, true, "_PLAN"});
+    routes.push_back({&r, true, "_PLAN_CURRENT"});  // sent again for daemons that join late
+    routes.push_back({&r, false, "_PLANNER_STATUS"});
   }
   for (Route& route : routes) {
-    const std::string channel = route.robot->prefix + (route.plan ? "_PLAN" : "_PLANNER_STATUS");
+    const std::string channel = route.robot->prefix + route.suffix;
     lcm.subscribeFunction(
            channel,
            +[](const lcm::ReceiveBuffer* rbuf, const std::string&, Route* r) {
