@@ -120,7 +120,8 @@ const bool kRegistered = register_command([](CLI::App& root) {
   cmd->add_option("--start", args->start,
                   "Common-clock time (s) of each plan's t = 0, one per robot; default: the plan "
                   "files' start_utime relative to the earliest, else 0")
-      ->delimiter(',');
+      ->delimiter(',')
+      ->expected(1);
   cmd->add_option("--clearance", args->clearance,
                   "Required distance (m) between robots (default 0: no contact)");
   cmd->add_option("--samples", args->samples,
