@@ -29,17 +29,6 @@ std::vector<double> common_times(const std::vector<RobotPlan>& robots, int per_i
   return unique;
 }
 
-// Robot `robot`'s configuration at common time t: on its interpolant, held at its first and
-// last knots outside its plan.
-Eigen::VectorXd configuration_at(const RobotPlan& robot, planning::TrajectorySampler& sampler,
-                                 double t) {
-  const double tau = t - robot.offset;
-  const planning::Plan& p = robot.plan;
-  if (tau <= p.t.front()) return p.q.row(0).transpose();
-  if (tau >= p.t.back()) return p.q.row(p.q.rows() - 1).transpose();
-  return sampler.at(tau).q;
-}
-
 }  // namespace
 
 std::string describe(const JointClearance& c) {
@@ -93,7 +82,8 @@ JointClearance joint_clearance(const std::vector<RobotPlan>& robots,
         world.add_obstacle(b.obstacle);
       }
       for (const double t : times) {
-        dynamics::forward_kinematics(model, data, configuration_at(robots[i], *samplers[i], t));
+        dynamics::forward_kinematics(
+            model, data, held_configuration(robots[i].plan, *samplers[i], t - robots[i].offset));
         const collision::Proximity p = world.closest(data, t);
         if (p.robot_geom >= 0 && p.distance < result.min_distance) {
           result.min_distance = p.distance;

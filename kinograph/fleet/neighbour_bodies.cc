@@ -6,7 +6,6 @@
 #include "kinograph/collision/shape.h"
 #include "kinograph/dynamics/data.h"
 #include "kinograph/dynamics/kinematics.h"
-#include "kinograph/planning/trajectory_sampler.h"
 
 namespace kinograph::fleet {
 namespace {
@@ -45,6 +44,13 @@ std::string body_name(const std::string& neighbour, const dynamics::Geometry& ge
 
 double clock_offset(std::int64_t utime, std::int64_t origin_utime) {
   return static_cast<double>(utime - origin_utime) * 1e-6;
+}
+
+Eigen::VectorXd held_configuration(const planning::Plan& plan,
+                                   planning::TrajectorySampler& sampler, double tau) {
+  if (tau <= plan.t.front()) return plan.q.row(0).transpose();
+  if (tau >= plan.t.back()) return plan.q.row(plan.q.rows() - 1).transpose();
+  return sampler.at(tau).q;
 }
 
 std::vector<NeighbourBody> bodies_at(const Neighbour& neighbour, const Eigen::VectorXd& q,
@@ -105,18 +111,8 @@ std::vector<NeighbourBody> bodies_along(const Neighbour& neighbour, const planni
   std::vector<std::vector<Eigen::Isometry3d>> poses(bodies.size());
   for (auto& p : poses) p.reserve(times.size());
   dynamics::Data data(model);
-  const double t0 = plan.t.front(), tN = plan.t.back();
-  const Eigen::Index last = static_cast<Eigen::Index>(plan.t.size()) - 1;
   for (const double t : times) {
-    // The bodies stand at the first knot before the plan and at the last knot after it.
-    const double tau = t - offset;
-    if (tau <= t0) {
-      dynamics::forward_kinematics(model, data, plan.q.row(0).transpose());
-    } else if (tau >= tN) {
-      dynamics::forward_kinematics(model, data, plan.q.row(last).transpose());
-    } else {
-      dynamics::forward_kinematics(model, data, sampler->at(tau).q);
-    }
+    dynamics::forward_kinematics(model, data, held_configuration(plan, *sampler, t - offset));
     for (size_t g = 0; g < bodies.size(); ++g) {
       poses[g].push_back(geometry_pose(model.collision[g], data));
     }

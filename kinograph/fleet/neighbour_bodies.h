@@ -10,6 +10,7 @@
 #include "kinograph/collision/obstacle.h"
 #include "kinograph/dynamics/model.h"
 #include "kinograph/planning/plan.h"
+#include "kinograph/planning/trajectory_sampler.h"
 
 namespace kinograph::fleet {
 
@@ -44,6 +45,11 @@ std::string body_name(const std::string& neighbour, const dynamics::Geometry& ge
 /// Seconds from the clock origin `origin_utime` to `utime` (both µs on the robots' common clock):
 /// the offset that puts a neighbour's plan time (plan_t start_utime + t) on one's own plan clock.
 double clock_offset(std::int64_t utime, std::int64_t origin_utime);
+
+/// A plan's configuration at plan time `tau` on its interpolant (`sampler` reads `plan`), at its
+/// first knot before it starts and at its last knot after it ends.
+Eigen::VectorXd held_configuration(const planning::Plan& plan,
+                                   planning::TrajectorySampler& sampler, double tau);
 
 /// The neighbour's bodies standing still at configuration q (one per collision geometry, ids
 /// from first_id). Throws std::invalid_argument when q is not one finite value per joint.
