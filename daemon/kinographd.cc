@@ -79,6 +79,15 @@ int main(int argc, char** argv) {
   app.add_option("--state-file", options.state_file,
                  "remember plan ids and the obstacles received over LCM in this file across "
                  "restarts (written atomically); default: none, plan ids start at 1");
+  std::vector<std::string> neighbour_options;
+  app.add_option("--neighbour", neighbour_options,
+                 "a robot sharing the workspace, NAME=SCENE[@PREFIX] (repeatable): its scene "
+                 "file gives its robot, payload and base, PREFIX its channels (default NAME "
+                 "upper-cased); planned around as docs/multi_robot.md says");
+  app.add_option("--neighbour-timeout", options.neighbour_watch.timeout_s,
+                 "a neighbour heard from neither in heartbeats nor in states for this long (s) is "
+                 "held still at its last known state and reported (default 3)")
+      ->check(CLI::PositiveNumber);
   CLI11_PARSE(app, argc, argv);
   options.answer_goal_id_gaps = !ignore_gaps;
   options.replanning.use_incremental = !batch_only;
@@ -88,6 +97,9 @@ int main(int argc, char** argv) {
   std::signal(SIGTERM, on_signal);
   try {
     kinograph::planning::Scene scene = kinograph::planning::load_scene(scene_path);
+    for (const std::string& text : neighbour_options) {
+      options.neighbours.push_back(kinograph::daemon::neighbour_from_option(text));
+    }
     // Every batch solve of the node (first plans, fallbacks) is in this formulation.
     const std::string name = formulation.empty() ? scene.planner.formulation : formulation;
     options.replanning.incremental.batch.formulation =
@@ -103,10 +115,11 @@ int main(int argc, char** argv) {
     }
     spdlog::info(
         "kinographd: stopped after {} goals ({} answered, {} superseded, {} cancelled, {} "
-        "dropped in transport), {} plans ({} failed, {} incremental replans, {} fallbacks), {} "
-        "rejected messages",
+        "dropped in transport), {} plans ({} failed, {} incremental replans, {} fallbacks, {} for "
+        "neighbours), {} rejected messages",
         c.goals_received, c.goals_answered, c.goals_superseded, c.goals_cancelled, c.goals_dropped,
-        c.plans_published, c.failures, c.incremental, c.fallbacks, c.messages_rejected);
+        c.plans_published, c.failures, c.incremental, c.fallbacks, c.neighbour_replans,
+        c.messages_rejected);
   } catch (const std::exception& e) {
     std::cerr << "kinographd: error: " << e.what() << "\n";
     return 1;

@@ -20,6 +20,7 @@
 #include "daemon/state_file.h"
 #include "daemon/state_limits.h"
 #include "daemon/wire_strings.h"
+#include "kinograph/fleet/model_id.h"
 #include "kinograph/graph/cancellation.h"
 #include "kinograph/lcm/drake_convert.h"
 #include "kinograph/lcm/lcm_connection.h"
@@ -81,6 +82,12 @@ PlannerNode::PlannerNode(planning::Scene scene, PlannerNodeOptions options, lcm:
   }
   for (std::size_t i = 0; i < subscriptions_.size(); ++i) {
     subscriptions_[i]->setQueueCapacity(capacities[i]);
+  }
+  model_id_ = fleet::model_id(*scene_.problem.model);
+  if (!options_.neighbours.empty()) {
+    neighbours_ = std::make_unique<Neighbours>(options_.neighbours, identity_.channel_prefix,
+                                               options_.neighbour_watch);
+    neighbours_->subscribe(*lcm_, [this] { wake_.notify_one(); });
   }
 }
 
@@ -150,6 +157,7 @@ void PlannerNode::save_state_locked() {
 
 // A shared LCM instance outlives the node: its handlers must not call into a destroyed node.
 PlannerNode::~PlannerNode() {
+  if (neighbours_) neighbours_->unsubscribe(*lcm_);
   for (lcm::Subscription* s : subscriptions_) {
     if (s != nullptr) lcm_->unsubscribe(s);
   }
@@ -699,6 +707,14 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t
   }
   spdlog::debug("goal {}: planning{}", goal.goal_id, replan ? " (replan)" : "");
   for (const auto& [name, obstacle] : live_obstacles_) problem.obstacles.push_back(obstacle);
+  // Neighbours' bodies on this plan's clock: knot 0 is the state, the take-over, or now.
+  std::optional<fleet::Decision> around;
+  std::optional<int64_t> origin;  // without a state, the plan then starts when planning began
+  if (neighbours_) {
+    around = neighbours_->decide({goal.utime, ""}, !replan);
+    origin = join ? join->takeover_utime : state_utime.value_or(wall_utime());
+    neighbours_->add_obstacles(*around, *origin, problem.obstacles);
+  }
   // Joints a goal does not name stay where this plan starts.
   problem.goal = messages::goal_for_start(goal, problem.start_q);
   problem.task_constraints.insert(problem.task_constraints.end(), goal.task_constraints.begin(),
@@ -746,11 +762,19 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t
     if (threw || !plan.success()) ++counters_.failures;
     state_ = threw ? planner_status_t::ERROR : planner_status_t::IDLE;
     last_message_ = threw ? error : (plan.success() ? "" : plan.stats.reason);
+    if (neighbours_) last_message_ = neighbours_->name_bodies(last_message_);
+    if (!threw && plan.success()) {
+      valid_plan_id_ = plan_id;
+      valid_goal_utime_ = goal.utime;
+    }
   }
+  if (around && !threw && plan.success()) neighbours_->planned(*around);
   // Knot 0 is the measured state, at its own time, or where the motion under way will be at
-  // the take-over; without a state the plan starts when it is published.
+  // the take-over; without a state the plan starts when it is published (with neighbours, when
+  // planning began: the time their bodies were placed on).
   time.state_utime = state_utime.value_or(-1);
-  time.start_utime = join ? join->takeover_utime : state_utime.value_or(time.utime);
+  time.start_utime =
+      join ? join->takeover_utime : state_utime.value_or(origin.value_or(time.utime));
   time.takeover_utime = time.start_utime;
   plan_t msg;
   if (threw) {
@@ -761,6 +785,7 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t
     msg = messages::plan_to_message(plan, *problem.model, identity_.model_name, plan_id,
                                     goal.goal_id, time);
     msg.method = report.method;
+    if (neighbours_) msg.status_message = neighbours_->name_bodies(msg.status_message);
     spdlog::info("goal {}: plan {} {} ({}, {} iterations, {:.1f} ms)", goal.goal_id, plan_id,
                  plan.success() ? "valid" : "INVALID", msg.method, plan.stats.iterations,
                  plan.stats.solve_time_s * 1e3);
@@ -785,6 +810,7 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t
         {plan_id, time.start_utime, time.takeover_utime, time.state_utime, plan});
   }
   publish(channel("PLAN"), msg);
+  if (msg.status == plan_t::SUCCESS) current_plan_msg_ = msg;
   if (!options_.drake_plan_channel.empty() && msg.status == plan_t::SUCCESS) {
     drake::lcmt_robot_plan drake_plan = messages::robot_plan_from_plan(msg);
     publish(options_.drake_plan_channel, drake_plan);
@@ -834,8 +860,28 @@ void PlannerNode::worker_loop(const std::atomic<bool>& stop) {
       plan_and_publish(*taken.goal, /*replan=*/false, taken.goal->utime);
     } else if (obstacles_changed && current_goal_) {
       plan_and_publish(*current_goal_, /*replan=*/true, taken.obstacles_utime);
+    } else if (neighbours_ && current_goal_ && neighbours_->take_changed()) {
+      replan_for_neighbours();
     }
+    if (neighbours_ && neighbours_->take_joined()) republish_current_plan();
   }
+}
+
+void PlannerNode::republish_current_plan() {
+  if (current_plan_msg_) publish(channel("PLAN_CURRENT"), *current_plan_msg_);
+}
+
+void PlannerNode::replan_for_neighbours() {
+  const fleet::Decision d = neighbours_->decide({current_goal_->utime, ""}, false);
+  if (!d.replan) return;
+  int64_t trigger_utime = current_goal_->utime;
+  {
+    std::lock_guard lock(mutex_);
+    ++counters_.neighbour_replans;
+    if (latest_state_) trigger_utime = latest_state_->utime;  // a neighbour's change is now
+  }
+  spdlog::info("goal {}: replanning: {}", current_goal_->goal_id, d.reason);
+  plan_and_publish(*current_goal_, /*replan=*/true, trigger_utime);
 }
 
 void PlannerNode::publish_status() {
@@ -864,6 +910,18 @@ void PlannerNode::publish_status() {
     msg.num_goals_answered = counters_.goals_answered;
     msg.num_goals_superseded = counters_.goals_superseded;
     msg.num_goals_dropped = counters_.goals_dropped;
+    msg.model_id = model_id_;
+    const Eigen::Vector3d base = scene_.base.translation();
+    const Eigen::Quaterniond turn(scene_.base.linear());
+    for (int i = 0; i < 3; ++i) msg.base_position[i] = base[i];
+    msg.base_quaternion[0] = turn.w();
+    msg.base_quaternion[1] = turn.x();
+    msg.base_quaternion[2] = turn.y();
+    msg.base_quaternion[3] = turn.z();
+    msg.goal_utime = valid_goal_utime_;
+    msg.valid_plan_id = valid_plan_id_;
+    msg.num_neighbour_replans = static_cast<int32_t>(counters_.neighbour_replans);
+    if (neighbours_) msg.neighbours = neighbours_->summary();
     // Recorded before it is sent, under the lock that gave it its utime, so that its
     // loop-back is always recognised as ours.
     bytes.resize(static_cast<std::size_t>(msg.getEncodedSize()));

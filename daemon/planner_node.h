@@ -23,6 +23,7 @@
 #include "daemon/intake.h"
 #include "daemon/log_limiter.h"
 #include "daemon/motion_join.h"
+#include "daemon/neighbours.h"
 #include "daemon/own_heartbeats.h"
 #include "daemon/robot_payload.h"
 #include "kinograph/lcm/message_convert.h"
@@ -79,6 +80,11 @@ struct PlannerNodeOptions {
   /// while an executor follows this daemon's plans, a replan starts where the plan in force is
   /// this long after the latest state, and takes over there (daemon/motion_join.h).
   double takeover_latency_s = 0.3;
+  /// Robots sharing the workspace (kinographd --neighbour): planned around under the
+  /// coordination rule (docs/multi_robot.md); none by default.
+  std::vector<NeighbourSpec> neighbours;
+  /// How neighbours are watched (their timeout).
+  NeighboursOptions neighbour_watch;
 };
 
 /// What a node has done since it started (for its status and for tests).
@@ -100,6 +106,7 @@ struct NodeCounters {
   int64_t joined = 0;              ///< plans that join the motion under way (take over later)
   int64_t late_takeovers = 0;      ///< of which published after their take-over time had passed
   int64_t payload_changes = 0;     ///< payload_t attaches and detaches taken
+  int64_t neighbour_replans = 0;   ///< replans because a higher-priority neighbour changed
 };
 
 /// The planner daemon's node: scene (robot, defaults, fixed obstacles) + LCM + worker thread.
@@ -209,6 +216,12 @@ class PlannerNode {
   /// made it plan (the goal, or for a replan the obstacle update), for the state's age.
   void plan_and_publish(const GoalRequest& goal, bool replan, int64_t trigger_utime);
   void publish_status();
+  /// Replans the current goal when the coordination rule says a neighbour's change calls for
+  /// it (worker thread).
+  void replan_for_neighbours();
+  /// Sends the current valid plan again on PREFIX_PLAN_CURRENT, for a neighbour that joined
+  /// after it was published (worker thread).
+  void republish_current_plan();
   /// Takes the next plan id; first writes a new reservation to the state file when the
   /// reserved ids run out. Caller holds mutex_.
   int64_t take_plan_id_locked();
@@ -262,6 +275,12 @@ class PlannerNode {
   std::atomic<bool> cancel_{false};
   MotionJoin motion_join_;  // the newest valid plan and the executor following it
   std::optional<RobotWithPayload> pending_robot_;  // after a payload_t, not yet taken
+  // What the heartbeat tells neighbours: the model's id, the current valid plan and its goal.
+  std::string model_id_;
+  int64_t valid_plan_id_ = -1;
+  int64_t valid_goal_utime_ = -1;
+  std::unique_ptr<Neighbours> neighbours_;  // null without neighbours
+  std::optional<plan_t> current_plan_msg_;  // the last SUCCESS plan_t sent (worker thread)
 
   // Owned by the worker thread.
   std::map<ObstacleKey, collision::Obstacle> live_obstacles_;  // by (source, id)

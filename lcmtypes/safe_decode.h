@@ -30,6 +30,7 @@
 #include "kinograph/plan_t.hpp"
 #include "kinograph/plan_v1_t.hpp"
 #include "kinograph/planner_status_t.hpp"
+#include "kinograph/planner_status_v2_t.hpp"
 #include "kinograph/robot_state_t.hpp"
 #include "kinograph/stop_request_t.hpp"
 #include "kinograph/task_constraint_t.hpp"
@@ -337,14 +338,29 @@ inline bool check_fields(WireReader& r, const ::drake::lcmt_robot_plan*) {
   return true;
 }
 
-inline bool check_fields(WireReader& r, const planner_status_t*) {
+// Version 2's members, which version 3 begins with (type names the fields).
+inline bool check_status_v2_fields(WireReader& r, const char* type) {
+  const std::string t(type);
   int64_t i64 = 0;
-  return r.read_i64(i64, "planner_status_t.utime") && r.string("planner_status_t.robot") &&
-         r.skip(1, 1, "planner_status_t.state") &&
-         r.skip(2, 8, "planner_status_t.last_goal_id/last_plan_id") &&
-         r.string("planner_status_t.message") &&
-         r.skip(2, 4, "planner_status_t.num_plans/num_failures") &&
-         r.skip(4, 8, "planner_status_t.num_goals_*");
+  return r.read_i64(i64, (t + ".utime").c_str()) && r.string((t + ".robot").c_str()) &&
+         r.skip(1, 1, (t + ".state").c_str()) &&
+         r.skip(2, 8, (t + ".last_goal_id/last_plan_id").c_str()) &&
+         r.string((t + ".message").c_str()) &&
+         r.skip(2, 4, (t + ".num_plans/num_failures").c_str()) &&
+         r.skip(4, 8, (t + ".num_goals_*").c_str());
+}
+
+inline bool check_fields(WireReader& r, const planner_status_v2_t*) {
+  return check_status_v2_fields(r, "planner_status_v2_t");
+}
+
+inline bool check_fields(WireReader& r, const planner_status_t*) {
+  return check_status_v2_fields(r, "planner_status_t") &&
+         r.string("planner_status_t.model_id") &&
+         r.skip(7, 8, "planner_status_t.base_position/base_quaternion") &&
+         r.skip(2, 8, "planner_status_t.goal_utime/valid_plan_id") &&
+         r.skip(1, 4, "planner_status_t.num_neighbour_replans") &&
+         r.string("planner_status_t.neighbours");
 }
 
 }  // namespace detail

@@ -173,7 +173,9 @@ int finish(PlanWaiter& waiter, const Common& c, int64_t goal_id,
     if (extra) add_obstacle(*scene, extra->first, extra->second);
     if (plan->num_steps == 0)
       throw CommandFailure("plan has no trajectory to write", kExitInvalidPlan);
-    write_plan_json(messages::plan_from_message(*plan), *scene, c.out);
+    nlohmann::json json = planning::plan_to_json(messages::plan_from_message(*plan), *scene);
+    json["start_utime"] = plan->start_utime;  // knot 0 on the robot's clock (check-together)
+    write_plan_json(std::move(json), *scene, c.out);
     std::cout << "wrote " << c.out << "\n";
   }
   return plan->status == plan_t::SUCCESS ? kExitOk : kExitInvalidPlan;

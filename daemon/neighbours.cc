@@ -1,0 +1,348 @@
+#include "daemon/neighbours.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cctype>
+#include <lcm/lcm-cpp.hpp>
+#include <regex>
+#include <sstream>
+#include <stdexcept>
+
+#include "kinograph/fleet/model_id.h"
+#include "kinograph/fleet/neighbour_bodies.h"
+#include "kinograph/lcm/message_convert.h"
+#include "kinograph/plan_t.hpp"
+#include "kinograph/planner_status_t.hpp"
+#include "kinograph/planning/io/scene.h"
+#include "kinograph/robot_state_t.hpp"
+#include "lcmtypes/safe_decode.h"
+
+namespace kinograph::daemon {
+namespace {
+
+std::string upper(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return s;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+}  // namespace
+
+NeighbourSpec neighbour_from_option(const std::string& text) {
+  const std::size_t eq = text.find('=');
+  if (eq == std::string::npos || eq == 0 || eq + 1 == text.size()) {
+    throw std::invalid_argument("--neighbour '" + text + "': expected NAME=SCENE[@PREFIX]");
+  }
+  NeighbourSpec spec;
+  spec.name = text.substr(0, eq);
+  std::string scene_path = text.substr(eq + 1);
+  const std::size_t at = scene_path.rfind('@');
+  if (at != std::string::npos) {
+    spec.channel_prefix = scene_path.substr(at + 1);
+    scene_path = scene_path.substr(0, at);
+    if (spec.channel_prefix.empty() || scene_path.empty()) {
+      throw std::invalid_argument("--neighbour '" + text + "': expected NAME=SCENE[@PREFIX]");
+    }
+  } else {
+    spec.channel_prefix = upper(spec.name);
+  }
+  const planning::Scene scene = planning::load_scene(scene_path);
+  spec.model = scene.problem.model;
+  spec.start_q = scene.problem.start_q;
+  spec.base = scene.base;
+  return spec;
+}
+
+Neighbours::Neighbours(std::vector<NeighbourSpec> specs, std::string own_prefix,
+                       NeighboursOptions options)
+    : specs_(std::move(specs)), own_prefix_(std::move(own_prefix)), options_(options) {
+  if (specs_.size() > static_cast<std::size_t>(kMaxNeighbours)) {
+    throw std::invalid_argument("at most " + std::to_string(kMaxNeighbours) +
+                                " neighbours, got " + std::to_string(specs_.size()));
+  }
+  for (std::size_t i = 0; i < specs_.size(); ++i) {
+    const NeighbourSpec& s = specs_[i];
+    if (!s.model) throw std::invalid_argument("neighbour '" + s.name + "' has no robot model");
+    if (s.model->collision.size() > static_cast<std::size_t>(kMaxBodies)) {
+      throw std::invalid_argument("neighbour '" + s.name + "' has more than " +
+                                  std::to_string(kMaxBodies) + " collision geometries");
+    }
+    if (s.channel_prefix == own_prefix_) {
+      throw std::invalid_argument("neighbour '" + s.name + "' uses this robot's own channels " +
+                                  own_prefix_ + "_*");
+    }
+    for (std::size_t j = 0; j < i; ++j) {
+      if (specs_[j].name == s.name || specs_[j].channel_prefix == s.channel_prefix) {
+        throw std::invalid_argument("neighbour '" + s.name + "' is named twice (name or prefix)");
+      }
+    }
+    model_ids_.push_back(fleet::model_id(*s.model));
+  }
+  heard_.resize(specs_.size());
+}
+
+void Neighbours::subscribe(lcm::LCM& lcm, std::function<void()> changed) {
+  changed_callback_ = std::move(changed);
+  // Queue sizes: one plan is ~25 kB and only the newest counts; states come at up to 1 kHz.
+  const struct {
+    const char* suffix;
+    void (Neighbours::*handler)(std::size_t, const lcm::ReceiveBuffer*);
+    int capacity;
+  } kinds[] = {{"_PLAN", &Neighbours::on_plan, 20},
+               {"_PLAN_CURRENT", &Neighbours::on_plan, 20},
+               {"_STATE", &Neighbours::on_state, 2000},
+               {"_PLANNER_STATUS", &Neighbours::on_heartbeat, 100}};
+  for (std::size_t i = 0; i < specs_.size(); ++i) {
+    for (const auto& kind : kinds) {
+      routes_.push_back(std::make_unique<Route>(Route{this, i, kind.handler}));
+      lcm::Subscription* s = lcm.subscribeFunction(
+          specs_[i].channel_prefix + kind.suffix,
+          +[](const lcm::ReceiveBuffer* rbuf, const std::string&, Route* r) {
+            (r->self->*(r->handler))(r->index, rbuf);
+          },
+          routes_.back().get());
+      s->setQueueCapacity(kind.capacity);
+      subscriptions_.push_back(s);
+    }
+  }
+}
+
+void Neighbours::unsubscribe(lcm::LCM& lcm) {
+  for (lcm::Subscription* s : subscriptions_) lcm.unsubscribe(s);
+  subscriptions_.clear();
+}
+
+void Neighbours::notify() {
+  if (changed_callback_) changed_callback_();
+}
+
+void Neighbours::on_plan(std::size_t i, const lcm::ReceiveBuffer* rbuf) {
+  plan_t msg;
+  if (auto s = lcmtypes::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), msg); !s.ok) {
+    spdlog::warn("neighbour '{}': malformed plan_t: {}", specs_[i].name, s.reason);
+    return;
+  }
+  // A failure answer leaves the neighbour on the plan it had.
+  if (msg.status != plan_t::SUCCESS || msg.num_steps < 2) return;
+  const dynamics::Model& model = *specs_[i].model;
+  bool order_ok = msg.num_joints == model.nq();
+  for (int j = 0; order_ok && j < model.nq(); ++j) {
+    order_ok = msg.joint_name[j] == model.bodies[j].joint_name;
+  }
+  if (!order_ok) {
+    std::lock_guard lock(mutex_);
+    heard_[i].mismatch = "its plans' joints are not those of its scene's robot '" + model.name + "'";
+    return;
+  }
+  planning::Plan plan = messages::plan_from_message(msg);
+  {
+    std::lock_guard lock(mutex_);
+    Heard& h = heard_[i];
+    // The current plan sent again (for a robot that joined late) is no change.
+    if (h.plan && h.plan_id == msg.plan_id && h.plan_start_utime == msg.start_utime) return;
+    h.plan = std::move(plan);
+    h.plan_start_utime = msg.start_utime;
+    h.plan_id = msg.plan_id;
+    ++h.generation;
+    changed_ = true;
+  }
+  notify();
+}
+
+void Neighbours::on_state(std::size_t i, const lcm::ReceiveBuffer* rbuf) {
+  robot_state_t msg;
+  if (auto s = lcmtypes::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), msg); !s.ok) {
+    return;
+  }
+  messages::RobotIdentity identity{specs_[i].model->name, specs_[i].channel_prefix};
+  messages::MeasuredState state;
+  if (!messages::state_from_message(msg, *specs_[i].model, identity, state).ok ||
+      !state.q.allFinite()) {
+    return;
+  }
+  bool woke = false;
+  {
+    std::lock_guard lock(mutex_);
+    Heard& h = heard_[i];
+    h.state = state.q;
+    h.last_heard = std::chrono::steady_clock::now();
+    if (h.silent) {
+      h.silent = false;
+      changed_ = woke = true;
+    }
+  }
+  if (woke) notify();
+}
+
+void Neighbours::on_heartbeat(std::size_t i, const lcm::ReceiveBuffer* rbuf) {
+  planner_status_t msg;
+  if (auto s = lcmtypes::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), msg); !s.ok) {
+    std::lock_guard lock(mutex_);
+    heard_[i].mismatch = "its heartbeat is not a planner_status_t of version 3: " + s.reason;
+    return;
+  }
+  std::string mismatch;
+  if (msg.model_id != model_ids_[i]) {
+    mismatch = "its model is " + msg.model_id + ", its scene's is " + model_ids_[i];
+  } else {
+    Eigen::Isometry3d base = Eigen::Isometry3d::Identity();
+    base.translation() = Eigen::Vector3d(msg.base_position[0], msg.base_position[1],
+                                         msg.base_position[2]);
+    base.linear() = Eigen::Quaterniond(msg.base_quaternion[0], msg.base_quaternion[1],
+                                       msg.base_quaternion[2], msg.base_quaternion[3])
+                        .normalized()
+                        .toRotationMatrix();
+    mismatch = fleet::base_mismatch(specs_[i].base, base);
+  }
+  const std::int64_t goal_utime =
+      msg.goal_utime < 0 ? std::numeric_limits<std::int64_t>::max() : msg.goal_utime;
+  bool changed = false;
+  {
+    std::lock_guard lock(mutex_);
+    Heard& h = heard_[i];
+    if (mismatch != h.mismatch && !mismatch.empty()) {
+      spdlog::warn("neighbour '{}': {}", specs_[i].name, mismatch);
+    }
+    h.mismatch = mismatch;
+    if (!h.last_heard || h.silent) joined_ = true;
+    h.last_heard = std::chrono::steady_clock::now();
+    changed = h.silent || h.goal_utime != goal_utime;
+    h.silent = false;
+    h.goal_utime = goal_utime;
+    changed_ = changed_ || changed;
+  }
+  if (changed) notify();
+}
+
+bool Neighbours::update_silence_locked() {
+  bool any = false;
+  for (std::size_t i = 0; i < heard_.size(); ++i) {
+    Heard& h = heard_[i];
+    if (!h.silent && h.last_heard && seconds_since(*h.last_heard) > options_.timeout_s) {
+      h.silent = true;
+      any = true;
+      spdlog::warn("neighbour '{}': silent for {} s, held at its last known state",
+                   specs_[i].name, options_.timeout_s);
+    }
+  }
+  return any;
+}
+
+bool Neighbours::take_changed() {
+  std::lock_guard lock(mutex_);
+  const bool silence = update_silence_locked();
+  const bool changed = changed_ || silence;
+  changed_ = false;
+  return changed;
+}
+
+bool Neighbours::take_joined() {
+  std::lock_guard lock(mutex_);
+  const bool joined = joined_;
+  joined_ = false;
+  return joined;
+}
+
+fleet::Decision Neighbours::decide(const fleet::PriorityKey& own, bool own_goal_changed) {
+  std::vector<fleet::NeighbourView> views;
+  {
+    std::lock_guard lock(mutex_);
+    update_silence_locked();
+    for (std::size_t i = 0; i < specs_.size(); ++i) {
+      const Heard& h = heard_[i];
+      fleet::NeighbourView v;
+      v.name = specs_[i].name;
+      v.key = {h.goal_utime, specs_[i].channel_prefix};
+      if (h.plan) v.plan_id = h.generation;
+      v.silent = h.silent;
+      views.push_back(std::move(v));
+    }
+  }
+  fleet::PriorityKey key = own;
+  key.robot = own_prefix_;
+  return fleet::coordinate(key, views, planned_, own_goal_changed);
+}
+
+void Neighbours::add_obstacles(const fleet::Decision& decision, std::int64_t origin_utime,
+                               std::vector<collision::Obstacle>& obstacles) {
+  std::lock_guard lock(mutex_);
+  ++rebuilds_;
+  body_names_.clear();
+  for (std::size_t i = 0; i < specs_.size(); ++i) {
+    const Heard& h = heard_[i];
+    const fleet::Neighbour n{specs_[i].name, specs_[i].model};
+    const int slot = static_cast<int>(i) * kMaxBodies;
+    std::vector<fleet::NeighbourBody> bodies;
+    if (decision.treatment[i] == fleet::Treatment::kAlongPlan && h.plan) {
+      // Moving bodies get new ids every time: the planner keeps a moving obstacle whose id it
+      // knows, so a new plan of the neighbour must come as new obstacles.
+      const int first = kFirstObstacleId + (1 << 20) +
+                        static_cast<int>(rebuilds_ % 1000) * kMaxNeighbours * kMaxBodies + slot;
+      bodies = fleet::bodies_along(n, *h.plan, fleet::clock_offset(h.plan_start_utime, origin_utime),
+                                   fleet::SweepOptions{.first_id = first});
+    } else if (h.state) {
+      bodies = fleet::bodies_at(n, *h.state, kFirstObstacleId + slot);
+    } else if (h.plan) {
+      // Heard a plan but no state: it comes to rest where the plan ends.
+      bodies = fleet::bodies_at(n, h.plan->q.row(h.plan->q.rows() - 1).transpose(),
+                                kFirstObstacleId + slot);
+    } else if (specs_[i].start_q.size() == specs_[i].model->nq()) {
+      // Nothing heard yet: it stands at its scene's start.
+      bodies = fleet::bodies_at(n, specs_[i].start_q, kFirstObstacleId + slot);
+    }
+    for (fleet::NeighbourBody& b : bodies) {
+      body_names_[b.obstacle.id] = b.name;
+      obstacles.push_back(std::move(b.obstacle));
+    }
+  }
+}
+
+void Neighbours::planned(const fleet::Decision& decision) {
+  std::lock_guard lock(mutex_);
+  planned_ = decision.around;
+}
+
+std::string Neighbours::name_bodies(std::string text) const {
+  static const std::regex kObstacleId("obstacle (\\d+)");
+  std::lock_guard lock(mutex_);
+  std::string out;
+  auto begin = std::sregex_iterator(text.begin(), text.end(), kObstacleId);
+  std::size_t last = 0;
+  for (auto it = begin; it != std::sregex_iterator(); ++it) {
+    const auto found = body_names_.find(std::stoi((*it)[1].str()));
+    if (found == body_names_.end()) continue;
+    out += text.substr(last, it->position() - last) + found->second;
+    last = it->position() + it->length();
+  }
+  return out + text.substr(last);
+}
+
+std::string Neighbours::summary() const {
+  std::lock_guard lock(mutex_);
+  std::ostringstream os;
+  for (std::size_t i = 0; i < specs_.size(); ++i) {
+    const Heard& h = heard_[i];
+    if (i > 0) os << "; ";
+    os << specs_[i].name << ": ";
+    if (!h.last_heard && !h.plan) {
+      os << "not heard yet";
+    } else if (h.silent) {
+      os << "silent for " << seconds_since(*h.last_heard) << " s, held at its last state";
+    } else if (h.plan) {
+      os << "plan " << h.plan_id;
+      const auto it = planned_.find(specs_[i].name);
+      os << (it != planned_.end() && it->second == h.generation ? ", followed"
+                                                                   : ", held at its state");
+    } else {
+      os << "no plan, held at its state";
+    }
+    if (!h.mismatch.empty()) os << " (" << h.mismatch << ")";
+  }
+  return os.str();
+}
+
+}  // namespace kinograph::daemon

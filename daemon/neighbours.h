@@ -1,0 +1,141 @@
+#pragma once
+// The robots a daemon shares its workspace with: their plans, states and heartbeats heard on
+// their channels, turned into obstacles of this robot's planner under the coordination rule
+// (kinograph/fleet/coordination.h, docs/multi_robot.md). Handlers run on the LCM thread, the rest
+// on the planner's worker; one mutex guards what both see.
+#include <Eigen/Geometry>
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "kinograph/collision/obstacle.h"
+#include "kinograph/dynamics/model.h"
+#include "kinograph/fleet/coordination.h"
+#include "kinograph/planning/plan.h"
+
+namespace lcm {
+class LCM;
+class ReceiveBuffer;
+class Subscription;
+}  // namespace lcm
+
+namespace kinograph::daemon {
+
+/// One neighbour as this daemon's configuration names it.
+struct NeighbourSpec {
+  std::string name;            ///< its name in reasons and the status, e.g. "right"
+  std::string channel_prefix;  ///< its channels PREFIX_PLAN, _STATE, _PLANNER_STATUS
+  /// Its robot placed at its base, payload attached (from its scene file).
+  std::shared_ptr<const dynamics::Model> model;
+  Eigen::Isometry3d base = Eigen::Isometry3d::Identity();  ///< where its scene puts its base
+  /// Its scene's start: where it stands until a state or plan of it is heard (empty: nowhere).
+  Eigen::VectorXd start_q;
+};
+
+/// Reads kinographd's `--neighbour NAME=SCENE[@PREFIX]`: the neighbour's own scene file gives its
+/// robot, payload and base; PREFIX defaults to NAME upper-cased.
+/// @throws std::invalid_argument naming the option text, or the scene's SceneError.
+NeighbourSpec neighbour_from_option(const std::string& text);
+
+/// How neighbours are watched.
+struct NeighboursOptions {
+  /// A neighbour heard from neither in heartbeats nor in states for this long (s, wall clock)
+  /// is silent: held still at its last known state and reported. Default 3 s, three heartbeats
+  /// of the default period.
+  double timeout_s = 3.0;
+};
+
+/// The neighbours of one daemon.
+class Neighbours {
+ public:
+  /// At most kMaxNeighbours neighbours of at most kMaxBodies collision geometries each.
+  static constexpr int kMaxNeighbours = 16;
+  static constexpr int kMaxBodies = 64;
+  /// Obstacle ids of neighbour bodies start here, far above the scene's and LCM's.
+  static constexpr int kFirstObstacleId = 1 << 28;
+
+  /// `own_prefix` is this robot's channel prefix: its name in the priority order. Throws
+  /// std::invalid_argument for a neighbour without model, beyond the limits, or named twice.
+  Neighbours(std::vector<NeighbourSpec> specs, std::string own_prefix, NeighboursOptions options);
+
+  /// Subscribes to every neighbour's PLAN, PLAN_CURRENT (its current plan again, for a robot
+  /// that joined late), STATE and PLANNER_STATUS channels; `changed` is called
+  /// (LCM thread) whenever what the rule sees may have changed. The LCM must outlive this.
+  void subscribe(lcm::LCM& lcm, std::function<void()> changed);
+  /// Unsubscribes (before the LCM goes).
+  void unsubscribe(lcm::LCM& lcm);
+
+  /// True once since the last call when a neighbour's plan, priority or liveness changed (a
+  /// silence found here counts). Worker thread.
+  bool take_changed();
+  /// The rule's decision for this robot (priority key `own`) now.
+  fleet::Decision decide(const fleet::PriorityKey& own, bool own_goal_changed);
+  /// Appends every neighbour's bodies as the decision treats them, timed from `origin_utime`
+  /// (the own plan's knot 0 on the common clock), to `obstacles`.
+  void add_obstacles(const fleet::Decision& decision, std::int64_t origin_utime,
+                     std::vector<collision::Obstacle>& obstacles);
+  /// True once when a neighbour was heard for the first time or after being silent (a started
+  /// or restarted daemon, which has missed this robot's current plan). Worker thread.
+  bool take_joined();
+  /// Records that a valid plan was made as `decision` says (what later changes are judged by).
+  void planned(const fleet::Decision& decision);
+  /// `text` with "obstacle <id>" of a neighbour body replaced by its name ("neighbour 'right'
+  /// link 'iiwa_link_4'").
+  std::string name_bodies(std::string text) const;
+  /// One entry per neighbour for the heartbeat, "; "-separated: how it is seen ("right: plan 3,
+  /// followed" when the current plan was made around its plan 3; "right: plan 3, held at its
+  /// state"; "silent for 4.1 s, held at its last state"; a model or base mismatch in brackets).
+  std::string summary() const;
+  /// Number of neighbours.
+  std::size_t size() const { return specs_.size(); }
+
+ private:
+  struct Heard {
+    std::optional<planning::Plan> plan;  // its newest valid plan
+    std::int64_t plan_start_utime = 0;
+    std::int64_t generation = 0;  // local count of the valid plans received (ids may restart)
+    std::int64_t plan_id = -1;    // as the neighbour numbers it
+    std::optional<Eigen::VectorXd> state;
+    std::int64_t goal_utime = std::numeric_limits<std::int64_t>::max();
+    std::string mismatch;  // why its heartbeat does not fit the scene, or empty
+    std::optional<std::chrono::steady_clock::time_point> last_heard;
+    bool silent = false;
+  };
+  void on_plan(std::size_t i, const lcm::ReceiveBuffer* rbuf);
+  void on_state(std::size_t i, const lcm::ReceiveBuffer* rbuf);
+  void on_heartbeat(std::size_t i, const lcm::ReceiveBuffer* rbuf);
+  // Marks neighbours silent after the timeout; true when one became silent. Caller holds mutex_.
+  bool update_silence_locked();
+  void notify();
+  // One subscription's target: which neighbour, which handler.
+  struct Route {
+    Neighbours* self;
+    std::size_t index;
+    void (Neighbours::*handler)(std::size_t, const lcm::ReceiveBuffer*);
+  };
+
+  std::vector<NeighbourSpec> specs_;
+  std::vector<std::string> model_ids_;
+  std::string own_prefix_;
+  NeighboursOptions options_;
+  std::function<void()> changed_callback_;
+  std::vector<lcm::Subscription*> subscriptions_;
+  std::vector<std::unique_ptr<Route>> routes_;
+
+  mutable std::mutex mutex_;
+  std::vector<Heard> heard_;
+  bool changed_ = false;
+  bool joined_ = false;
+  fleet::PlannedAround planned_;
+  std::int64_t rebuilds_ = 0;               // obstacle sets made (moving bodies get new ids)
+  std::map<int, std::string> body_names_;   // obstacle id -> name, of the last set made
+};
+
+}  // namespace kinograph::daemon

@@ -1,0 +1,77 @@
+#pragma once
+// The coordination rule of robots that plan around each other (docs/multi_robot.md): who yields
+// to whom, how each neighbour is treated, and when a robot replans. Pure functions, no I/O.
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace kinograph::fleet {
+
+/// What orders robots: the utime of the goal its current plan answers (earlier = higher
+/// priority), then its name. A robot without a goal has the latest possible utime.
+struct PriorityKey {
+  std::int64_t goal_utime = std::numeric_limits<std::int64_t>::max();
+  std::string robot;
+};
+
+/// True when `a` has priority over `b`: an earlier goal, or the same goal time and a name that
+/// sorts first. A strict total order on robots of different names.
+bool outranks(const PriorityKey& a, const PriorityKey& b);
+
+/// How a robot plans around one neighbour.
+enum class Treatment {
+  kAlongPlan,   ///< a higher-priority neighbour with a plan: its bodies move along that plan
+  kHeldAtState  ///< a lower-priority, silent or planless neighbour: held still at its state
+};
+
+/// "along plan" or "held at state".
+std::string to_string(Treatment treatment);
+
+/// What a robot knows of one neighbour when it decides.
+struct NeighbourView {
+  std::string name;
+  PriorityKey key;                      ///< from its heartbeat
+  std::optional<std::int64_t> plan_id;  ///< its current valid plan; none without one
+  bool silent = false;  ///< nothing heard within the neighbour timeout: held at its last state
+};
+
+/// What the robot's current plan was planned around: per neighbour the plan id followed, or
+/// kHeldMark when it was held at a state.
+using PlannedAround = std::map<std::string, std::int64_t>;
+/// The PlannedAround entry of a neighbour held at a state.
+inline constexpr std::int64_t kHeldMark = -1;
+
+/// What the rule says now.
+struct Decision {
+  std::vector<Treatment> treatment;  ///< one per neighbour, in the order given
+  bool replan = false;               ///< plan again around the neighbours as treated
+  std::string reason;                ///< why (or why not), in the user's terms
+  PlannedAround around;  ///< what a plan made now is planned around (store it when replanning)
+};
+
+/// The rule: higher-priority neighbours with a plan are followed along it, the others held at
+/// their state; replan when the own goal changed or a neighbour's entry in `around` would differ
+/// from what `planned` says for a higher-priority neighbour (a new plan, a neighbour gone silent
+/// or newly higher), never for a change of a lower-priority one. `planned` is empty before the
+/// first plan.
+Decision coordinate(const PriorityKey& own, const std::vector<NeighbourView>& neighbours,
+                    const PlannedAround& planned, bool own_goal_changed);
+
+/// When a yielding robot has no way around a neighbour: wait with its start held until the
+/// neighbour's plan ends, then move.
+struct WaitPlan {
+  double wait = 0;     ///< s the start is held (0: the neighbour's plan has ended already)
+  double horizon = 0;  ///< s: the own motion's horizon plus the wait
+};
+
+/// The wait for a blocking plan ending at `blocking_end` (own clock, s) when the own plan would
+/// start at `own_start` with `horizon` s of motion.
+WaitPlan wait_for(double blocking_end, double own_start, double horizon);
+
+/// The FAILED reason of a deadlock: no plan around `neighbour`, even after waiting for it.
+std::string deadlock_reason(const std::string& neighbour, const std::string& why);
+
+}  // namespace kinograph::fleet

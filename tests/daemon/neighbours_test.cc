@@ -1,0 +1,149 @@
+// A daemon's neighbours over an in-process memq:// LCM: a neighbour's valid plan is followed when
+// it has priority and held at its state otherwise, its bodies are named in reasons, a heartbeat
+// whose model or base does not fit its scene is reported, and failure answers change nothing.
+#include "daemon/neighbours.h"
+
+#include <gtest/gtest.h>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "kinograph/fleet/model_id.h"
+#include "kinograph/lcm/message_convert.h"
+#include "kinograph/plan_t.hpp"
+#include "kinograph/planner_status_t.hpp"
+#include "kinograph/planning/io/scene.h"
+
+namespace kinograph::daemon {
+namespace {
+
+class NeighboursTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_TRUE(lcm_.good());
+    spec_ = neighbour_from_option("right=" + std::string(KINOGRAPH_SOURCE_DIR) +
+                                  "/robots/scenes/iiwa_pair_right.yaml");
+    neighbours_ = std::make_unique<Neighbours>(std::vector<NeighbourSpec>{spec_}, "LEFT",
+                                               NeighboursOptions{});
+    neighbours_->subscribe(lcm_, [] {});
+  }
+  void TearDown() override { neighbours_->unsubscribe(lcm_); }
+  // Publishes and handles everything queued.
+  template <class Message>
+  void send(const std::string& channel, const Message& m) {
+    lcm_.publish(channel, &m);
+    while (lcm_.handleTimeout(0) > 0) {
+    }
+  }
+  planner_status_t heartbeat(int64_t goal_utime) const {
+    planner_status_t m;
+    m.robot = "iiwa14";
+    m.model_id = fleet::model_id(*spec_.model);
+    const Eigen::Quaterniond turn(spec_.base.linear());
+    for (int i = 0; i < 3; ++i) m.base_position[i] = spec_.base.translation()[i];
+    m.base_quaternion[0] = turn.w();
+    m.base_quaternion[1] = turn.x();
+    m.base_quaternion[2] = turn.y();
+    m.base_quaternion[3] = turn.z();
+    m.goal_utime = goal_utime;
+    m.valid_plan_id = 7;
+    return m;
+  }
+  plan_t plan(int64_t id, int8_t status = plan_t::SUCCESS) const {
+    planning::Plan p;
+    const int n = spec_.model->nq(), knots = 10;
+    p.q = p.qd = p.qdd = p.tau = Eigen::MatrixXd::Zero(knots + 1, n);
+    for (int k = 0; k <= knots; ++k) {
+      p.t.push_back(0.1 * k);
+      p.q.row(k) = spec_.start_q.transpose();
+    }
+    p.validation.valid = true;
+    messages::PlanTime time;
+    time.start_utime = 5'000'000;
+    plan_t m = messages::plan_to_message(p, *spec_.model, "iiwa14", id, 1, time);
+    m.status = status;
+    return m;
+  }
+
+  lcm::LCM lcm_{"memq://"};
+  NeighbourSpec spec_;
+  std::unique_ptr<Neighbours> neighbours_;
+};
+
+TEST_F(NeighboursTest, FollowsAHigherNeighboursPlanAndNamesItsBodies) {
+  send("RIGHT_PLANNER_STATUS", heartbeat(1'000'000));
+  send("RIGHT_PLAN", plan(7));
+  EXPECT_TRUE(neighbours_->take_changed());
+  EXPECT_FALSE(neighbours_->take_changed());
+  // Own goal at 2 s: right (goal at 1 s) has priority and is followed along its plan.
+  const fleet::Decision d = neighbours_->decide({2'000'000, ""}, true);
+  ASSERT_EQ(d.treatment.size(), 1u);
+  EXPECT_EQ(d.treatment[0], fleet::Treatment::kAlongPlan);
+  std::vector<collision::Obstacle> obstacles;
+  neighbours_->add_obstacles(d, 4'000'000, obstacles);
+  ASSERT_EQ(obstacles.size(), spec_.model->collision.size());
+  int moving = 0;
+  for (const auto& o : obstacles) {
+    EXPECT_GE(o.id, Neighbours::kFirstObstacleId);
+    moving += o.is_moving();
+  }
+  EXPECT_GT(moving, 0);
+  const int id = obstacles.back().id;
+  EXPECT_EQ(neighbours_->name_bodies("link 'a' and obstacle " + std::to_string(id) + " overlap"),
+            "link 'a' and neighbour 'right' link '" + spec_.model->collision.back().link_name +
+                "' overlap");
+  neighbours_->planned(d);
+  EXPECT_NE(neighbours_->summary().find("right: plan 7, followed"), std::string::npos)
+      << neighbours_->summary();
+  EXPECT_FALSE(neighbours_->decide({2'000'000, ""}, false).replan);
+
+  // A failure answer leaves it on its plan; the same plan sent again is no change.
+  send("RIGHT_PLAN", plan(8, plan_t::NOT_CONVERGED));
+  send("RIGHT_PLAN_CURRENT", plan(7));
+  EXPECT_FALSE(neighbours_->take_changed());
+  EXPECT_FALSE(neighbours_->decide({2'000'000, ""}, false).replan);
+  // A new plan of it: one replan.
+  send("RIGHT_PLAN", plan(9));
+  EXPECT_TRUE(neighbours_->decide({2'000'000, ""}, false).replan);
+}
+
+TEST_F(NeighboursTest, HoldsALowerNeighbourAtItsState) {
+  send("RIGHT_PLANNER_STATUS", heartbeat(3'000'000));
+  send("RIGHT_PLAN", plan(7));
+  const fleet::Decision d = neighbours_->decide({2'000'000, ""}, true);
+  EXPECT_EQ(d.treatment[0], fleet::Treatment::kHeldAtState);
+  std::vector<collision::Obstacle> obstacles;
+  neighbours_->add_obstacles(d, 4'000'000, obstacles);
+  ASSERT_EQ(obstacles.size(), spec_.model->collision.size());
+  for (const auto& o : obstacles) EXPECT_FALSE(o.is_moving());
+  neighbours_->planned(d);
+  send("RIGHT_PLAN", plan(8));  // it yields: no replan here
+  EXPECT_FALSE(neighbours_->decide({2'000'000, ""}, false).replan);
+}
+
+TEST_F(NeighboursTest, ReportsAHeartbeatThatDoesNotFitTheScene) {
+  planner_status_t wrong_model = heartbeat(1);
+  wrong_model.model_id = "iiwa14:0000000000000000";
+  send("RIGHT_PLANNER_STATUS", wrong_model);
+  EXPECT_NE(neighbours_->summary().find("its model is iiwa14:0000000000000000"),
+            std::string::npos)
+      << neighbours_->summary();
+  planner_status_t moved = heartbeat(1);
+  moved.base_position[1] = 0.5;
+  send("RIGHT_PLANNER_STATUS", moved);
+  EXPECT_NE(neighbours_->summary().find("its base is 0.5 m"), std::string::npos)
+      << neighbours_->summary();
+}
+
+TEST(NeighbourOption, NeedsANameAndAScene) {
+  EXPECT_THROW(neighbour_from_option("right"), std::invalid_argument);
+  EXPECT_THROW(neighbour_from_option("=x.yaml"), std::invalid_argument);
+  EXPECT_THROW(neighbour_from_option("right=x.yaml@"), std::invalid_argument);
+  EXPECT_THROW(neighbour_from_option("right=/nonexistent/scene.yaml"), planning::SceneError);
+  const NeighbourSpec s = neighbour_from_option(
+      "r=" + std::string(KINOGRAPH_SOURCE_DIR) + "/robots/scenes/iiwa_pair_right.yaml@ARM2");
+  EXPECT_EQ(s.channel_prefix, "ARM2");
+  EXPECT_NEAR(s.base.translation().x(), 1.3, 1e-12);
+}
+
+}  // namespace
+}  // namespace kinograph::daemon

@@ -1,0 +1,81 @@
+// Robots checked together on a common clock: closed forms with sliding spheres (the closest
+// approach between the knots, plans starting at different times, each robot held at its ends),
+// the pair named, and bad input refused with the robot's name.
+#include "kinograph/fleet/joint_clearance.h"
+
+#include <gtest/gtest.h>
+
+#include "tests/fleet/slider.h"
+
+namespace kinograph::fleet {
+namespace {
+
+using testing::constant_velocity;
+using testing::kSphereRadius;
+using testing::slider;
+
+TEST(JointClearance, FindsTheClosestApproachBetweenTheKnots) {
+  // 'a' crosses from x = −1 to x = 1 in one interval of 1 s; 'b' stands 0.25 m to the side at
+  // x = 0. At the knots they are 1.03 m apart; at t = 0.5 s only 0.25 − 2r.
+  const std::vector<RobotPlan> robots = {
+      {"a", slider(Eigen::Vector3d(0, 0, 0)), constant_velocity(-1.0, 2.0, 1.0, 1), 0.0},
+      {"b", slider(Eigen::Vector3d(0, 0.25, 0)), constant_velocity(0.0, 0.0, 1.0, 1), 0.0}};
+  const JointClearance c = joint_clearance(robots);
+  EXPECT_NEAR(c.min_distance, 0.25 - 2 * kSphereRadius, 1e-6);
+  EXPECT_NEAR(c.t, 0.5, 1e-12);
+  EXPECT_EQ(c.robot_a, "a");
+  EXPECT_EQ(c.link_a, "ball");
+  EXPECT_EQ(c.robot_b, "b");
+  EXPECT_TRUE(c.clear());
+  EXPECT_FALSE(c.clear(0.1));
+  EXPECT_EQ(c.samples, 11);
+}
+
+TEST(JointClearance, PutsEveryPlanOnTheCommonClockAndHoldsItsEnds) {
+  // 'a' at x = 0 moves +0.3 m/s for 1 s, then stands at 0.3; 'b' at x = 1 stands still until
+  // t = 0.5 s, then moves −0.3 m/s until 1.5 s. Closest at t = 1.5: 1 − 0.3 − 0.3 − 2r.
+  const std::vector<RobotPlan> robots = {
+      {"a", slider(Eigen::Vector3d(0, 0, 0)), constant_velocity(0.0, 0.3, 1.0, 5), 0.0},
+      {"b", slider(Eigen::Vector3d(1, 0, 0)), constant_velocity(0.0, -0.3, 1.0, 5), 0.5}};
+  const JointClearance c = joint_clearance(robots);
+  EXPECT_NEAR(c.min_distance, 0.4 - 2 * kSphereRadius, 1e-6);
+  EXPECT_NEAR(c.t, 1.5, 1e-9);
+}
+
+TEST(JointClearance, ReportsAnOverlapWithTheDepth) {
+  // Head-on at 0.45 m/s each from 1 m apart: at t = 1 s the centres are 0.1 m apart, the spheres
+  // overlap by 2r − 0.1. The third robot stands far away and is never the closest pair.
+  const std::vector<RobotPlan> robots = {
+      {"left", slider(Eigen::Vector3d(0, 0, 0)), constant_velocity(0.0, 0.45, 1.0, 4), 0.0},
+      {"far", slider(Eigen::Vector3d(0, 5, 0)), constant_velocity(0.0, 0.0, 1.0, 4), 0.0},
+      {"right", slider(Eigen::Vector3d(1, 0, 0)), constant_velocity(0.0, -0.45, 1.0, 4), 0.0}};
+  const JointClearance c = joint_clearance(robots);
+  EXPECT_NEAR(c.min_distance, 0.1 - 2 * kSphereRadius, 1e-6);
+  EXPECT_NEAR(c.t, 1.0, 1e-9);
+  EXPECT_FALSE(c.clear());
+  EXPECT_EQ(c.robot_a, "left");
+  EXPECT_EQ(c.robot_b, "right");
+  EXPECT_NE(describe(c).find("overlap by 0.1 m"), std::string::npos) << describe(c);
+  EXPECT_NE(describe(c).find("'left' (link 'ball') and 'right'"), std::string::npos);
+}
+
+TEST(JointClearance, RefusesBadInputNamingTheRobot) {
+  planning::Plan bad = constant_velocity(0.0, 0.0, 1.0, 2);
+  bad.t[1] = bad.t[0];
+  std::vector<RobotPlan> robots = {
+      {"a", slider(Eigen::Vector3d::Zero()), constant_velocity(0.0, 0.0, 1.0, 2), 0.0},
+      {"b", slider(Eigen::Vector3d(1, 0, 0)), bad, 0.0}};
+  try {
+    joint_clearance(robots);
+    FAIL() << "a plan whose times do not increase was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("robot 'b'"), std::string::npos) << e.what();
+  }
+  robots[1] = robots[0];
+  EXPECT_THROW(joint_clearance(robots), std::invalid_argument);  // two robots named 'a'
+  robots.pop_back();
+  EXPECT_THROW(joint_clearance(robots, {.samples_per_interval = 0}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace kinograph::fleet
