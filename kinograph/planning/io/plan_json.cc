@@ -8,6 +8,7 @@
 #include <limits>
 #include <sstream>
 
+#include "kinograph/dynamics/base_placement.h"
 #include "kinograph/dynamics/payload.h"
 #include "kinograph/planning/io/data_dir.h"
 
@@ -382,6 +383,7 @@ json plan_to_json(const Plan& plan, const Scene& scene) {
   j["format_version"] = kPlanFormatVersion;
   j["name"] = problem.name;
   j["robot"]["urdf"] = data_relative_path(scene.urdf_path);
+  if (!dynamics::is_identity_pose(scene.base)) j["robot"]["base"] = pose_json(scene.base);
   if (scene.payload) {
     const PayloadSpec& p = *scene.payload;
     j["robot"]["payload"] = {{"frame", p.frame},
@@ -540,6 +542,10 @@ PlanFileInfo plan_info_from_json(const json& j, const std::string& source) {
     fail(source, "robot.urdf", "missing string");
   }
   info.urdf = robot["urdf"].get<std::string>();
+  if (robot.contains("base")) {
+    if (!robot["base"].is_object()) fail(source, "robot.base", "must be an object");
+    info.base = read_pose(robot["base"], source, "robot.base");
+  }
   info.payload = read_payload(robot, source);
   if (j.contains("obstacles")) {
     const json& list = j["obstacles"];
@@ -609,6 +615,11 @@ dynamics::Model load_plan_model(const PlanFileInfo& info) {
     model = dynamics::Model::from_urdf_file(*urdf);
   } catch (const std::exception& e) {
     fail(info.source, "robot.urdf", std::string("cannot load the robot: ") + e.what());
+  }
+  try {
+    if (!dynamics::is_identity_pose(info.base)) model = dynamics::place_base(model, info.base);
+  } catch (const std::invalid_argument& e) {
+    fail(info.source, "robot.base", e.what());
   }
   if (info.payload) {
     const PayloadSpec& p = *info.payload;

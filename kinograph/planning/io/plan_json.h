@@ -23,7 +23,7 @@ class PlanFileError : public std::runtime_error {
 
 /// The plan file format this kinograph writes ("format_version"); it reads this one, older ones
 /// and files without the field (written before it existed).
-inline constexpr int kPlanFormatVersion = 1;
+inline constexpr int kPlanFormatVersion = 2;
 
 /// The solver statistics as a JSON object (every field of SolveStats).
 nlohmann::json to_json(const SolveStats& stats);
@@ -69,6 +69,7 @@ struct PlanFileInfo {
   std::string source;  ///< file it was read from: names it in errors, anchors relative paths
   std::string name;    ///< "name"; empty when absent
   std::string urdf;    ///< "robot.urdf" as written (see resolve_plan_path)
+  Eigen::Isometry3d base = Eigen::Isometry3d::Identity();  ///< "robot.base" (identity if absent)
   std::optional<PayloadSpec> payload;          ///< "robot.payload"
   std::vector<collision::Obstacle> obstacles;  ///< obstacles[i].id == i; "motion" as trajectory
   std::vector<std::string> obstacle_names;     ///< their "id"s ("obstacles[i]" when absent)

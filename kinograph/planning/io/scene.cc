@@ -10,6 +10,7 @@
 
 #include "kinograph/collision/obstacle.h"
 #include "kinograph/collision/shape.h"
+#include "kinograph/dynamics/base_placement.h"
 #include "kinograph/dynamics/payload.h"
 #include "kinograph/planning/batch/batch_planner.h"
 #include "kinograph/planning/clearance_world.h"
@@ -112,7 +113,7 @@ class SceneParser {
 
   dynamics::Model parse_robot(const YAML::Node& root, Scene& scene) {
     const YAML::Node robot = r_.required(root, "", "robot");
-    r_.expect_map(robot, "robot", {"urdf", "payload", "srdf"});
+    r_.expect_map(robot, "robot", {"urdf", "payload", "srdf", "base"});
     const YAML::Node urdf = r_.required(robot, "robot", "urdf");
     scene.urdf = r_.string(urdf, "robot.urdf");
     scene.urdf_path = resolve(urdf, "robot.urdf", scene.urdf);
@@ -121,6 +122,18 @@ class SceneParser {
       model = dynamics::Model::from_urdf_file(scene.urdf_path);
     } catch (const std::exception& e) {
       r_.fail(urdf, "robot.urdf", std::string("cannot load the robot: ") + e.what());
+    }
+    if (const YAML::Node b = robot["base"]) {
+      r_.expect_map(b, "robot.base", {"position", "rpy", "quaternion"});
+      const Eigen::Vector3d position =
+          b["position"] ? r_.vector3(b["position"], "robot.base.position")
+                        : Eigen::Vector3d::Zero().eval();
+      if (const std::string e = collision::position_range_error(position); !e.empty()) {
+        r_.fail(b["position"], "robot.base.position", e);
+      }
+      scene.base =
+          make_pose(position, r_.rotation(b, "robot.base").value_or(Eigen::Matrix3d::Identity()));
+      model = dynamics::place_base(model, scene.base);
     }
     if (const YAML::Node p = robot["payload"]) {
       r_.expect_map(p, "robot.payload", {"frame", "mass", "size", "offset"});
@@ -676,6 +689,11 @@ std::string scene_to_yaml(const Scene& scene) {
   out << YAML::Key << "name" << YAML::Value << p.name;
   out << YAML::Key << "robot" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "urdf" << YAML::Value << scene.urdf_path;
+  if (!dynamics::is_identity_pose(scene.base)) {
+    out << YAML::Key << "base" << YAML::Value << YAML::BeginMap;
+    emit_pose(out, scene.base);
+    out << YAML::EndMap;
+  }
   if (scene.payload) {
     const PayloadSpec& pl = *scene.payload;
     out << YAML::Key << "payload" << YAML::Value << YAML::BeginMap;

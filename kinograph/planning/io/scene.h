@@ -61,6 +61,9 @@ struct Scene {
   std::string source;     ///< file it was read from; empty when parsed from text
   std::string urdf;       ///< robot.urdf as written in the file
   std::string urdf_path;  ///< robot.urdf resolved to an absolute path
+  /// robot.base: where the robot's root link stands in the world (identity by default);
+  /// problem.model is placed there.
+  Eigen::Isometry3d base = Eigen::Isometry3d::Identity();
   std::optional<PayloadSpec> payload;
   /// Limit overrides in file order, by joint name.
   std::vector<std::pair<std::string, LimitOverride>> limits;
