@@ -11,10 +11,12 @@
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <string>
 
 #include "kinograph/cell/cell.h"
 #include "kinograph/cell/composite_problem.h"
+#include "kinograph/planning/io/data_dir.h"
 #include "kinograph/planning/io/plan_json.h"
 #include "kinograph/planning/io/scene.h"
 #include "kinograph/planning/validate.h"

@@ -35,9 +35,11 @@ struct Args {
   int seed = 1;
   std::string cells_dir;  // where the generated cells are written (empty: a fresh temp dir)
   std::string out = "multi_robot.json";
-  std::string table;      // Markdown table file (empty: stdout only)
-  std::string plot;       // PNG
+  std::string table;  // Markdown table file (empty: stdout only)
+  std::string plot;   // PNG
   bool generate_only = false;
+  std::string write_cell;  // write one cell (--robots N, --seed) here and stop
+  std::string urdf;        // the URDF as written in it (default: the source tree's, absolute)
 };
 
 std::vector<int> robot_counts(const std::string& list) {
@@ -61,8 +63,8 @@ nlohmann::json plan_centralized(const std::string& path) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   bool valid = plan.success();
   for (std::size_t i = 0; valid && i < c.robots.size(); ++i) {
-    valid = planning::validate(c.robots[i].scene.problem, cell::robot_plan(plan, cp.ranges[i]))
-                .valid;
+    valid =
+        planning::validate(c.robots[i].scene.problem, cell::robot_plan(plan, cp.ranges[i])).valid;
   }
   nlohmann::json j;
   j["success"] = valid;
@@ -74,14 +76,10 @@ nlohmann::json plan_centralized(const std::string& path) {
   j["status"] = planning::to_string(plan.stats.status);
   j["min_clearance"] = plan.validation.min_clearance;
   if (!valid) {
-    j["reason"] = plan.validation.failures.empty() ? plan.stats.reason
-                                                   : plan.validation.failures.front();
+    j["reason"] =
+        plan.validation.failures.empty() ? plan.stats.reason : plan.validation.failures.front();
   }
   return j;
-}
-
-double number_or_nan(const nlohmann::json& j, const char* key) {
-  return j.contains(key) ? json_number(j[key]) : std::nan("");
 }
 
 std::string markdown(const nlohmann::json& results) {
@@ -127,12 +125,25 @@ void write_plot(const nlohmann::json& results, const std::string& path) {
     }
     series.values.push_back(v);
   }
-  for (const auto& g : groups) o.joint_names.push_back(fmt::format("N = {} arms", g["robots"].get<int>()));
+  for (const auto& g : groups)
+    o.joint_names.push_back(fmt::format("N = {} arms", g["robots"].get<int>()));
   o.columns = static_cast<int>(groups.size());
   render::write_png(render::plot_torques({series}, o), path);
 }
 
+int write_one_cell(const Args& args) {
+  CellGeneratorOptions g;
+  g.robots = std::stoi(args.robots);
+  g.seed = static_cast<std::uint64_t>(args.seed);
+  g.urdf = args.urdf.empty() ? std::string(KINOGRAPH_SOURCE_DIR) + "/robots/iiwa14/iiwa14.urdf"
+                             : args.urdf;
+  g.path = args.write_cell;
+  std::ofstream(args.write_cell) << generate_cell(g, fs::path(args.write_cell).stem().string());
+  return 0;
+}
+
 int run(const Args& args) {
+  if (!args.write_cell.empty()) return write_one_cell(args);
   std::string dir = args.cells_dir;
   if (dir.empty()) {
     char tmpl[] = "/tmp/multi_robot_cells.XXXXXX";
@@ -156,6 +167,7 @@ int run(const Args& args) {
       g.seed = static_cast<std::uint64_t>(args.seed) * 100 + k;
       const std::string name = fmt::format("iiwa{}_p{:02d}", n, k);
       const std::string path = (fs::path(dir) / (name + ".yaml")).string();
+      g.path = path;
       std::ofstream(path) << generate_cell(g, name);
       nlohmann::json problem;
       problem["cell"] = path;
@@ -163,11 +175,11 @@ int run(const Args& args) {
         problem["centralized"] = plan_centralized(path);
         problem["distributed"] = nullptr;
         const auto& c = problem["centralized"];
-        std::cerr << fmt::format("{}: {} cpu {:.2f} s objective {:.1f}{}\n", name,
-                                 c["success"].get<bool>() ? "ok" : "FAILED",
-                                 json_number(c["cpu_s"]), json_number(c["objective"]),
-                                 c.contains("reason") ? " (" + c["reason"].get<std::string>() + ")"
-                                                      : "");
+        std::cerr << fmt::format(
+            "{}: {} cpu {:.2f} s objective {:.1f}{}\n", name,
+            c["success"].get<bool>() ? "ok" : "FAILED", json_number(c["cpu_s"]),
+            json_number(c["objective"]),
+            c.contains("reason") ? " (" + c["reason"].get<std::string>() + ")" : "");
       }
       group["problems"].push_back(problem);
     }
@@ -196,6 +208,8 @@ int main(int argc, char** argv) {
       .value("--out", &args.out)
       .value("--table", &args.table)
       .value("--plot", &args.plot)
+      .value("--write-cell", &args.write_cell)
+      .value("--urdf", &args.urdf)
       .toggle("--generate-only", [&] { args.generate_only = true; });
   if (!flags.parse(argc, argv)) return 64;
   spdlog::set_level(spdlog::level::warn);

@@ -99,6 +99,7 @@ TEST_F(ComposeTest, NamesArePrefixedAndGeometryKept) {
 }
 
 TEST_F(ComposeTest, BadInputIsRefusedNamingTheRobot) {
+  const Eigen::Isometry3d I = Eigen::Isometry3d::Identity();
   const auto message = [](const std::vector<ComposedPart>& p) {
     try {
       compose(p);
@@ -108,13 +109,13 @@ TEST_F(ComposeTest, BadInputIsRefusedNamingTheRobot) {
     return std::string("no error");
   };
   EXPECT_NE(message({}).find("at least one robot"), std::string::npos);
-  EXPECT_NE(message({{"a", &iiwa, {}}, {"a", &iiwa, {}}}).find("two robots are named 'a'"),
+  EXPECT_NE(message({{"a", &iiwa, I}, {"a", &iiwa, I}}).find("two robots are named 'a'"),
             std::string::npos);
-  EXPECT_NE(message({{"a/b", &iiwa, {}}}).find("must not contain '/'"), std::string::npos);
-  EXPECT_NE(message({{"a", nullptr, {}}}).find("robot 'a' has no model"), std::string::npos);
+  EXPECT_NE(message({{"a/b", &iiwa, I}}).find("must not contain '/'"), std::string::npos);
+  EXPECT_NE(message({{"a", nullptr, I}}).find("robot 'a' has no model"), std::string::npos);
   Model moon = iiwa;
   moon.gravity = Eigen::Vector3d(0, 0, -1.62);
-  EXPECT_NE(message({{"a", &iiwa, {}}, {"b", &moon, {}}}).find("robot 'b' has a gravity"),
+  EXPECT_NE(message({{"a", &iiwa, I}, {"b", &moon, I}}).find("robot 'b' has a gravity"),
             std::string::npos);
   Eigen::Isometry3d skew = Eigen::Isometry3d::Identity();
   skew.linear()(0, 1) = 0.5;

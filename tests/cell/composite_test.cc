@@ -85,7 +85,7 @@ TEST(CompositeTest, PoseGoalIsRefusedUntilResolved) {
     composite_problem(cell);
     FAIL() << "a pose goal was taken";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("robot 'right' has a pose goal"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("robot 'arm1' has a pose goal"), std::string::npos);
   }
 }
 
