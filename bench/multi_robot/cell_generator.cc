@@ -12,6 +12,7 @@
 #include "kinograph/dynamics/data.h"
 #include "kinograph/dynamics/kinematics.h"
 #include "kinograph/planning/goal_sampler.h"
+#include "kinograph/planning/problem_check.h"
 
 namespace kinograph::bench {
 namespace {
@@ -67,8 +68,8 @@ std::string cell_text(const CellGeneratorOptions& o, const std::string& name,
           ? "facing each other across a table, bases 1.3 m apart"
           : fmt::format("on a circle of radius {} m around a round table, facing its centre",
                         l.radius),
-      o.robots, o.seed, name, o.horizon, o.steps, l.table, 0.6 * (l.radius + 1.6),
-      -1.8 * (l.radius + 1.0), 1.4 * (l.radius + 0.8));
+      o.robots, o.seed, name, o.horizon, o.steps, l.table, 0.5 * (l.radius + 1.2),
+      -1.4 * (l.radius + 0.9), 0.9 * (l.radius + 1.0));
   for (int i = 0; i < o.robots; ++i) {
     const double angle = 2 * M_PI * i / o.robots + M_PI;  // robot 0 on the −x side
     s += fmt::format(
@@ -177,7 +178,13 @@ std::string generate_cell(const CellGeneratorOptions& o, const std::string& name
     const std::uint64_t seed = o.seed * 1000 + static_cast<std::uint64_t>(attempt);
     if (!draw_poses(c, cp, cross, o, seed, 0, starts)) continue;
     if (!draw_poses(c, cp, cross, o, seed, 1, goals)) continue;
-    if (lines_collide(cp, cross, starts, goals)) return cell_text(o, name, starts, goals);
+    if (!lines_collide(cp, cross, starts, goals)) continue;
+    // The planner's own refusals (a horizon too short for a joint's move, ...) redraw too.
+    const std::string text = cell_text(o, name, starts, goals);
+    if (planning::check_problem(cell::composite_problem(cell::parse_cell(text, o.path)).problem)
+            .empty()) {
+      return text;
+    }
   }
   throw std::runtime_error(
       fmt::format("generate_cell {}: no crossing problem of clear starts and goals in {} tries",
