@@ -28,8 +28,8 @@
 #include "render/scene_renderer.h"
 #include "tools/command_registry.h"
 #include "tools/formulation.h"
+#include "tools/picture_options.h"
 #include "tools/plan_file.h"
-#include "tools/png_path.h"
 
 namespace kinograph::tools {
 namespace {
@@ -124,16 +124,9 @@ void run_plan_cell(const PlanCellArgs& args) {
   }
 }
 
-struct RenderCellArgs {
+struct RenderCellArgs : PictureArgs {
   std::string cell;
   std::string plans;
-  std::string out = "cell.png";
-  std::string style = "strip";
-  int frames = 5;
-  int width = 1600;
-  int height = 400;
-  int samples = 4;
-  bool no_labels = false;
 };
 
 void run_render_cell(const RenderCellArgs& args) {
@@ -168,12 +161,8 @@ void run_render_cell(const RenderCellArgs& args) {
     }
     scene.camera = render::read_scene_camera(c.source);
     scene.paths = render::robot_paths(ranges, ee_frames);
-    render::FrameOptions options;
-    options.frames = args.frames;
-    options.width = args.width;
-    options.height = args.height;
-    options.labels = !args.no_labels;
-    render::SceneRenderer renderer(render::RendererOptions{.samples = args.samples});
+    const render::FrameOptions options = frame_options(args, args.frames);
+    render::SceneRenderer renderer = make_renderer(args);
     render::RenderResult result =
         args.style == "ghost" ? renderer.ghost(scene, options) : renderer.strip(scene, options);
     if (failure) render::mark_failed(result.image, *failure);
@@ -212,18 +201,7 @@ const bool kRegisteredRender = register_command([](CLI::App& root) {
   cmd->add_option("cell", args->cell, "Cell file (YAML)")->required();
   cmd->add_option("plans", args->plans, "Folder holding one plan file <robot>.json per robot")
       ->required();
-  cmd->add_option("--style", args->style, "strip (side by side) or ghost (one overlaid view)")
-      ->check(CLI::IsMember({"strip", "ghost"}))
-      ->capture_default_str();
-  cmd->add_option("--frames", args->frames, "Number of poses, evenly spaced in time")
-      ->capture_default_str();
-  cmd->add_option("--width", args->width, "Picture width, pixels")->capture_default_str();
-  cmd->add_option("--height", args->height, "Picture height, pixels")->capture_default_str();
-  cmd->add_option("--out", args->out, "Output picture (.png)")
-      ->check(png_path())
-      ->capture_default_str();
-  cmd->add_option("--samples", args->samples, "MSAA samples per pixel")->capture_default_str();
-  cmd->add_flag("--no-labels", args->no_labels, "Leave out the time labels");
+  add_picture_options(cmd, *args);
   cmd->callback([args] { run_render_cell(*args); });
 });
 
