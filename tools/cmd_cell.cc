@@ -104,7 +104,9 @@ void run_plan_cell(const PlanCellArgs& args) {
     }
     all_valid = all_valid && own.success();
     const std::string scene_path = (fs::path(args.out) / (robot.name + ".yaml")).string();
-    std::ofstream(scene_path) << planning::scene_to_yaml(robot.scene);
+    std::ofstream scene_file(scene_path);
+    scene_file << planning::scene_to_yaml(robot.scene);
+    if (!scene_file) throw CommandFailure("cannot write the scene file '" + scene_path + "'");
     write_plan_file(own, robot.scene, options.formulation, robot_plan_path(args.out, robot.name));
     report << "robot " << robot.name << ": " << (own.success() ? "valid" : "INVALID")
            << ", min clearance " << own.validation.min_clearance << " m"

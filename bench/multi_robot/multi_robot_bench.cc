@@ -40,6 +40,7 @@ struct Args {
   bool generate_only = false;
   std::string write_cell;  // write one cell (--robots N, --seed) here and stop
   std::string urdf;        // the URDF as written in it (default: the source tree's, absolute)
+  std::string report;      // results files (comma-separated) to tabulate and plot, no runs
 };
 
 std::vector<int> robot_counts(const std::string& list) {
@@ -106,29 +107,35 @@ std::string markdown(const nlohmann::json& results) {
   return t;
 }
 
+// One curve per arm count: log10 of each problem's CPU time against the problem's index (the
+// times of 2 and 8 arms differ by two orders of magnitude).
 void write_plot(const nlohmann::json& results, const std::string& path) {
-  render::PlotSeries series;
-  series.label = "centralized (filled: success)";
-  render::TorquePlotOptions o;
-  o.title = "Centralized planner: CPU time per problem";
-  o.y_label = "CPU time [s]";
-  o.x_label = "problem";
-  const auto& groups = results["groups"];
-  const std::size_t problems = groups[0]["problems"].size();
-  for (std::size_t k = 0; k < problems; ++k) {
-    series.t.push_back(static_cast<double>(k));
-    Eigen::VectorXd v(groups.size());
-    for (std::size_t g = 0; g < groups.size(); ++g) {
-      v[g] = k < groups[g]["problems"].size()
-                 ? json_number(groups[g]["problems"][k]["centralized"]["cpu_s"])
-                 : std::nan("");
+  std::vector<render::PlotSeries> series;
+  for (const auto& group : results["groups"]) {
+    render::PlotSeries s;
+    s.label = fmt::format("N = {} arms", group["robots"].get<int>());
+    for (const auto& p : group["problems"]) {
+      s.t.push_back(static_cast<double>(s.t.size()));
+      s.values.push_back(
+          Eigen::VectorXd::Constant(1, std::log10(json_number(p["centralized"]["cpu_s"]))));
     }
-    series.values.push_back(v);
+    if (!s.t.empty()) series.push_back(std::move(s));
   }
-  for (const auto& g : groups)
-    o.joint_names.push_back(fmt::format("N = {} arms", g["robots"].get<int>()));
-  o.columns = static_cast<int>(groups.size());
-  render::write_png(render::plot_torques({series}, o), path);
+  render::TorquePlotOptions o;
+  o.title = "Centralized planner on random crossing-goal cells";
+  o.y_label = "log10 CPU time [s]";
+  o.x_label = "problem";
+  o.joint_names = {"CPU time per problem"};
+  o.height = 420;
+  render::write_png(render::plot_torques(series, o), path);
+}
+
+// The table (stdout and --table) and the plot (--plot) of a results file.
+void report(const nlohmann::json& results, const Args& args) {
+  const std::string table = markdown(results);
+  std::cout << table;
+  if (!args.table.empty()) std::ofstream(args.table) << table;
+  if (!args.plot.empty()) write_plot(results, args.plot);
 }
 
 int write_one_cell(const Args& args) {
@@ -142,8 +149,24 @@ int write_one_cell(const Args& args) {
   return 0;
 }
 
+// --report A.json,B.json: the groups of several results files in one table and plot.
+int report_files(const Args& args) {
+  nlohmann::json merged;
+  merged["groups"] = nlohmann::json::array();
+  std::stringstream ss(args.report);
+  for (std::string file; std::getline(ss, file, ',');) {
+    std::ifstream in(file);
+    if (!in) throw std::runtime_error("cannot read '" + file + "'");
+    const nlohmann::json j = nlohmann::json::parse(in);
+    for (const auto& group : j["groups"]) merged["groups"].push_back(group);
+  }
+  report(merged, args);
+  return 0;
+}
+
 int run(const Args& args) {
   if (!args.write_cell.empty()) return write_one_cell(args);
+  if (!args.report.empty()) return report_files(args);
   std::string dir = args.cells_dir;
   if (dir.empty()) {
     char tmpl[] = "/tmp/multi_robot_cells.XXXXXX";
@@ -160,8 +183,7 @@ int run(const Args& args) {
       "slot: per problem, 'distributed' = {success, time_to_mutually_clear_s, replans, messages}"
       " from one kinographd per arm over LCM (bench/multi_robot/README.md)";
   for (int n : robot_counts(args.robots)) {
-    nlohmann::json group;
-    group["robots"] = n;
+    results["groups"].push_back({{"robots", n}, {"problems", nlohmann::json::array()}});
     for (int k = 0; k < args.problems; ++k) {
       g.robots = n;
       g.seed = static_cast<std::uint64_t>(args.seed) * 100 + k;
@@ -181,16 +203,12 @@ int run(const Args& args) {
             json_number(c["objective"]),
             c.contains("reason") ? " (" + c["reason"].get<std::string>() + ")" : "");
       }
-      group["problems"].push_back(problem);
+      results["groups"].back()["problems"].push_back(problem);
+      // Written after every problem, so a run cut short keeps what it measured.
+      std::ofstream(args.out) << results.dump(1) << "\n";
     }
-    results["groups"].push_back(group);
   }
-  std::ofstream(args.out) << results.dump(1) << "\n";
-  if (args.generate_only) return 0;
-  const std::string table = markdown(results);
-  std::cout << table;
-  if (!args.table.empty()) std::ofstream(args.table) << table;
-  if (!args.plot.empty()) write_plot(results, args.plot);
+  if (!args.generate_only) report(results, args);
   return 0;
 }
 
@@ -210,6 +228,7 @@ int main(int argc, char** argv) {
       .value("--plot", &args.plot)
       .value("--write-cell", &args.write_cell)
       .value("--urdf", &args.urdf)
+      .value("--report", &args.report)
       .toggle("--generate-only", [&] { args.generate_only = true; });
   if (!flags.parse(argc, argv)) return 64;
   spdlog::set_level(spdlog::level::warn);
