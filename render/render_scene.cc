@@ -49,6 +49,7 @@ void RenderScene::check() const {
     }
   }
   if (!end_effector_frame.empty()) model->frame_index(end_effector_frame);  // throws if unknown
+  for (const ScenePath& path : paths) model->frame_index(path.frame);
 }
 
 int highlight_changed_obstacles(const RenderScene& before, RenderScene& after,

@@ -31,6 +31,12 @@ struct SceneObstacle {
   std::string name;  ///< the plan file's id, to tell obstacles of two plans apart
 };
 
+/// A frame whose path a ghost overlay draws, in its own colour.
+struct ScenePath {
+  std::string frame;
+  Eigen::Vector4f rgba = Eigen::Vector4f(0.85f, 0.12f, 0.08f, 1.f);
+};
+
 /// Everything a picture of a plan depends on. The model is borrowed and must outlive the
 /// scene.
 struct RenderScene {
@@ -39,6 +45,8 @@ struct RenderScene {
   std::vector<SceneObstacle> obstacles;
   std::optional<Camera> camera;    ///< automatic framing when absent
   std::string end_effector_frame;  ///< frame whose path a ghost overlay draws; empty = last frame
+  /// Paths a ghost overlay draws instead, each in its colour (several robots in one model).
+  std::vector<ScenePath> paths;
 
   /// Throws std::invalid_argument naming the problem when the scene cannot be drawn (no model,
   /// empty trajectory, joint vectors of the wrong size, decreasing times).

@@ -418,12 +418,17 @@ RenderResult SceneRenderer::overlay(const std::vector<Layer>& layers, const Came
     const RenderScene& scene = *layer.scene;
     const dynamics::Model& model = *scene.model;
     const std::vector<double> times = scene.trajectory.even_times(n);
-    const int ee_frame = end_effector(scene);
-    if (ee_frame >= 0) {
+    std::vector<ScenePath> paths = scene.paths;
+    if (paths.empty() && end_effector(scene) >= 0) {
+      paths.push_back({model.frames[end_effector(scene)].name, layer.path_color});
+    }
+    for (std::size_t p = 0; p < paths.size(); ++p) {
       const double radius = std::max(layer.path_radius * bounds.diagonal().norm(), 1e-3);
+      const std::string key = p == 0 ? layer.path_key : layer.path_key + ":" + std::to_string(p);
       DrawItem path;
-      path.mesh = renderer_.upload(layer.path_key, make_tube(path_points(scene, ee_frame), radius));
-      path.color = layer.path_color;
+      path.mesh = renderer_.upload(
+          key, make_tube(path_points(scene, model.frame_index(paths[p].frame)), radius));
+      path.color = paths[p].rgba;
       opaque.push_back(path);
     }
     // Fixed obstacles once; moving ones where they are at each pose's time, faded with it.

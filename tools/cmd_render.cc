@@ -17,42 +17,20 @@
 #include "render/scene_renderer.h"
 #include "render/start_scene.h"
 #include "tools/command_registry.h"
+#include "tools/picture_options.h"
 #include "tools/plan_file.h"
-#include "tools/png_path.h"
 
 namespace kinograph::tools {
 namespace {
 
-struct RenderArgs {
+struct RenderArgs : PictureArgs {
   std::string plan;
   std::string compare;
   std::string scene;
-  std::string out = "strip.png";
-  std::string style = "strip";
   std::string ee_frame;
   std::string before_label = "before: grey poses, green path";
   std::string after_label = "after: robot colours, red path";
-  int frames = 5;
-  int width = 1600;
-  int height = 400;
-  int samples = 4;
-  bool no_labels = false;
-  bool no_floor = false;
 };
-
-render::SceneRenderer make_renderer(const RenderArgs& args) {
-  return render::SceneRenderer(render::RendererOptions{.samples = args.samples});
-}
-
-render::FrameOptions frame_options(const RenderArgs& args, int frames) {
-  render::FrameOptions options;
-  options.frames = frames;
-  options.width = args.width;
-  options.height = args.height;
-  options.labels = !args.no_labels;
-  options.floor = !args.no_floor;
-  return options;
-}
 
 // A scene file's start pose among its obstacles, or a URDF's robot at rest: one picture.
 void render_still(const RenderArgs& args, const std::string& extension) {
@@ -76,8 +54,7 @@ void render_still(const RenderArgs& args, const std::string& extension) {
 void run_render(const RenderArgs& args) {
   const auto start = std::chrono::steady_clock::now();
   const std::string extension = std::filesystem::path(args.plan).extension().string();
-  if (extension != ".json" && extension != ".yaml" && extension != ".yml" &&
-      extension != ".urdf") {
+  if (extension != ".json" && extension != ".yaml" && extension != ".yml" && extension != ".urdf") {
     throw CommandFailure(args.plan + ": not a plan (.json), scene (.yaml) or robot (.urdf)");
   }
   try {
@@ -141,25 +118,13 @@ const bool kRegistered = register_command([](CLI::App& root) {
   cmd->add_option("--scene", args->scene,
                   "Scene file (YAML) whose optional 'camera' block (eye, target, up, fov_y_deg) "
                   "replaces the automatic framing; default: the scene the plan file names");
-  cmd->add_option("--frames", args->frames, "Number of robot poses, evenly spaced in time")
-      ->capture_default_str();
-  cmd->add_option("--style", args->style, "strip (side by side) or ghost (one overlaid view)")
-      ->check(CLI::IsMember({"strip", "ghost"}))
-      ->capture_default_str();
-  cmd->add_option("--width", args->width, "Picture width, pixels")->capture_default_str();
-  cmd->add_option("--height", args->height, "Picture height, pixels")->capture_default_str();
-  cmd->add_option("--out", args->out, "Output picture (.png)")
-      ->check(png_path())
-      ->capture_default_str();
+  add_picture_options(cmd, *args);
   cmd->add_option("--ee-frame", args->ee_frame,
                   "Frame whose path a ghost overlay draws (default: the model's last frame)");
   cmd->add_option("--before-label", args->before_label, "Legend line of the plan (--compare)")
       ->capture_default_str();
   cmd->add_option("--after-label", args->after_label, "Legend line of the --compare plan")
       ->capture_default_str();
-  cmd->add_option("--samples", args->samples, "MSAA samples per pixel")->capture_default_str();
-  cmd->add_flag("--no-labels", args->no_labels, "Leave out the time labels and the legend");
-  cmd->add_flag("--no-floor", args->no_floor, "Leave out the checker floor / backdrop");
   cmd->callback([args] { run_render(*args); });
 });
 

@@ -17,6 +17,7 @@
 #include "kinograph/planning/io/data_dir.h"
 #include "kinograph/planning/io/number_text.h"
 #include "kinograph/planning/io/srdf.h"
+#include "kinograph/planning/io/yaml_reader.h"
 
 namespace kinograph::planning {
 namespace {
@@ -33,148 +34,9 @@ std::string format_error(const std::string& file, const std::string& key, int li
   return os.str();
 }
 
-// 1-based line of a node, 0 when yaml-cpp has no mark for it.
-int line_of(const YAML::Node& node) {
-  if (!node.IsDefined()) return 0;
-  const YAML::Mark mark = node.Mark();
-  return mark.is_null() ? 0 : mark.line + 1;
-}
-
-std::string join(const std::string& parent, const std::string& key) {
-  return parent.empty() ? key : parent + "." + key;
-}
-
-std::string index_key(const std::string& parent, std::size_t i) {
-  return parent + "[" + std::to_string(i) + "]";
-}
-
-// Reads typed values out of YAML nodes, naming the file, key path and line on every error.
-class Reader {
- public:
-  explicit Reader(std::string file) : file_(std::move(file)) {}
-
-  [[noreturn]] void fail(const YAML::Node& node, const std::string& key,
-                         const std::string& message) const {
-    throw SceneError(file_, key, line_of(node), message);
-  }
-
-  // Requires a map whose keys are all in `allowed`.
-  void expect_map(const YAML::Node& node, const std::string& key,
-                  std::initializer_list<const char*> allowed) const {
-    if (!node.IsMap()) fail(node, key, "must be a map");
-    std::set<std::string> seen;
-    for (const auto& entry : node) {
-      if (!entry.first.IsScalar()) fail(entry.first, key, "has a key that is not a string");
-      const std::string name = entry.first.Scalar();
-      if (!seen.insert(name).second) fail(entry.first, join(key, name), "duplicate key");
-      bool known = false;
-      for (const char* a : allowed) known = known || name == a;
-      if (!known) {
-        std::string list;
-        for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
-        fail(entry.first, join(key, name), "unknown key (expected one of: " + list + ")");
-      }
-    }
-  }
-
-  // The child `name` of map `parent`; fails naming the key if it is missing.
-  YAML::Node required(const YAML::Node& parent, const std::string& parent_key,
-                      const std::string& name) const {
-    const YAML::Node child = parent[name];
-    if (!child) fail(parent, join(parent_key, name), "missing required key");
-    return child;
-  }
-
-  double number(const YAML::Node& node, const std::string& key) const {
-    if (!node.IsScalar()) fail(node, key, "must be a number");
-    const std::string text = node.Scalar();
-    const std::optional<double> value = parse_number_text(text);  // angles may use pi
-    if (!value) fail(node, key, "must be a number, got '" + text + "'");
-    if (std::isnan(*value)) fail(node, key, "must not be NaN");
-    return *value;
-  }
-
-  double positive(const YAML::Node& node, const std::string& key) const {
-    const double v = number(node, key);
-    if (!(v > 0) || !std::isfinite(v)) fail(node, key, "must be a positive finite number");
-    return v;
-  }
-
-  double non_negative(const YAML::Node& node, const std::string& key) const {
-    const double v = number(node, key);
-    if (!(v >= 0) || !std::isfinite(v)) fail(node, key, "must be a finite number >= 0");
-    return v;
-  }
-
-  double finite(const YAML::Node& node, const std::string& key) const {
-    const double v = number(node, key);
-    if (!std::isfinite(v)) fail(node, key, "must be finite");
-    return v;
-  }
-
-  int integer(const YAML::Node& node, const std::string& key) const {
-    int value = 0;
-    if (!node.IsScalar() || !YAML::convert<int>::decode(node, value)) {
-      fail(node, key, "must be an integer");
-    }
-    return value;
-  }
-
-  bool boolean(const YAML::Node& node, const std::string& key) const {
-    bool value = false;
-    if (!node.IsScalar() || !YAML::convert<bool>::decode(node, value)) {
-      fail(node, key, "must be true or false");
-    }
-    return value;
-  }
-
-  std::string string(const YAML::Node& node, const std::string& key) const {
-    if (!node.IsScalar() || node.Scalar().empty()) fail(node, key, "must be a non-empty string");
-    return node.Scalar();
-  }
-
-  // A list of finite numbers; `size` < 0 accepts any length.
-  Eigen::VectorXd vector(const YAML::Node& node, const std::string& key, int size) const {
-    if (!node.IsSequence()) fail(node, key, "must be a list of numbers");
-    if (size >= 0 && static_cast<int>(node.size()) != size) {
-      fail(node, key,
-           "must have " + std::to_string(size) + " numbers, has " + std::to_string(node.size()));
-    }
-    Eigen::VectorXd v(node.size());
-    for (std::size_t i = 0; i < node.size(); ++i) v[i] = finite(node[i], index_key(key, i));
-    return v;
-  }
-
-  Eigen::Vector3d vector3(const YAML::Node& node, const std::string& key) const {
-    return vector(node, key, 3);
-  }
-
-  // Rotation from `rpy` (URDF fixed-axis roll, pitch, yaw: R = Rz Ry Rx) or `quaternion`
-  // [w, x, y, z]; nullopt when neither is given; both at once is an error.
-  std::optional<Eigen::Matrix3d> rotation(const YAML::Node& map, const std::string& key) const {
-    const YAML::Node rpy = map["rpy"], quat = map["quaternion"];
-    if (rpy && quat) fail(quat, join(key, "quaternion"), "give either rpy or quaternion, not both");
-    if (rpy) {
-      const Eigen::Vector3d a = vector3(rpy, join(key, "rpy"));
-      return (Eigen::AngleAxisd(a.z(), Eigen::Vector3d::UnitZ()) *
-              Eigen::AngleAxisd(a.y(), Eigen::Vector3d::UnitY()) *
-              Eigen::AngleAxisd(a.x(), Eigen::Vector3d::UnitX()))
-          .toRotationMatrix();
-    }
-    if (quat) {
-      const Eigen::VectorXd q = vector(quat, join(key, "quaternion"), 4);
-      Eigen::Quaterniond r(q[0], q[1], q[2], q[3]);
-      if (r.norm() < 1e-9) fail(quat, join(key, "quaternion"), "must not be zero");
-      return r.normalized().toRotationMatrix();
-    }
-    return std::nullopt;
-  }
-
-  const std::string& file() const { return file_; }
-
- private:
-  std::string file_;
-};
+using yaml::index_key;
+using yaml::join;
+using yaml::Reader;
 
 std::string anchor_of(const std::string& source) {
   if (source.empty()) return fs::current_path().string();
@@ -190,7 +52,8 @@ Eigen::Isometry3d make_pose(const Eigen::Vector3d& position, const Eigen::Matrix
 
 class SceneParser {
  public:
-  explicit SceneParser(std::string source) : r_(source), source_(std::move(source)) {
+  explicit SceneParser(std::string source, yaml::KeyPathMap key_path = {})
+      : r_(source, std::move(key_path)), source_(std::move(source)) {
     anchor_ = anchor_of(source_);
   }
 
@@ -723,6 +586,11 @@ Scene parse_scene(const std::string& yaml, const std::string& source) {
                      "not valid YAML: " + e.msg);
   }
   return SceneParser(source).parse(root);
+}
+
+Scene yaml::parse_scene_tree(const YAML::Node& root, const std::string& source,
+                             KeyPathMap key_path) {
+  return SceneParser(source, std::move(key_path)).parse(root);
 }
 
 Scene load_scene(const std::string& path) {
