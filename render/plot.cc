@@ -258,7 +258,7 @@ Image plot_torques(const std::vector<PlotSeries>& series, const TorquePlotOption
                                  : fmt::format("joint {}", j + 1);
     cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
     text(cr, name, 0.5 * (x0 + x1), y0 - 20, 13, 0.5, 0);
-    text(cr, "t [s]", x1, y1 + 22, 11, 1.0, 0);
+    text(cr, options.x_label, x1, y1 + 22, 11, 1.0, 0);
     cairo_save(cr);
     cairo_move_to(cr, x0 - 52, 0.5 * (y0 + y1));
     cairo_rotate(cr, -std::numbers::pi / 2);
