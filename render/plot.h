@@ -24,7 +24,7 @@ struct TorquePlotOptions {
   int columns = 0;  ///< subplot columns; 0: 1 for up to 3 joints, else 2
   std::string title = "Joint torques";
   std::string y_label = "\u03c4 [N\u00b7m]";
-  std::string x_label = "t [s]";  ///< under the bottom row of subplots
+  std::string x_label = "t [s]";  ///< under each subplot's axis (e.g. "steps" for a scaling plot)
   std::vector<std::string> joint_names;  ///< subplot titles; "joint i" when empty
   /// ±limit per joint, dashed within the axes, else named at the edge; inf or empty = none
   std::vector<double> limits;

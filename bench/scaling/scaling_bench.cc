@@ -4,6 +4,7 @@
 // one iteration should cost time linear in the steps).
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -18,18 +19,61 @@
 #include "bench/common/cpu_clock.h"
 #include "kinograph/planning/batch/batch_planner.h"
 #include "kinograph/planning/io/scene.h"
+#include "render/image.h"
+#include "render/plot.h"
 
 using nlohmann::json;
 namespace planning = kinograph::planning;
 
 namespace {
 
-std::vector<int> parse_list(const std::string& text) {
-  std::vector<int> out;
+std::vector<std::string> split(const std::string& text) {
+  std::vector<std::string> out;
   std::stringstream ss(text);
-  for (std::string item; std::getline(ss, item, ',');) out.push_back(std::stoi(item));
+  for (std::string item; std::getline(ss, item, ',');) out.push_back(item);
   if (out.empty()) throw std::invalid_argument(text);
   return out;
+}
+
+std::vector<int> parse_list(const std::string& text) {
+  std::vector<int> out;
+  for (const std::string& item : split(text)) out.push_back(std::stoi(item));
+  return out;
+}
+
+bool wanted(const std::vector<std::string>& names, const std::string& name) {
+  return names.empty() || std::find(names.begin(), names.end(), name) != names.end();
+}
+
+// CPU per iteration against steps: one subplot per robot, one curve per formulation, over the
+// steps at which every robot's plan iterated.
+void write_plot(const json& result, const std::vector<std::string>& robots,
+                const std::vector<std::string>& formulations, const std::string& path) {
+  std::vector<kinograph::render::PlotSeries> series;
+  for (const std::string& f : formulations) {
+    kinograph::render::PlotSeries s;
+    s.label = f;
+    const std::vector<int> steps = result["steps"].get<std::vector<int>>();
+    for (size_t i = 0; i < steps.size(); ++i) {
+      Eigen::VectorXd v(static_cast<Eigen::Index>(robots.size()));
+      for (size_t r = 0; r < robots.size(); ++r) {
+        v[static_cast<Eigen::Index>(r)] =
+            kinograph::bench::json_number(result[robots[r]][f][i]["cpu_ms_per_iteration"]);
+      }
+      if (!v.allFinite()) continue;
+      s.t.push_back(steps[i]);
+      s.values.push_back(v);
+    }
+    if (!s.t.empty()) series.push_back(std::move(s));
+  }
+  if (series.empty()) return;
+  kinograph::render::TorquePlotOptions options;
+  options.title = "CPU per LM iteration against the number of steps";
+  options.y_label = "ms per iteration";
+  options.x_label = "steps";
+  options.joint_names = robots;
+  options.columns = static_cast<int>(robots.size());
+  kinograph::render::write_png(kinograph::render::plot_torques(series, options), path);
 }
 
 /// y ≈ a + b·x by least squares, with R².
@@ -63,11 +107,16 @@ Line fit(const std::vector<double>& x, const std::vector<double>& y) {
 
 int main(int argc, char** argv) {
   std::vector<int> steps = {25, 50, 100, 200, 400, 1000};
-  std::string json_path;
+  std::string json_path, png_path;
+  std::vector<std::string> only_robots, only_formulations;
   bool quick = false;
   kinograph::bench::Flags flags("scaling_bench");
   flags.value("--steps", "N,N,...", [&](const std::string& v) { steps = parse_list(v); })
       .value("--json", &json_path)
+      .value("--png", &png_path)
+      .value("--robots", "iiwa,acrobot", [&](const std::string& v) { only_robots = split(v); })
+      .value("--formulations", "condensed,dfg",
+             [&](const std::string& v) { only_formulations = split(v); })
       .toggle("--quick", [&] { quick = true; });
   if (!flags.parse(argc, argv)) return 64;
   if (quick) steps = {25, 50, 100};
@@ -83,9 +132,14 @@ int main(int argc, char** argv) {
       "|\n");
   std::printf("|---|---|---|---|---|---|---|\n");
   json fits = json::array();
+  std::vector<std::string> plotted_robots, plotted_formulations;
   for (const auto& [robot, scene_file] : robots) {
+    if (!wanted(only_robots, robot)) continue;
+    plotted_robots.push_back(robot);
     const planning::Scene scene = planning::load_scene(kinograph::bench::kScenes + scene_file);
     for (const planning::Formulation f : formulations) {
+      if (!wanted(only_formulations, to_string(f))) continue;
+      if (plotted_robots.size() == 1) plotted_formulations.push_back(to_string(f));
       planning::BatchPlannerOptions options;
       options.formulation = f;
       const planning::BatchPlanner planner(options);
@@ -135,5 +189,6 @@ int main(int argc, char** argv) {
                 kinograph::bench::json_number(f["r2"]));
   }
   if (!json_path.empty()) std::ofstream(json_path) << result.dump(2) << "\n";
+  if (!png_path.empty()) write_plot(result, plotted_robots, plotted_formulations, png_path);
   return 0;
 }

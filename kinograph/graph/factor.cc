@@ -113,7 +113,8 @@ bool all_finite(const Eigen::Ref<const Eigen::MatrixXd>& M) {
   return std::isfinite((M.array() * 0.0).sum());
 }
 
-int compact_nonzero_rows(Eigen::Ref<Eigen::MatrixXd> J, Eigen::Ref<Eigen::VectorXd> r) {
+int compact_nonzero_rows(Eigen::Ref<Eigen::MatrixXd> J, Eigen::Ref<Eigen::VectorXd> r,
+                         bool* finite) {
   // J is column-major: rows are found and moved column by column, never by strided row scans.
   // A row of finite entries is all zero exactly when the sum of its magnitudes is zero.
   const Eigen::Index m = J.rows();
@@ -123,6 +124,12 @@ int compact_nonzero_rows(Eigen::Ref<Eigen::MatrixXd> J, Eigen::Ref<Eigen::Vector
   auto mag = magnitude.head(m);
   mag.setZero();
   for (Eigen::Index c = 0; c < J.cols(); ++c) mag += J.col(c).array().abs();
+  if (finite != nullptr) {
+    // A NaN or ±inf entry makes its row's magnitude non-finite; only an overflowing sum of
+    // finite entries needs the exact test.
+    *finite = mag.allFinite() || all_finite(J);
+    if (!*finite) return static_cast<int>(m);
+  }
   rows.clear();
   for (Eigen::Index i = 0; i < m; ++i) {
     if (mag[i] != 0) rows.push_back(i);

@@ -126,7 +126,10 @@ bool all_finite(const Eigen::Ref<const Eigen::MatrixXd>& M);
 /// from its bound) are exactly zero and add nothing to JᵀJ or Jᵀr; a collision factor has a row
 /// per (link, obstacle) pair and usually one or none active, so products over the kept rows
 /// skip most of the work. Order of the kept rows is preserved.
-int compact_nonzero_rows(Eigen::Ref<Eigen::MatrixXd> J, Eigen::Ref<Eigen::VectorXd> r);
+/// With `finite` non-null it also says whether every entry of J is finite, from the same pass
+/// (then J and r are left as they were when it is false).
+int compact_nonzero_rows(Eigen::Ref<Eigen::MatrixXd> J, Eigen::Ref<Eigen::VectorXd> r,
+                         bool* finite = nullptr);
 
 /// H = JᵀJ of a factor's (kept) Jacobian rows. From 16 columns on (GP prior, collocation) a
 /// symmetric rank update, half the flops of the product (21×42: 3.1 instead of 4.4 µs); below,

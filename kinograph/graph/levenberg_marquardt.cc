@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "kinograph/graph/cancellation.h"
+#include "kinograph/graph/envelope_cholesky.h"
 #include "kinograph/graph/normal_equations.h"
 
 namespace kinograph::graph {
@@ -42,6 +43,14 @@ LevenbergMarquardt::~LevenbergMarquardt() = default;
 LevenbergMarquardt::LevenbergMarquardt(LevenbergMarquardt&&) noexcept = default;
 LevenbergMarquardt& LevenbergMarquardt::operator=(LevenbergMarquardt&&) noexcept = default;
 
+const SparseCholesky* LevenbergMarquardt::cholesky() const {
+  return dynamic_cast<const SparseCholesky*>(cholesky_.get());
+}
+
+bool LevenbergMarquardt::uses_envelope() const {
+  return dynamic_cast<const EnvelopeCholesky*>(cholesky_.get()) != nullptr;
+}
+
 void LevenbergMarquardt::set_options(const LevenbergMarquardtOptions& options) {
   if (options.ordering != options_.ordering || options.factorization != options_.factorization) {
     equations_.reset();
@@ -68,18 +77,37 @@ OptimizationResult LevenbergMarquardt::optimize(const FactorGraph& graph, Values
 void LevenbergMarquardt::prepare(const FactorGraph& graph, const Values& values, Solve& s) {
   const LevenbergMarquardtOptions& o = options_;
   if (!equations_ || !equations_->matches(graph, values)) {
-    cholesky_.reset();
-    equations_ = std::make_unique<NormalEquations>(graph, values, o.ordering);
-    if (equations_->dim() > 0) {
-      cholesky_ = std::make_unique<SparseCholesky>(equations_->dim(), equations_->col_ptr(),
-                                                   equations_->row_idx(), o.factorization);
-    }
+    build_structure(graph, values);
     s.result.symbolic_s = seconds_since(s.t_start);
   }
   if (o.linearize_at_evaluation && (!candidate_ || !candidate_->matches(graph, values))) {
     candidate_ = std::make_unique<NormalEquations>(*equations_);
   }
   if (o.record_history) s.result.history.reserve(std::min(o.max_iterations, 64) * 2);
+}
+
+// The pattern of H and its factorization: the envelope in natural order when asked or when it
+// wins (kAuto), else CHOLMOD in the options' ordering.
+void LevenbergMarquardt::build_structure(const FactorGraph& graph, const Values& values) {
+  const LevenbergMarquardtOptions& o = options_;
+  cholesky_.reset();
+  equations_.reset();
+  if (o.factorization == Factorization::kAuto || o.factorization == Factorization::kEnvelope) {
+    auto natural = std::make_unique<NormalEquations>(graph, values, OrderingMethod::kNatural);
+    const int n = natural->dim();
+    if (n > 0 && (o.factorization == Factorization::kEnvelope ||
+                  EnvelopeCholesky::wins(n, natural->col_ptr(), natural->row_idx()))) {
+      cholesky_ = std::make_unique<EnvelopeCholesky>(n, natural->col_ptr(), natural->row_idx());
+      equations_ = std::move(natural);
+      return;
+    }
+    if (o.ordering == OrderingMethod::kNatural) equations_ = std::move(natural);
+  }
+  if (!equations_) equations_ = std::make_unique<NormalEquations>(graph, values, o.ordering);
+  if (equations_->dim() > 0) {
+    cholesky_ = std::make_unique<SparseCholesky>(equations_->dim(), equations_->col_ptr(),
+                                                 equations_->row_idx(), o.factorization);
+  }
 }
 
 // Linearizes at the start point, where the solve may already end, and sets up damping.

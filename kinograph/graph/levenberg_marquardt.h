@@ -44,7 +44,8 @@ struct LevenbergMarquardtOptions {
   double step_tol = 1e-14;
   /// Elimination order of the variables, which sets the fill of the Cholesky factor.
   OrderingMethod ordering = OrderingMethod::kAmd;
-  /// Supernodal or simplicial CHOLMOD factorization (kAuto: CHOLMOD decides).
+  /// How H + λD is factorized (kAuto: the envelope in natural order when it adds little fill,
+  /// as for a trajectory, else CHOLMOD's choice in `ordering`).
   Factorization factorization = Factorization::kAuto;
   /// Take Jacobians at every trial point, so an accepted step is not linearized a second time.
   bool linearize_at_evaluation = true;
@@ -73,9 +74,11 @@ class LevenbergMarquardt {
   const LevenbergMarquardtOptions& options() const { return options_; }
   /// Changing ordering or factorization forces a rebuild on the next optimize().
   void set_options(const LevenbergMarquardtOptions& options);
-  /// The cached CHOLMOD factorization (null before the first solve), e.g. to see which form
-  /// kAuto chose.
-  const SparseCholesky* cholesky() const { return cholesky_.get(); }
+  /// The cached CHOLMOD factorization (null before the first solve or when the envelope
+  /// factorization is used), e.g. to see which form kAuto chose.
+  const SparseCholesky* cholesky() const;
+  /// Whether the last solve factorized H within its envelope (EnvelopeCholesky).
+  bool uses_envelope() const;
 
  private:
   struct Solve;  // one optimize() call's state
@@ -84,6 +87,7 @@ class LevenbergMarquardt {
   // The steps of optimize(); those returning bool return true once the solve has ended (status
   // and reason set by finish()).
   void prepare(const FactorGraph& graph, const Values& values, Solve& s);
+  void build_structure(const FactorGraph& graph, const Values& values);
   bool start(const FactorGraph& graph, const Values& values, Solve& s);
   void update_damping(Solve& s) const;
   bool run_trial(const FactorGraph& graph, Values& values, Solve& s);
@@ -101,7 +105,7 @@ class LevenbergMarquardt {
   LevenbergMarquardtOptions options_;
   std::unique_ptr<NormalEquations> equations_;
   std::unique_ptr<NormalEquations> candidate_;  // linearized at the trial step
-  std::unique_ptr<SparseCholesky> cholesky_;
+  std::unique_ptr<CholeskyFactor> cholesky_;  // SparseCholesky or EnvelopeCholesky
 };
 
 }  // namespace kinograph::graph

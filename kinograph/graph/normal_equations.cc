@@ -266,14 +266,16 @@ bool NormalEquations::run(const FactorGraph& graph, const Values& values, double
       const bool kept = cache != nullptr && cache->version == version;
       Eigen::Ref<Eigen::MatrixXd> J = J_.topLeftCorner(m, nc);
       f.whitened(x_ptrs_.data(), r, kept ? nullptr : &J);
-      const bool r_ok = r.allFinite();
-      if (!r_ok || (!kept && !all_finite(J))) {
+      const auto non_finite = [&](const char* what) {
         if (reason) {
           *reason = "factor " + std::to_string(info.slot) + " (" + f.name() +
-                    ") has a non-finite " + (r_ok ? "Jacobian" : "residual");
+                    ") has a non-finite " + what;
         }
         return false;
-      }
+      };
+      if (!r.allFinite()) return non_finite("residual");
+      // A factor that adds to H learns whether J is finite from the row compaction below.
+      if (!kept && info.num_pairs == 0 && !all_finite(J)) return non_finite("Jacobian");
       total += 0.5 * r.squaredNorm();
       if (info.num_pairs == 0) continue;
       auto Jtr = Jtr_.head(nc);
@@ -285,7 +287,9 @@ bool NormalEquations::run(const FactorGraph& graph, const Values& values, double
         stride = cache->JtJ.outerStride();
       } else {
         if (cache != nullptr) cache->J = J;  // before the compaction reorders its rows
-        const int active = compact_nonzero_rows(J, r);
+        bool finite = true;
+        const int active = compact_nonzero_rows(J, r, &finite);
+        if (!finite) return non_finite("Jacobian");
         if (active == 0) continue;  // e.g. a collision factor with every pair clear
         const auto Ja = J.topRows(active);
         auto JtJ = JtJ_.topLeftCorner(nc, nc);

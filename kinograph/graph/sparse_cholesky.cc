@@ -16,6 +16,8 @@ std::string to_string(Factorization f) {
       return "supernodal";
     case Factorization::kSimplicial:
       return "simplicial";
+    case Factorization::kEnvelope:
+      return "envelope";
   }
   return "unknown";
 }
@@ -45,6 +47,7 @@ SparseCholesky::SparseCholesky(int n, const std::vector<int>& col_ptr,
       common_->supernodal = CHOLMOD_SUPERNODAL;
       break;
     case Factorization::kSimplicial:
+    case Factorization::kEnvelope:  // not CHOLMOD's; a caller that falls back gets simplicial
       common_->supernodal = CHOLMOD_SIMPLICIAL;
       break;
   }

@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "kinograph/graph/cholesky_factor.h"
+
 struct cholmod_common_struct;
 struct cholmod_sparse_struct;
 struct cholmod_factor_struct;
@@ -12,17 +14,20 @@ struct cholmod_dense_struct;
 
 namespace kinograph::graph {
 
-/// Supernodal or simplicial Cholesky. kAuto leaves the choice to CHOLMOD's flop-count rule
-/// (supernodal when the average flops per nonzero of L is at least 40), which picks simplicial
-/// for small banded systems such as a planning horizon.
-enum class Factorization { kAuto, kSupernodal, kSimplicial };
+/// How H is factorized. kSupernodal and kSimplicial are CHOLMOD's two forms in the solver's
+/// ordering. kEnvelope is a dense LLᵀ within the envelope of H in the variables' natural (slot)
+/// order (EnvelopeCholesky), which suits trajectory graphs stored in time order. kAuto (used by
+/// LevenbergMarquardt) takes the envelope when it adds little fill to H in that order
+/// (envelope_wins), else CHOLMOD's own flop-count rule (supernodal when the average flops per
+/// nonzero of L is at least 40).
+enum class Factorization { kAuto, kSupernodal, kSimplicial, kEnvelope };
 
-/// "auto", "supernodal", "simplicial".
+/// "auto", "supernodal", "simplicial", "envelope".
 std::string to_string(Factorization f);
 
 /// A CHOLMOD factorization of an n×n SPD matrix A given as its upper triangle in compressed
 /// columns (sorted row indices). The caller writes values() and calls factorize().
-class SparseCholesky {
+class SparseCholesky final : public CholeskyFactor {
  public:
   /// Copies the pattern and runs the symbolic analysis with the natural order (the caller orders
   /// the matrix already). Throws std::runtime_error if CHOLMOD fails to analyze.
@@ -33,17 +38,17 @@ class SparseCholesky {
   SparseCholesky& operator=(const SparseCholesky&) = delete;
 
   /// Numerical values of A's upper triangle, in pattern order.
-  double* values();
+  double* values() override;
   int nnz() const { return static_cast<int>(row_idx_.size()); }
   int rows() const { return n_; }
 
   /// Numeric factorization of the current values. False if A is not positive definite; then
   /// failed_column() is the column where it broke down.
-  bool factorize();
-  int failed_column() const { return failed_column_; }
+  bool factorize() override;
+  int failed_column() const override { return failed_column_; }
   /// Solves A x = b with the last factorization. Allocation-free for the simplicial form; CHOLMOD's
   /// supernodal factorization and solve allocate internally on every call.
-  void solve(const Eigen::Ref<const Eigen::VectorXd>& b, Eigen::Ref<Eigen::VectorXd> x);
+  void solve(const Eigen::Ref<const Eigen::VectorXd>& b, Eigen::Ref<Eigen::VectorXd> x) override;
 
   /// Whether CHOLMOD chose (or was told) the supernodal form, and nnz(L).
   bool is_supernodal() const;

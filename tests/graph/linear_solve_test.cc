@@ -114,13 +114,18 @@ TEST(LinearSolve, GaussNewtonEqualsDenseQrForEveryOrderingAndFactorization) {
 TEST(LinearSolve, LevenbergMarquardtEqualsDenseQr) {
   auto p = random_linear(80, 2);
   const Eigen::VectorXd expected = p.A.colPivHouseholderQr().solve(p.b);
+  for (auto fact : {Factorization::kAuto, Factorization::kSimplicial, Factorization::kEnvelope})
   for (auto damping : {Damping::kDiagonal, Damping::kIdentity}) {
     Values v = p.values;
     LevenbergMarquardtOptions o;
     o.damping = damping;
+    o.factorization = fact;
     o.relative_error_tol = 0;  // run to the step tolerance
     o.step_tol = 1e-13;
-    const auto result = LevenbergMarquardt(o).optimize(p.graph, v);
+    LevenbergMarquardt lm(o);
+    const auto result = lm.optimize(p.graph, v);
+    // The chain is banded in slot order, so kAuto takes the envelope too.
+    EXPECT_EQ(lm.uses_envelope(), fact != Factorization::kSimplicial) << to_string(fact);
     EXPECT_TRUE(result.converged()) << result.reason;
     EXPECT_LT((v.vector() - expected).norm(), 1e-10 * expected.norm());
     EXPECT_NEAR(result.final_error, 0.5 * (p.A * expected - p.b).squaredNorm(),

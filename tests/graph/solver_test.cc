@@ -28,8 +28,8 @@ TEST(Solver, EveryOrderingAndFactorizationGivesTheSameSolution) {
   Eigen::VectorXd reference;
   for (auto ordering : {OrderingMethod::kNatural, OrderingMethod::kAmd, OrderingMethod::kColamd,
                         OrderingMethod::kMetis}) {
-    for (auto fact :
-         {Factorization::kAuto, Factorization::kSupernodal, Factorization::kSimplicial}) {
+    for (auto fact : {Factorization::kAuto, Factorization::kSupernodal, Factorization::kSimplicial,
+                      Factorization::kEnvelope}) {
       LevenbergMarquardtOptions o;
       o.ordering = ordering;
       o.factorization = fact;
@@ -182,10 +182,13 @@ TEST(Solver, LinearizingTrialStepsChangesNothingButTheWork) {
 TEST(Solver, LevenbergMarquardtIteratesArePinned) {
   // Exact on purpose: the guard for LM's arithmetic, where any reordering of its floating-point
   // operations moves the last bits. Re-record only for an intended change of the algorithm.
+  // CHOLMOD's simplicial factorization; the default (the envelope, for these banded problems)
+  // is pinned below.
   const auto p = problems::curve_fit();  // rejects three steps first: both branches run
   for (bool linearize : {true, false}) {
     LevenbergMarquardtOptions o;
     o.linearize_at_evaluation = linearize;
+    o.factorization = Factorization::kSimplicial;
     Values v = p.start;
     const OptimizationResult r = LevenbergMarquardt(o).optimize(p.graph, v);
     std::string accepted;
@@ -200,11 +203,35 @@ TEST(Solver, LevenbergMarquardtIteratesArePinned) {
   }
   const auto chain = problems::chain(60);
   Values v = chain.start;
-  const OptimizationResult r = LevenbergMarquardt().optimize(chain.graph, v);
+  LevenbergMarquardtOptions simplicial;
+  simplicial.factorization = Factorization::kSimplicial;
+  const OptimizationResult r = LevenbergMarquardt(simplicial).optimize(chain.graph, v);
   EXPECT_EQ(r.iterations, 7);
   EXPECT_EQ(r.trials, 7);
   EXPECT_EQ(r.final_error, 0x1.5552aceacc7b2p+5);
   EXPECT_EQ(r.lambda, 0x1.32da800a30412p-18);
+  // The default factorization of both problems (EnvelopeCholesky).
+  for (bool linearize : {true, false}) {
+    LevenbergMarquardtOptions o;
+    o.linearize_at_evaluation = linearize;
+    Values w = p.start;
+    LevenbergMarquardt lm(o);
+    const OptimizationResult e = lm.optimize(p.graph, w);
+    EXPECT_TRUE(lm.uses_envelope());
+    EXPECT_EQ(e.iterations, 8);
+    EXPECT_EQ(e.trials, 11);
+    EXPECT_EQ(e.final_error, 0x1.4bffb412f2263p+0);
+    EXPECT_EQ(e.lambda, 0x1.32d9ccb1ec24bp-12);
+    EXPECT_EQ(w.vector(), Eigen::Vector2d(0x1.3f160b151c444p-2, 0x1.0a2d5971557fbp-4));
+  }
+  Values w = chain.start;
+  LevenbergMarquardt lm;
+  const OptimizationResult e = lm.optimize(chain.graph, w);
+  EXPECT_TRUE(lm.uses_envelope());
+  EXPECT_EQ(e.iterations, 7);
+  EXPECT_EQ(e.trials, 7);
+  EXPECT_EQ(e.final_error, 0x1.5552aceacc7b2p+5);
+  EXPECT_EQ(e.lambda, 0x1.32da800a30412p-18);
 }
 
 // First trial step on ½((x − 1)/0.1)² from x = 0, where H = 100 and g = −100: the step

@@ -109,6 +109,18 @@ TEST(TorquePlot, AxesSpanTheDataNotALimitFarBeyond) {
             red + 300);  // within the data: both dashed lines
 }
 
+// The x label is the caller's: a scaling plot says "steps", not the default "t [s]".
+TEST(TorquePlot, XLabelIsAnOption) {
+  TorquePlotOptions options;
+  options.width = 600;
+  const PlotSeries series = sine_series("batch", 30, 1);
+  EXPECT_EQ(options.x_label, "t [s]");
+  const Image time_axis = plot_torques({series}, options);
+  EXPECT_EQ(plot_torques({series}, options).rgba, time_axis.rgba);  // deterministic
+  options.x_label = "steps";
+  EXPECT_NE(plot_torques({series}, options).rgba, time_axis.rgba);
+}
+
 TEST(TorquePlot, BadInputIsAClearError) {
   EXPECT_THROW(plot_torques({}), std::invalid_argument);
   PlotSeries empty;

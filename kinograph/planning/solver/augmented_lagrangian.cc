@@ -45,16 +45,41 @@ ConstraintReport AugmentedLagrangian::report(const graph::Values& values) const 
 }
 
 double AugmentedLagrangian::update(const graph::Values& values) {
-  double worst = 0;
-  for (size_t i = 0; i < constraints_.size(); ++i) {
-    worst = std::max(worst,
-                     constraints_[i]->constrained->update_multipliers(values, *multipliers_[i]).scaled);
+  return update_unless_within(values, -1).scaled_violation;
+}
+
+ConstraintReport AugmentedLagrangian::update_unless_within(const graph::Values& values,
+                                                           double tolerance) {
+  const bool may_keep = tolerance >= 0;
+  if (may_keep) {
+    saved_.resize(multipliers_.size());
+    for (size_t i = 0; i < multipliers_.size(); ++i) saved_[i] = *multipliers_[i];
   }
-  if (last_violation_ >= 0 && worst > options_.required_decrease * last_violation_) {
+  ConstraintReport r;
+  for (size_t i = 0; i < constraints_.size(); ++i) {
+    const ConstrainedFactor::Violation v =
+        constraints_[i]->constrained->update_multipliers(values, *multipliers_[i]);
+    if (v.scaled > r.scaled_violation) {  // the same choice as worst_constraint
+      r.scaled_violation = v.scaled;
+      r.violation = v.own_units;
+      r.entry = constraints_[i];
+      r.row = v.row;
+      r.value = v.value;
+    }
+  }
+  if (r.entry != nullptr) {
+    const ConstrainedFactor& worst = *r.entry->constrained;
+    r.where = worst.name() + " " + worst.keys().front().to_string();
+  }
+  if (may_keep && r.scaled_violation <= tolerance) {
+    for (size_t i = 0; i < multipliers_.size(); ++i) *multipliers_[i] = saved_[i];
+    return r;
+  }
+  if (last_violation_ >= 0 && r.scaled_violation > options_.required_decrease * last_violation_) {
     state_.set_penalty(std::min(options_.max_penalty, state_.penalty() * options_.penalty_growth));
   }
-  last_violation_ = worst;
-  return worst;
+  last_violation_ = r.scaled_violation;
+  return r;
 }
 
 namespace {
@@ -92,25 +117,26 @@ OuterLoopResult solve_outer_loop(const graph::FactorGraph& graph, graph::Values&
       break;
     }
     const auto t_al = Clock::now();
-    const ConstraintReport worst = al.report(values);
-    spdlog::debug("AL outer {}: mu={:.3g} LM {} its ({}), cost {:.6g}, worst {:.3g} at {}", outer,
-                  al.penalty(), r.iterations, graph::to_string(r.status), r.final_error,
-                  worst.scaled_violation, worst.where);
     // Converged once feasible at the final inner tolerance (the slack absorbs the rounding of
-    // the repeated 10× tightening).
-    if (worst.scaled_violation <= tol && lm_options.relative_error_tol <= tol_final * 1.0001) {
+    // the repeated 10× tightening); otherwise the multipliers move, from the same evaluation.
+    const double mu = al.penalty();
+    const bool final_tolerance = lm_options.relative_error_tol <= tol_final * 1.0001;
+    const ConstraintReport worst = al.update_unless_within(values, final_tolerance ? tol : -1);
+    spdlog::debug("AL outer {}: mu={:.3g} LM {} its ({}), cost {:.6g}, worst {:.3g} at {}", outer,
+                  mu, r.iterations, graph::to_string(r.status), r.final_error,
+                  worst.scaled_violation, worst.where);
+    al_s += seconds_since(t_al);
+    if (final_tolerance && worst.scaled_violation <= tol) {
       out.status = PlanStatus::kConverged;
-      al_s += seconds_since(t_al);
+      out.worst = worst;
       break;
     }
-    al.update(values);
-    al_s += seconds_since(t_al);
     // Feasible: one more solve at the final tolerance settles the objective.
     lm_options.relative_error_tol = worst.scaled_violation <= tol
                                         ? tol_final
                                         : std::max(tol_final, lm_options.relative_error_tol * 0.1);
   }
-  out.worst = al.report(values);
+  if (out.status != PlanStatus::kConverged) out.worst = al.report(values);
   if (out.status == PlanStatus::kInfeasible && out.worst.scaled_violation <= tol) {
     out.status = PlanStatus::kConverged;
   }

@@ -53,6 +53,10 @@ class AugmentedLagrangian {
   /// After an inner solve: λ ← λ + μc on every factor, then μ grows unless the worst scaled
   /// violation fell below required_decrease × the previous one. Returns that violation.
   double update(const graph::Values& values);
+  /// report() and update() from one evaluation of each constraint: the worst row at `values`;
+  /// the multipliers and μ are updated unless its scaled violation is at most `tolerance`
+  /// (then they are left exactly as they were). A negative tolerance always updates.
+  ConstraintReport update_unless_within(const graph::Values& values, double tolerance);
 
  private:
   std::vector<const FactorEntry*> constraints_;
@@ -60,6 +64,7 @@ class AugmentedLagrangian {
   ConstraintState& state_;
   AugmentedLagrangianOptions options_;
   double last_violation_ = -1;
+  std::vector<Multipliers> saved_;  // update_unless_within's copy, reused
 };
 
 /// Limits and tolerances of the outer loop.

@@ -1,0 +1,45 @@
+#pragma once
+// Dense Cholesky LLᵀ inside the envelope (profile) of a symmetric matrix: row j of L is stored
+// from its first nonzero column to the diagonal, and no fill falls outside. For a trajectory
+// graph in time order the envelope is a band of about two states, so the factorization is a
+// sequence of contiguous dot products, several times cheaper than a general sparse one.
+#include <Eigen/Core>
+#include <vector>
+
+#include "kinograph/graph/cholesky_factor.h"
+
+namespace kinograph::graph {
+
+/// LLᵀ of an n×n SPD matrix within its row envelope, in the matrix's own order.
+class EnvelopeCholesky final : public CholeskyFactor {
+ public:
+  /// Takes the pattern of A's upper triangle (compressed columns, sorted row indices, each
+  /// column's diagonal present). Throws std::invalid_argument if a column lacks its diagonal.
+  EnvelopeCholesky(int n, const std::vector<int>& col_ptr, const std::vector<int>& row_idx);
+
+  /// Floating-point multiply-adds of one factorization (Σ over rows of their dot products).
+  static double flops(int n, const std::vector<int>& col_ptr, const std::vector<int>& row_idx);
+
+  double* values() override { return values_.data(); }
+  bool factorize() override;
+  int failed_column() const override { return failed_column_; }
+  void solve(const Eigen::Ref<const Eigen::VectorXd>& b, Eigen::Ref<Eigen::VectorXd> x) override;
+
+  /// Whether the envelope factorization of this pattern costs at most a few times the
+  /// multiply-adds a factorization without any fill would (true for banded patterns).
+  static bool wins(int n, const std::vector<int>& col_ptr, const std::vector<int>& row_idx);
+
+  /// Stored entries of L (the envelope's size).
+  long envelope_size() const { return static_cast<long>(env_.size()); }
+
+ private:
+  int n_;
+  std::vector<int> col_ptr_, row_idx_;
+  std::vector<int> first_;   // row j of L: first stored column
+  std::vector<long> start_;  // row j of L: offset of column first_[j] in env_
+  std::vector<double> values_;  // A's upper triangle, pattern order
+  std::vector<double> env_;     // L by rows within the envelope
+  int failed_column_ = -1;
+};
+
+}  // namespace kinograph::graph
