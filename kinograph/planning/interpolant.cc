@@ -8,9 +8,9 @@
 
 namespace kinograph::planning {
 
-int integration_steps(double dt) {
+int integration_steps(double dt, double max_step) {
   // The small allowance keeps Δt = 0.1 s at 10 steps despite rounding in Δt = horizon/steps.
-  return std::max(1, static_cast<int>(std::ceil(dt / kMaxIntegrationStep - 1e-9)));
+  return std::max(1, static_cast<int>(std::ceil(dt / max_step - 1e-9)));
 }
 
 int limit_points(int requested, double dt) {
@@ -18,8 +18,9 @@ int limit_points(int requested, double dt) {
   return std::max(requested, integration_steps(dt) - 1);
 }
 
-IntervalInterpolant::IntervalInterpolant(const dynamics::Model& model)
-    : model_(model), data_(model) {
+IntervalInterpolant::IntervalInterpolant(const dynamics::Model& model, double max_step)
+    : model_(model), max_step_(max_step), data_(model) {
+  if (!(max_step > 0)) throw std::invalid_argument("interpolant: the RK4 step must be > 0");
   for (int j = 0; j < model.nq(); ++j) {
     (model.bodies[j].actuated ? actuated_ : unactuated_).push_back(j);
   }
@@ -28,7 +29,6 @@ IntervalInterpolant::IntervalInterpolant(const dynamics::Model& model)
   qd0_.setZero(n);
   qdd0_.setZero(n);
   qdd1_.setZero(n);
-  muu_.resize(m, m);
   rhs_.resize(m, 4 * n);
   for (int i = 0; i < 4; ++i) {
     k_[i].resize(2 * m);
@@ -97,10 +97,6 @@ void IntervalInterpolant::point(double s, const Eigen::VectorXd& y, const Eigen:
   p.tau = data_.tau;
   for (int i = 0; i < m; ++i) p.qdd[unactuated_[i]] = data_.qdd[unactuated_[i]];
   if (!derivatives) return;
-  for (int a = 0; a < m; ++a) {
-    for (int b = 0; b < m; ++b) muu_(a, b) = data_.M(unactuated_[a], unactuated_[b]);
-  }
-  llt_.compute(muu_);
   // Implicit function τ_u(q, q̇, q̈_a, q̈_u) = 0: dq̈_u = −M_uu⁻¹(∂τ_u/∂q dq + ∂τ_u/∂q̇ dq̇ +
   // M_ua dq̈_a), where dq̈ holds only the actuated rows so far.
   for (int i = 0; i < m; ++i) {
@@ -109,7 +105,12 @@ void IntervalInterpolant::point(double s, const Eigen::VectorXd& y, const Eigen:
     rhs_.row(i).noalias() += data_.dtau_dqd.row(u) * p.dqd;
     rhs_.row(i).noalias() += data_.M.row(u) * p.dqdd;
   }
-  llt_.solveInPlace(rhs_);
+  // passive_dynamics left M_uu's Cholesky factor in its scratch; one joint divides instead.
+  if (m == 1) {
+    rhs_ /= data_.M(unactuated_[0], unactuated_[0]);
+  } else {
+    data_.scratch.llt_p.solveInPlace(rhs_);
+  }
   for (int i = 0; i < m; ++i) p.dqdd.row(unactuated_[i]) = -rhs_.row(i);
   if (with_tau) {
     p.dtau.noalias() = data_.dtau_dq * p.dq;
@@ -163,7 +164,7 @@ void IntervalInterpolant::start(const Eigen::Ref<const Eigen::VectorXd>& q0,
   qdd1_ = qdd1;
   dt_ = dt;
   derivatives_ = derivatives;
-  steps_ = integration_steps(dt);
+  steps_ = integration_steps(dt, max_step_);
   h_ = dt / steps_;
   if (m == 0) return;
   // Grow-only node storage: intervals of one plan share their step count.

@@ -21,8 +21,8 @@ namespace kinograph::planning {
 /// that integrates the same way reproduces the plan exactly.
 inline constexpr double kMaxIntegrationStep = 0.01;
 
-/// Number of equal RK4 steps over an interval of length dt: ⌈dt / kMaxIntegrationStep⌉, ≥ 1.
-int integration_steps(double dt);
+/// Number of equal RK4 steps over an interval of length dt: ⌈dt / max_step⌉, ≥ 1.
+int integration_steps(double dt, double max_step = kMaxIntegrationStep);
 
 /// Interior points per interval of length dt where limits are enforced and checked: at least
 /// `requested`, and at least one per RK4 node (so never more than kMaxIntegrationStep apart);
@@ -42,8 +42,11 @@ struct InterpolantPoint {
 /// Allocates nothing once it has seen an interval of the same number of RK4 steps.
 class IntervalInterpolant {
  public:
-  /// Borrows `model`, which must outlive this.
-  explicit IntervalInterpolant(const dynamics::Model& model);
+  /// Borrows `model`, which must outlive this. `max_step` is the longest RK4 step: the
+  /// interpolant's kMaxIntegrationStep, or a longer one for the planner's coarse warm-up rows
+  /// (an approximation of the interpolant, never what a plan is checked on).
+  explicit IntervalInterpolant(const dynamics::Model& model,
+                               double max_step = kMaxIntegrationStep);
 
   /// Starts the interval from the knot (q0, qd0, qdd0) that ends, dt later, with acceleration
   /// qdd1: integrates the unactuated joints to every RK4 node, with their sensitivities when
@@ -85,6 +88,7 @@ class IntervalInterpolant {
                 bool derivatives, Eigen::VectorXd& y1, Eigen::MatrixXd& S1);
 
   const dynamics::Model& model_;
+  double max_step_;
   dynamics::Data data_;
   std::vector<int> unactuated_, actuated_;
   // The current interval: inputs, RK4 step and the state (and sensitivity) at every node.
@@ -100,8 +104,7 @@ class IntervalInterpolant {
   Eigen::MatrixXd dk_[4];
   Eigen::VectorXd ys_, y_part_;
   Eigen::MatrixXd Ss_, S_part_;
-  Eigen::MatrixXd muu_, rhs_;
-  Eigen::LLT<Eigen::MatrixXd> llt_;
+  Eigen::MatrixXd rhs_;
 };
 
 }  // namespace kinograph::planning

@@ -171,16 +171,14 @@ namespace {
 // the knots before its interior limit points join the graph: close enough that few intervals
 // qualify, far enough that the re-solve rarely pushes an unlisted one over.
 constexpr double kNearLimit = 0.1;
-// Re-solves with more between-knot rows after the knot-only solve; each adds the intervals
-// the last one left near a limit, so few are ever needed.
-constexpr int kMaxIntervalRounds = 4;
+// Re-solves with more between-knot rows after the knot-only solve (the warm-up included); each
+// adds the intervals the last one left near a limit, so few are ever needed.
+constexpr int kMaxIntervalRounds = 5;
 
-// Whether the problem's robot has joints that follow their dynamics between the knots.
-bool has_unactuated(const Problem& problem) {
-  for (const dynamics::Body& b : problem.model->bodies) {
-    if (!b.actuated) return true;
-  }
-  return false;
+// How many of the problem's joints follow their dynamics between the knots.
+int unactuated_count(const Problem& problem) {
+  return static_cast<int>(std::count_if(problem.model->bodies.begin(), problem.model->bodies.end(),
+                                        [](const dynamics::Body& b) { return !b.actuated; }));
 }
 
 // Intervals whose interior limit points gain rows: the union of `flags` and `near`; returns
@@ -193,18 +191,20 @@ bool add_flags(std::vector<char>& flags, const std::vector<char>& near) {
   return added;
 }
 
-// Carries the multipliers of every interval factor that gains rows (its defect rows come
-// first and keep their multipliers) into a record of the new size, which bind() then keeps.
-void grow_interval_records(ConstraintState& state, const PlanningGraph& pg) {
+// Carries the multipliers of the shooting-defect rows (the first `defect_rows` of every
+// interval factor) into a record of the factor's new size, which bind() then keeps; the limit
+// rows of a new layout start from zero.
+void resize_interval_records(ConstraintState& state, const PlanningGraph& pg, int defect_rows) {
   for (const FactorEntry* e : pg.constraints(false)) {
     if (e->key.role != FactorRole::kInterval || !state.contains(e->key)) continue;
     Multipliers& m = state.at(e->key);
-    const Eigen::Index rows = e->constrained->residual_dim(), kept = m.lower.size();
-    if (kept >= rows) continue;
-    Multipliers grown(static_cast<int>(rows), m.penalty);
-    grown.lower.head(kept) = m.lower;
-    grown.upper.head(kept) = m.upper;
-    m = std::move(grown);
+    const Eigen::Index rows = e->constrained->residual_dim(), old = m.lower.size();
+    if (old == rows) continue;
+    const Eigen::Index kept = std::min<Eigen::Index>({old, rows, defect_rows});
+    Multipliers resized(static_cast<int>(rows), m.penalty);
+    resized.lower.head(kept) = m.lower.head(kept);
+    resized.upper.head(kept) = m.upper.head(kept);
+    m = std::move(resized);
   }
 }
 
@@ -216,14 +216,21 @@ Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init, const s
   if (solution != nullptr) *solution = BatchSolution();  // empty unless the solve runs
   // Between-knot rows by constraint generation: the knot-only graph first, then the intervals'
   // dynamics (unactuated joints) and interior limit points only where the interpolant of the
-  // last solve comes near a limit, each re-solve warm from the last.
+  // last solve comes near a limit, each re-solve warm from the last (multipliers included).
+  // With unactuated joints the first re-solve integrates them in longer RK4 steps
+  // (warmup_integration_step): it does most of the moving at a fraction of the price, and the
+  // re-solve on the interpolant that follows is short.
   IntervalRows between;
   between.knots_only = true;
   between.limits.assign(static_cast<size_t>(problem.steps), 0);
-  const bool shooting = has_unactuated(problem);
+  const bool shooting = unactuated_count(problem) > 0;
   PlanningGraph pg;
   ConstraintState state;
   OuterLoopResult r;
+  const double warmup_step = options_.warmup_integration_step;
+  const bool warmup = shooting && warmup_step > 0 &&
+                      integration_steps(problem.dt(), warmup_step) <
+                          integration_steps(problem.dt(), kMaxIntegrationStep);
   for (int round = 0;; ++round) {
     PlanningGraph next;
     std::vector<DfgConstraintStep> dfg_steps;
@@ -238,7 +245,7 @@ Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init, const s
     }
     if (round > 0) {
       next.values = pg.values;  // the same variables: interval rows add none
-      grow_interval_records(state, next);
+      resize_interval_records(state, next, 2 * unactuated_count(problem));
     }
     pg = std::move(next);
     OuterLoopOptions loop = dfg_steps.empty() ? options_.outer_loop : outer_loop_options(options_);
@@ -256,19 +263,32 @@ Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init, const s
     r.outer_iterations += before_outer;
     r.linear_solves += before_solves;
     spdlog::debug(
-        "{}: interval round {}: {} LM iterations, {}; {} of {} intervals with limit points",
-        problem.name, round, stage.iterations, to_string(stage.status),
+        "{}: interval round {}{}: {} LM iterations, {}; {} of {} intervals with limit points",
+        problem.name, round, between.integration_step != kMaxIntegrationStep ? " (warm-up)" : "",
+        stage.iterations, to_string(stage.status),
         std::count(between.limits.begin(), between.limits.end(), 1), problem.steps);
-    if (r.status == PlanStatus::kNonFinite || round == kMaxIntervalRounds ||
-        r.iterations >= options_.outer_loop.max_total_iterations) {
+    // A warm-up's graph is never the answer: the rows on the interpolant follow it, even with
+    // no iterations left.
+    const bool on_interpolant = between.integration_step == kMaxIntegrationStep;
+    if (r.status == PlanStatus::kNonFinite ||
+        (on_interpolant && (round == kMaxIntervalRounds ||
+                            r.iterations >= options_.outer_loop.max_total_iterations))) {
       break;
     }
     const bool added = add_flags(
         between.limits,
         intervals_near_limits(problem, plan_from_values(problem, pg.values, options_.dfg.keys),
                               kNearLimit));
-    const bool more_dynamics = between.knots_only && shooting;
-    if (!added && !more_dynamics) break;
+    if (between.knots_only && shooting) {
+      between.knots_only = false;
+      if (warmup) between.integration_step = warmup_step;
+      continue;
+    }
+    if (!on_interpolant) {
+      between.integration_step = kMaxIntegrationStep;
+      continue;
+    }
+    if (!added) break;
     between.knots_only = false;
   }
   if (r.status == PlanStatus::kInfeasible) r.reason = infeasible_reason(problem, r);

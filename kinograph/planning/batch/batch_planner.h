@@ -67,6 +67,12 @@ struct BatchPlannerOptions {
   /// first from the straight line, each later one and finally the problem itself warm-started
   /// from the last stage that validated). Dimensionless, > 0; empty = off.
   std::vector<double> effort_continuation{2, 1.5, 1.25, 1.125, 1.0625};
+  /// RK4 step (s) of a warm-up solve between the knot-only solve and the one on the
+  /// interpolant, for robots with an unactuated joint: the same rows (shooting defects, limit
+  /// points) integrated in steps this long, which cost a fraction of the interpolant's
+  /// kMaxIntegrationStep and leave the final solve a short projection. Used only when it takes
+  /// fewer steps per interval than the interpolant; 0 = off.
+  double warmup_integration_step = 0.05;
 };
 
 /// Where the solve of a plan ended: its graph, values and the constraint state (final

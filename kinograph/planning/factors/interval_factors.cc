@@ -69,7 +69,7 @@ IntervalDynamicsFactor::IntervalDynamicsFactor(int k, double dt,
       model_(std::move(model)),
       dt_(dt),
       layout_(layout(*model_, options)),
-      interpolant_(*model_) {
+      interpolant_(*model_, options.integration_step) {
   for (int i = 1; i <= options.checks; ++i) times_.push_back(dt * i / (options.checks + 1));
   times_.push_back(dt);
   points_.resize(times_.size());

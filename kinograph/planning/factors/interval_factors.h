@@ -19,6 +19,9 @@ struct IntervalDynamicsOptions {
   double defect_scale = 1;     ///< × Δt² (position rows) and × Δt (velocity rows), as collocation
   double torque_scale = 1;     ///< scale (N·m) of the effort rows
   double limit_scale = 0.1;    ///< scale (rad, rad/s) of the q and q̇ rows
+  /// Longest RK4 step (s) of the unactuated joints: the interpolant's, or longer for a coarse
+  /// warm-up of the batch planner (same rows, cheaper, only approximately the interpolant).
+  double integration_step = kMaxIntegrationStep;
 };
 
 /// Interval k of an n-joint robot, keys q_k v_k a_k q_{k+1} v_{k+1} a_{k+1}. Rows: for each

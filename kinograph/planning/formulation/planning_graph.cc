@@ -152,6 +152,7 @@ std::vector<FactorEntry> timing_entries(const Problem& problem, const GraphOptio
   between.defect_scale = options.collocation_scale;
   between.torque_scale = options.torque_scale;
   between.limit_scale = options.limit_scale;
+  between.integration_step = rows.integration_step;
   IntervalDynamicsOptions without_limits = between;
   between.checks = limit_points(problem.objectives.limit_substeps, dt);
   const bool has_between = !IntervalDynamicsFactor::layout(model, between).empty();

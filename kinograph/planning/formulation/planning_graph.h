@@ -12,6 +12,7 @@
 #include "kinograph/planning/factors/collision_factors.h"
 #include "kinograph/planning/factors/constrained_factor.h"
 #include "kinograph/planning/formulation/initialization.h"
+#include "kinograph/planning/interpolant.h"
 #include "kinograph/planning/plan.h"
 #include "kinograph/planning/problem.h"
 
@@ -100,6 +101,9 @@ struct IntervalRows {
   /// Per interval, whether its interior limit points are enforced; empty = on every interval.
   /// Intervals without them keep the unactuated joints' shooting defect.
   std::vector<char> limits;
+  /// Longest RK4 step (s) of the interval factors: the interpolant's, or longer for the batch
+  /// planner's coarse warm-up solve before the rows on the interpolant itself.
+  double integration_step = kMaxIntegrationStep;
 };
 
 /// A built planning graph: the role table, the factor graph of its non-anchor factors, the
