@@ -122,7 +122,7 @@ void write_plot(const nlohmann::json& results, const std::string& path) {
     if (!s.t.empty()) series.push_back(std::move(s));
   }
   render::TorquePlotOptions o;
-  o.title = "Centralized planner on random crossing-goal cells";
+  o.title = "Centralized planner";
   o.y_label = "log10 CPU time [s]";
   o.x_label = "problem";
   o.joint_names = {"CPU time per problem"};
