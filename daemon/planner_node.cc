@@ -331,7 +331,7 @@ void PlannerNode::on_goal(const lcm::ReceiveBuffer* rbuf, const std::string& cha
     decoded = decode_goal<goal_v3_t>("goal_v3_t", rbuf);
   } else {
     decoded.malformed =
-        "malformed goal: its fingerprint is none of goal_t's, goal_v2_t's or goal_v3_t's";
+        "malformed goal_t (or goal_v2_t, goal_v3_t): its fingerprint is none of theirs";
   }
   if (!decoded.malformed.empty()) {
     reject(channel, channel + ": " + decoded.malformed);
