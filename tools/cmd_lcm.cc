@@ -2,7 +2,7 @@
 //   kinograph send-goal     --prefix IIWA (--q ... | --joint NAME=V ... | --frame F
 //                           --position ... (--quaternion ... | --position-only)) [--utime US]
 //   kinograph send-obstacle --prefix IIWA --id box --shape box --size ... --position ...
-//                           [--utime US]
+//                           [--source NAME [--replace-all]] [--utime US]
 //   kinograph send-state    --prefix IIWA --scene S --q ... [--qd ...] [--utime US]
 //   kinograph send-raw      CHANNEL --text BYTES
 //   kinograph log-plans     LOG.lcmlog --channel IIWA_PLAN --scene S --out-dir DIR
@@ -296,6 +296,8 @@ const bool kSendObstacle = register_command([](CLI::App& root) {
   auto position = std::make_shared<std::string>("0,0,0");
   auto quaternion = std::make_shared<std::string>("1,0,0,0");
   auto remove = std::make_shared<bool>(false);
+  auto source = std::make_shared<std::string>();
+  auto replace_all = std::make_shared<bool>(false);
   auto goal_id = std::make_shared<int64_t>(-1);
   auto utime = std::make_shared<int64_t>(-1);
   c->add(sub, true);
@@ -309,6 +311,10 @@ const bool kSendObstacle = register_command([](CLI::App& root) {
   sub->add_option("--position", *position, "centre x,y,z (m)");
   sub->add_option("--quaternion", *quaternion, "orientation w,x,y,z");
   sub->add_flag("--remove", *remove, "remove the obstacle instead");
+  sub->add_option("--source", *source,
+                  "who sends it (obstacle_list_t.source, default none): ids are per source");
+  sub->add_flag("--replace-all", *replace_all,
+                "this obstacle replaces all of its source's, other sources' are kept");
   sub->add_option("--goal-id", *goal_id, "with --wait: the goal whose replan to wait for");
   sub->callback([=] {
     obstacle_t o;
@@ -330,15 +336,19 @@ const bool kSendObstacle = register_command([](CLI::App& root) {
     std::copy(r.begin(), r.end(), o.quaternion);
     obstacle_list_t msg;
     msg.utime = *utime >= 0 ? *utime : now_utime();
+    msg.source = *source;
     msg.num_obstacles = 1;
     msg.obstacles.push_back(o);
-    msg.replace_all = false;
+    msg.replace_all = *replace_all;
     if (c->wait_s > 0 && *goal_id < 0) throw CommandFailure("--wait needs --goal-id");
     std::optional<planning::Scene> scene = c->output_scene();
     lcm::LCM& lcm = open_lcm(c->url);
     PlanWaiter waiter(lcm, c->prefix + "_PLAN");
     lcm.publish(c->prefix + "_OBSTACLES", &msg);
-    std::cout << "sent obstacle \"" << o.id << "\" on " << c->prefix << "_OBSTACLES\n";
+    std::cout << "sent obstacle \"" << o.id << "\""
+              << (source->empty() ? "" : " from source \"" + *source + "\"")
+              << (*replace_all ? " replacing its others" : "") << " on " << c->prefix
+              << "_OBSTACLES\n";
     std::optional<std::pair<std::string, collision::Obstacle>> extra;
     if (!*remove) {
       std::vector<messages::ObstacleUpdate> updates;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "tests/lcmtypes/sample_messages.h"
+#include "tests/lib/temp_dir.h"
 #include "tests/tools/cli_run.h"
 
 namespace kinograph::tools {
@@ -30,9 +31,8 @@ void log_event(lcm::LogFile& log, int64_t timestamp, const std::vector<uint8_t>&
 }
 
 TEST(CliLogPlans, ReadsBothPlanVersionsAndSkipsWhatIsNeither) {
-  const fs::path dir = fs::temp_directory_path() / "kinograph_cli_log_plans";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const kinograph::test_support::TempDir temp("kinograph_cli_log_plans");
+  const fs::path& dir = temp.path();
   const std::string log_path = (dir / "mixed.lcmlog").string();
   {
     lcm::LogFile log(log_path, "w");
