@@ -4,7 +4,8 @@
 //                           [--joint-tolerance NAME=T ... | --position-tolerance M
 //                           --orientation-tolerance RAD]
 //   kinograph send-obstacle --prefix IIWA --id box --shape box --size ... --position ...
-//                           [--utime US] [--source S]; --shape mesh --mesh FILE [--scale ...]
+//                           [--utime US] [--source NAME [--replace-all]]; --shape mesh
+//                           --mesh FILE [--scale ...]
 //   kinograph send-payload  --prefix IIWA (--frame F --mass KG --size ... [--offset ...] |
 //                           --detach)
 //   kinograph send-state    --prefix IIWA --scene S --q ... [--qd ...] [--utime US]
@@ -402,6 +403,7 @@ const bool kSendObstacle = register_command([](CLI::App& root) {
   auto position = std::make_shared<std::string>("0,0,0");
   auto quaternion = std::make_shared<std::string>("1,0,0,0");
   auto remove = std::make_shared<bool>(false);
+  auto replace_all = std::make_shared<bool>(false);
   auto goal_id = std::make_shared<int64_t>(-1);
   auto utime = std::make_shared<int64_t>(-1);
   c->add(sub, true);
@@ -421,12 +423,17 @@ const bool kSendObstacle = register_command([](CLI::App& root) {
   sub->add_option("--position", *position, "centre (a mesh: its origin) x,y,z (m)");
   sub->add_option("--quaternion", *quaternion, "orientation w,x,y,z");
   sub->add_flag("--remove", *remove, "remove the obstacle instead");
+  sub->add_flag("--replace-all", *replace_all,
+                "this obstacle replaces all of its source's, other sources' are kept");
   sub->add_option("--goal-id", *goal_id, "with --wait: the goal whose replan to wait for");
   sub->callback([=] {
     const bool is_mesh = *shape == "mesh";
     if (is_mesh && !*remove && mesh->empty()) throw CommandFailure("--shape mesh needs --mesh");
     if (!is_mesh && !mesh->empty()) throw CommandFailure("--mesh needs --shape mesh");
     if (is_mesh && !size->empty()) throw CommandFailure("a mesh takes --scale, not --size");
+    if (is_mesh && *replace_all) {
+      throw CommandFailure("--replace-all is sent with box, sphere, cylinder and capsule obstacles");
+    }
     if (c->wait_s > 0 && *goal_id < 0) throw CommandFailure("--wait needs --goal-id");
     const auto p = parse_number_list(*position, "--position", 3);
     const auto r = parse_number_list(*quaternion, "--quaternion", 4);
@@ -456,7 +463,7 @@ const bool kSendObstacle = register_command([](CLI::App& root) {
       msg.source = *source;
       msg.num_obstacles = 1;
       msg.obstacles.push_back(o);
-      msg.replace_all = false;
+      msg.replace_all = *replace_all;
     }
     std::optional<planning::Scene> scene = c->output_scene();
     // The obstacle as the plan file (--out) must hold it: converted as the daemon does.
@@ -481,8 +488,10 @@ const bool kSendObstacle = register_command([](CLI::App& root) {
     } else {
       lcm.publish(c->prefix + "_OBSTACLES", &msg);
     }
-    std::cout << "sent obstacle \"" << *id << "\" on " << c->prefix << "_OBSTACLES ("
-              << (is_mesh ? "mesh_obstacle_list_t" : "obstacle_list_t") << ")\n";
+    std::cout << "sent obstacle \"" << *id << "\""
+              << (source->empty() ? "" : " from source \"" + *source + "\"")
+              << (*replace_all ? " replacing its others" : "") << " on " << c->prefix
+              << "_OBSTACLES (" << (is_mesh ? "mesh_obstacle_list_t" : "obstacle_list_t") << ")\n";
     if (int code = finish(waiter, *c, *goal_id, std::move(scene), extra); code != 0) {
       throw CommandFailure("", code);
     }

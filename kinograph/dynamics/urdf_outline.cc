@@ -104,6 +104,7 @@ class Outliner {
         }
       } else if (kind == "joint") {
         outline_.joint_lines[name ? name : ""] = e->Row();
+        record_edge(e, name ? name : "");
       } else if (kind != "material") {
         continue;  // gazebo, transmission, ...: not read by urdfdom's model parser
       }
@@ -111,10 +112,48 @@ class Outliner {
         check_numbers(c, label, "");
       }
     }
+    check_tree();
     return std::move(outline_);
   }
 
  private:
+  // One joint as a parent → child edge of the link graph.
+  struct Edge {
+    std::string joint, parent;
+    int line = 0;
+  };
+
+  void record_edge(const TiXmlElement* joint, const std::string& name) {
+    const TiXmlElement* parent = joint->FirstChildElement("parent");
+    const TiXmlElement* child = joint->FirstChildElement("child");
+    const char* p = parent ? parent->Attribute("link") : nullptr;
+    const char* c = child ? child->Attribute("link") : nullptr;
+    if (p == nullptr || c == nullptr) return;  // urdfdom names what is missing
+    const auto [it, added] = parent_of_.emplace(c, Edge{name, p, joint->Row()});
+    if (!added) {
+      fail(joint->Row(), "link '" + std::string(c) + "' is the child of joint '" +
+                             it->second.joint + "' (line " + std::to_string(it->second.line) +
+                             ") and of joint '" + name + "' (a URDF is a tree)");
+    }
+  }
+
+  // urdfdom links a loop of joints (or a link with two parents) into a cycle of shared pointers
+  // that is never freed; both are refused here first, naming the joint.
+  void check_tree() const {
+    for (const auto& [child, edge] : parent_of_) {
+      std::string link = edge.parent;
+      for (size_t hops = 0; hops <= parent_of_.size(); ++hops) {
+        if (link == child) {
+          fail(edge.line, "joint '" + edge.joint + "' closes a loop: link '" + child +
+                              "' would be its own ancestor (a URDF is a tree)");
+        }
+        const auto up = parent_of_.find(link);
+        if (up == parent_of_.end()) break;
+        link = up->second.parent;
+      }
+    }
+  }
+
   [[noreturn]] void fail(int line, const std::string& what) const {
     throw UrdfError(source_ + (line > 0 ? " line " + std::to_string(line) : "") + ": " + what);
   }
@@ -167,6 +206,7 @@ class Outliner {
 
   std::string source_;
   UrdfOutline outline_;
+  std::map<std::string, Edge> parent_of_;  // child link → the first joint naming it as child
 };
 
 std::string line_suffix(int line) {

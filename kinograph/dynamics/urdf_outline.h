@@ -32,7 +32,7 @@ inline constexpr int kMaxUrdfNesting = 100;
 /// line), a xacro file ("expand it with
 ///   xacro first"), a root that is not `<robot>`, or a numeric attribute that is not a list of the
 ///   right number of finite numbers (sizes must also be > 0), naming the link or joint, the
-///   element path and the line.
+///   element path and the line; joints that form a loop or give a link two parents.
 UrdfOutline outline_urdf(const std::string& xml, const std::string& source);
 
 }  // namespace kinograph::dynamics

@@ -11,6 +11,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "tests/lib/temp_dir.h"
+
 namespace kinograph::collision {
 namespace {
 
@@ -200,7 +202,8 @@ TEST(PairDistance, CylinderSphereSideTopRimPenetrating) {
 
 // Writes a cube of side 2 as an OBJ file (with an interior vertex the hull must ignore).
 std::string write_cube_obj() {
-  const auto path = std::filesystem::temp_directory_path() / "kinograph_collision_cube.obj";
+  static const kinograph::test_support::TempDir dir("kinograph_collision_cube");
+  const auto path = dir / "cube.obj";
   std::ofstream f(path);
   for (int i = 0; i < 8; ++i) {
     f << "v " << ((i & 1) ? 1 : -1) << ' ' << ((i & 2) ? 1 : -1) << ' ' << ((i & 4) ? 1 : -1)

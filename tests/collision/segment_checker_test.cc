@@ -220,6 +220,31 @@ TEST_F(RrSegment, PathCheckSkipsClearStretches) {
   EXPECT_GE(world.closest(data).distance, r.min_distance);
 }
 
+// A path that sweeps further than max_path_samples queries can walk stops there and says where,
+// instead of walking for ever (a plan file with q = 1e308).
+TEST_F(RrSegment, PathCheckStopsAtItsQueryBound) {
+  CollisionWorld world(model);
+  Obstacle o;
+  o.id = 1;
+  o.shape = Shape::sphere(0.05);
+  o.pose = at(0, 0, -1.5);  // below the base: every sample's budget is about a metre
+  ASSERT_TRUE(world.add_obstacle(o));
+  Eigen::MatrixXd path(3, 2);
+  path << 0, 0, 1e6, 0, 0, 0;
+  SegmentCheckOptions options;
+  options.max_path_samples = 1000;
+  SegmentChecker checker(model, options);
+  const PathCheckResult r = checker.check_path(world, data, path);
+  EXPECT_FALSE(r.complete);
+  EXPECT_EQ(r.samples, 1000);
+  EXPECT_EQ(r.stopped_segment, 0);
+  EXPECT_GT(r.stopped_s, 0);
+  EXPECT_LT(r.stopped_s, 1e-2);
+  // The same path within the bound is walked whole.
+  path << 0, 0, 1, 0, 0, 0;
+  EXPECT_TRUE(checker.check_path(world, data, path).complete);
+}
+
 // Moving obstacles: samples at most max_time_step apart in time, and the sphere that passes
 // through the arm mid-path is found.
 TEST_F(RrSegment, PathCheckFollowsMovingObstaclesInTime) {

@@ -13,6 +13,7 @@
 #include "kinograph/dynamics/kinematics.h"
 #include "kinograph/dynamics/model.h"
 #include "test_util.h"
+#include "tests/lib/temp_dir.h"
 
 namespace kinograph::dynamics {
 namespace {
@@ -158,7 +159,8 @@ TEST(UrdfBadInput, DirectoryInsteadOfFile) {
 
 TEST(UrdfBadInput, UnreadableFile) {
   if (geteuid() == 0) GTEST_SKIP() << "root can read files without read permission";
-  const fs::path p = fs::temp_directory_path() / "kinograph_unreadable.urdf";
+  const kinograph::test_support::TempDir dir("kinograph_unreadable");
+  const fs::path p = dir / "kinograph_unreadable.urdf";
   std::ofstream(p) << "<robot name='x'/>";
   fs::permissions(p, fs::perms::none);
   expect_urdf_error(p.string(), {"kinograph_unreadable.urdf", "cannot open"});
@@ -167,6 +169,51 @@ TEST(UrdfBadInput, UnreadableFile) {
 
 TEST(UrdfBadInput, MalformedXml) {
   expect_urdf_error(testing::data_path("malformed.urdf"), {"malformed.urdf", "malformed URDF"});
+}
+
+// 50,000 nested elements overflowed the stack of the recursive XML parser under urdfdom; deep
+// text is refused before it runs, naming the line of the first element too deep.
+TEST(UrdfBadInput, DeepNestingIsRefusedWithItsLine) {
+  std::string open, close;
+  for (int i = 0; i < 50000; ++i) open += "<a>", close += "</a>";
+  const std::string xml =
+      "<robot name='deep'>\n<link name='base'>\n" + open + close + "</link></robot>";
+  try {
+    Model::from_urdf_string(xml);
+    ADD_FAILURE() << "no UrdfError";
+  } catch (const UrdfError& e) {
+    EXPECT_NE(std::string(e.what()).find("<urdf string> line 3: elements nested deeper than 100"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+// Joints that close a loop (which urdfdom turns into a cycle of shared pointers it never frees,
+// found by the fuzzer) or give a link two parents are refused, naming the joint and its line.
+TEST(UrdfBadInput, JointsMustFormATree) {
+  const auto error_of = [](const std::string& joints) {
+    const std::string xml =
+        "<robot name='loop'><link name='a'/><link name='b'/><link name='c'/>\n" + joints +
+        "</robot>";
+    try {
+      Model::from_urdf_string(xml);
+    } catch (const UrdfError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no UrdfError");
+  };
+  const auto joint = [](const char* name, const char* parent, const char* child) {
+    return std::string("<joint name='") + name + "' type='fixed'><parent link='" + parent +
+           "'/><child link='" + child + "'/></joint>\n";
+  };
+  const std::string loop =
+      error_of(joint("ab", "a", "b") + joint("bc", "b", "c") + joint("ca", "c", "a"));
+  EXPECT_NE(loop.find("closes a loop"), std::string::npos) << loop;
+  EXPECT_NE(loop.find("<urdf string> line "), std::string::npos) << loop;
+  const std::string two = error_of(joint("ab", "a", "b") + joint("cb", "c", "b"));
+  EXPECT_NE(two.find("line 3: link 'b' is the child of joint 'ab' (line 2) and of joint 'cb'"),
+            std::string::npos)
+      << two;
 }
 
 TEST(UrdfBadInput, FloatingJoint) {

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "kinograph/planning/io/scene.h"
+#include "tests/lib/temp_dir.h"
 
 namespace kinograph::planning {
 namespace {
@@ -60,7 +61,8 @@ TEST_F(DataDirTest, PathsInsideTheDataDirectoryAreWrittenRelativeToIt) {
   EXPECT_EQ(data_relative_path((root_ / "robots/arm/arm.urdf").string()), "robots/arm/arm.urdf");
   fs::remove_all(linked);
   // Outside every data directory: the absolute path.
-  const fs::path outside = fs::temp_directory_path() / "kinograph_data_dir_outside.urdf";
+  const kinograph::test_support::TempDir outside_dir("kinograph_data_dir_outside");
+  const fs::path outside = outside_dir / "outside.urdf";
   std::ofstream(outside) << "x";
   EXPECT_EQ(data_relative_path(outside.string()), fs::canonical(outside).string());
   fs::remove(outside);

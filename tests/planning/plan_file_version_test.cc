@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "kinograph/planning/io/plan_json.h"
+#include "tests/lib/temp_dir.h"
 
 namespace kinograph::planning {
 namespace {
@@ -24,8 +25,7 @@ json read_json(const std::string& path) {
 
 // Writes `j` to a file of this test's own directory and returns its path.
 std::string write_json(const json& j, const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / "kinograph_plan_version_test";
-  std::filesystem::create_directories(dir);
+  static const kinograph::test_support::TempDir dir("kinograph_plan_version_test");
   const std::string path = (dir / name).string();
   std::ofstream(path) << j.dump(1);
   return path;

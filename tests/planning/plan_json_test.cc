@@ -8,6 +8,8 @@
 #include <fstream>
 #include <random>
 
+#include "tests/lib/temp_dir.h"
+
 namespace kinograph::planning {
 namespace {
 
@@ -98,8 +100,8 @@ void expect_same_plan(const Plan& a, const Plan& b) {
 TEST(PlanJson, RoundTripsExactlyThroughAFile) {
   const Scene scene = load_scene(kSceneDir + "iiwa_desk.yaml");
   const Plan plan = random_plan(scene.problem, 7);
-  const std::string path =
-      (std::filesystem::temp_directory_path() / "kinograph_plan_json_test" / "plan.json").string();
+  const kinograph::test_support::TempDir dir("kinograph_plan_json_test");
+  const std::string path = (dir / "new" / "plan.json").string();
   write_plan(plan, scene, path);  // creates the directory
   expect_same_plan(plan, read_plan(path, *scene.problem.model));
 }
@@ -262,8 +264,8 @@ obstacles:
     motion: [{t: 0, position: [0, 0.5, 1]}, {t: 2, position: [1, 0.5, 1], rpy: [0, 0, 1]}]
 )");
   const Plan plan = random_plan(scene.problem, 19);
-  const std::string path =
-      (std::filesystem::temp_directory_path() / "kinograph_plan_file_test" / "plan.json").string();
+  const kinograph::test_support::TempDir dir("kinograph_plan_file_test");
+  const std::string path = (dir / "plan.json").string();
   write_plan(plan, scene, path);
   const PlanFile file = read_plan_file(path);
   expect_same_plan(plan, file.plan);
@@ -376,9 +378,24 @@ TEST(PlanFile, ErrorsNameTheKey) {
   EXPECT_THROW(read_plan_file("/no/such/plan.json"), PlanFileError);
 }
 
+// A number no double holds is a PlanFileError naming the file, not nlohmann's bare
+// out_of_range (number overflow parsing '1e309').
+TEST(PlanFile, ANumberBeyondADoubleNamesTheFile) {
+  const kinograph::test_support::TempDir dir("kinograph_plan_overflow_test");
+  const std::string path = (dir / "huge.json").string();
+  std::ofstream(path) << R"({"format_version": 1, "t": [0, 1e309]})";
+  try {
+    read_plan_file(path);
+    ADD_FAILURE() << "no PlanFileError";
+  } catch (const PlanFileError& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("1e309"), std::string::npos) << e.what();
+  }
+}
+
 TEST(PlanFile, RelativePathsResolveNextToThePlan) {
-  const auto dir = std::filesystem::temp_directory_path() / "kinograph_plan_path_test";
-  std::filesystem::create_directories(dir);
+  const kinograph::test_support::TempDir temp("kinograph_plan_path_test");
+  const std::filesystem::path& dir = temp.path();
   std::ofstream(dir / "part.stl") << "solid x\nendsolid x\n";
   const std::string plan = (dir / "plan.json").string();
   EXPECT_EQ(resolve_plan_path("part.stl", plan),

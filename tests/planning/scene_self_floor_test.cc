@@ -8,6 +8,7 @@
 #include <string>
 
 #include "kinograph/planning/io/scene.h"
+#include "tests/lib/temp_dir.h"
 
 namespace kinograph::planning {
 namespace {
@@ -24,8 +25,7 @@ std::string scene_with(const std::string& robot_extra, const std::string& extra)
 }
 
 std::string write_temp(const std::string& name, const std::string& text) {
-  const fs::path dir = fs::temp_directory_path() / "kinograph_scene_self_floor_test";
-  fs::create_directories(dir);
+  static const kinograph::test_support::TempDir dir("kinograph_scene_self_floor_test");
   const fs::path path = dir / name;
   std::ofstream(path) << text;
   return path.string();

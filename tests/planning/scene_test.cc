@@ -12,6 +12,7 @@
 #include "kinograph/dynamics/data.h"
 #include "kinograph/dynamics/kinematics.h"
 #include "kinograph/planning/batch/batch_planner.h"
+#include "tests/lib/temp_dir.h"
 
 namespace kinograph::planning {
 namespace {
@@ -73,8 +74,7 @@ camera: {eye: [3, 0, 1], target: [0, 0, 0.5]}
 
 // Writes a file under the test's temporary directory.
 std::string write_temp(const std::string& name, const std::string& text) {
-  const fs::path dir = fs::temp_directory_path() / "kinograph_scene_test";
-  fs::create_directories(dir);
+  static const kinograph::test_support::TempDir dir("kinograph_scene_test");
   const fs::path path = dir / name;
   std::ofstream(path) << text;
   return path.string();
@@ -417,6 +417,28 @@ TEST(SceneErrors, NamesThatDoNotExist) {
       text.find("robot: {urdf: robots/rr/rr.urdf}"), 32,
       "robot: {urdf: robots/rr/rr.urdf, payload: {frame: hand, mass: 1, size: [1, 1, 1]}}");
   EXPECT_EQ(parse_error(text).key(), "robot.payload");
+}
+
+// Sizes that would allocate gigabytes are refused before anything is allocated, naming the key
+// and the bound (steps: 2147483647 overflowed the straight-line guess's N + 1).
+TEST(SceneErrors, SizesBeyondTheirBounds) {
+  std::string base = kBase;
+  const std::string steps = "steps: 10\n";
+  for (const char* n : {"10001", "2147483647"}) {
+    std::string text = base;
+    text.replace(text.find(steps), steps.size(), std::string("steps: ") + n + "\n");
+    const SceneError e = parse_error(text);
+    EXPECT_EQ(e.key(), "steps");
+    EXPECT_NE(std::string(e.what()).find("at most 10000"), std::string::npos) << e.what();
+  }
+  std::string ok = base;
+  ok.replace(ok.find(steps), steps.size(), "steps: 10000\n");
+  EXPECT_EQ(parse_scene(ok).problem.steps, 10000);
+  for (const char* key : {"collision_substeps", "limit_substeps"}) {
+    const SceneError e = parse_error(base + "objectives: {" + key + ": 101}\n");
+    EXPECT_EQ(e.key(), std::string("objectives.") + key);
+    EXPECT_NE(std::string(e.what()).find("at most 100"), std::string::npos) << e.what();
+  }
 }
 
 TEST(SceneErrors, InconsistentValues) {

@@ -46,6 +46,22 @@ std::string all_failures(const Validation& v) {
   return s;
 }
 
+// A plan file with q = 1e308 made the collision walk run for ever; it now stops at its query
+// bound and the plan is invalid, saying the rest was not checked.
+TEST(Validate, APathTooLongToWalkIsInvalidNotEndless) {
+  Fixture f;
+  collision::Obstacle ball;
+  ball.id = 0;
+  ball.shape = collision::Shape::sphere(0.05);
+  ball.pose.translation() = Eigen::Vector3d(0, 0, -1.5);  // out of reach, below the base
+  f.problem.obstacles.push_back(ball);
+  ASSERT_TRUE(validate(f.problem, f.plan).valid);
+  f.plan.q(5, 0) = 1e308;
+  const Validation v = validate(f.problem, f.plan);
+  EXPECT_FALSE(v.valid);
+  EXPECT_TRUE(mentions(v, "collision: not checked after t = ")) << all_failures(v);
+}
+
 // Start, goal and task failures say which joint or frame misses, by how much, and when.
 TEST(Validate, StartGoalAndTaskFailuresNameJointFrameAndTime) {
   {

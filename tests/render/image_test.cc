@@ -6,11 +6,14 @@
 #include <filesystem>
 #include <random>
 
+#include "tests/lib/temp_dir.h"
+
 namespace kinograph::render {
 namespace {
 
 std::string temp_path(const std::string& name) {
-  return (std::filesystem::temp_directory_path() / ("kinograph_image_test_" + name)).string();
+  static const kinograph::test_support::TempDir dir("kinograph_image_test");
+  return (dir / name).string();
 }
 
 TEST(Image, PngRoundTripKeepsEveryPixel) {

@@ -9,6 +9,8 @@
 #include <fstream>
 #include <numbers>
 
+#include "tests/lib/temp_dir.h"
+
 namespace kinograph::render {
 namespace {
 
@@ -81,10 +83,9 @@ TEST(Primitives, TubeFollowsThePolyline) {
 class MeshFiles : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           (std::string("kinograph_mesh_test") + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    std::filesystem::create_directories(dir_);
+    dir_ = test_support::TempDir::make(
+        std::string("kinograph_mesh_test") + "_" +
+        ::testing::UnitTest::GetInstance()->current_test_info()->name());
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }
   std::filesystem::path dir_;

@@ -17,6 +17,7 @@
 #include "kinograph/planning/io/scene.h"
 #include "render/image.h"
 #include "render/render_scene.h"
+#include "tests/lib/temp_dir.h"
 
 namespace kinograph::render::test {
 
@@ -126,14 +127,12 @@ inline nlohmann::json iiwa_test_plan(int steps = 25) {
   return planning::plan_to_json(plan, scene);
 }
 
-/// A fresh temporary folder for the running test, named after it: ctest -j runs the tests of
-/// one fixture in parallel processes, which must not share (and remove) each other's files.
+/// A fresh temporary folder for the running test, named after it and made unique: ctest -j runs
+/// the tests of one fixture in parallel processes, which must not share (and remove) each
+/// other's files. The caller removes it.
 inline std::filesystem::path make_test_dir(const std::string& prefix) {
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() /
-      (prefix + "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
-  std::filesystem::create_directories(dir);
-  return dir;
+  return test_support::TempDir::make(
+      prefix + "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
 }
 
 /// Writes a plan file's JSON to `path`.

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "kinograph/robot_state_t.hpp"
+#include "tests/lib/temp_dir.h"
 #include "tests/tools/cli_run.h"
 
 namespace kinograph::tools {
@@ -60,11 +61,8 @@ double value(const std::string& output, const std::string& key) {
 
 class CheckStatesTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  const fs::path dir_ = fs::temp_directory_path() / "kinograph_cli_check_states";
+  const test_support::TempDir temp_{"kinograph_cli_check_states"};
+  const fs::path dir_ = temp_.path();
   const std::string scene_ = std::string(KINOGRAPH_SOURCE_DIR) + "/robots/scenes/iiwa_desk.yaml";
 };
 

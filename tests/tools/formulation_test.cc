@@ -10,6 +10,7 @@
 #include <string>
 
 #include "kinograph/planning/io/scene.h"
+#include "tests/lib/temp_dir.h"
 #include "tests/tools/cli_run.h"
 
 namespace kinograph::tools {
@@ -30,10 +31,9 @@ std::string repo(const std::string& path) { return std::string(KINOGRAPH_SOURCE_
 class CliFormulation : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           (std::string("kinograph_cli_formulation_") +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
+    dir_ = test_support::TempDir::make(
+        std::string("kinograph_cli_formulation_") +
+        ::testing::UnitTest::GetInstance()->current_test_info()->name());
     // rr_reach with planner.formulation: dfg (paths written resolved, so it reads anywhere).
     planning::Scene scene = planning::load_scene(repo("robots/scenes/rr_reach.yaml"));
     ASSERT_EQ(scene.planner.formulation, "condensed");

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "tests/lcmtypes/sample_messages.h"
+#include "tests/lib/temp_dir.h"
 #include "tests/tools/cli_run.h"
 
 namespace kinograph::tools {
@@ -23,14 +24,6 @@ namespace {
 namespace fs = std::filesystem;
 using namespace kinograph::lcmtypes::testing;
 
-
-// A fresh directory of this test's own.
-fs::path temp_dir() {
-  char pattern[] = "/tmp/kinograph_cli_log_plans_XXXXXX";
-  const char* made = mkdtemp(pattern);
-  EXPECT_NE(made, nullptr);
-  return made != nullptr ? fs::path(made) : fs::path();
-}
 
 void log_event(lcm::LogFile& log, int64_t timestamp, const std::vector<uint8_t>& bytes,
                const std::string& channel = "IIWA_PLAN") {
@@ -44,7 +37,8 @@ void log_event(lcm::LogFile& log, int64_t timestamp, const std::vector<uint8_t>&
 }
 
 TEST(CliLogPlans, ReadsBothPlanVersionsAndSkipsWhatIsNeither) {
-  const fs::path dir = temp_dir();
+  const kinograph::test_support::TempDir temp("kinograph_cli_log_plans");
+  const fs::path& dir = temp.path();
   const std::string log_path = (dir / "mixed.lcmlog").string();
   {
     lcm::LogFile log(log_path, "w");
@@ -89,7 +83,8 @@ std::vector<std::string> obstacle_ids(const fs::path& plan_file) {
 // A ball added by "perception" before plan 1 and removed before plan 2: plan 1's file has it
 // beside the scene's desk, plan 2's does not; an update that fails its checks is reported.
 TEST(CliLogPlans, PlanFilesCarryTheObstaclesReceivedOverLcm) {
-  const fs::path dir = temp_dir();
+  const kinograph::test_support::TempDir temp("kinograph_cli_log_plans");
+  const fs::path& dir = temp.path();
   const std::string log_path = (dir / "session.lcmlog").string();
   obstacle_list_t add = make_obstacle_list();
   add.source = "perception";
