@@ -17,13 +17,14 @@
 #include "kinograph/planning/io/plan_json.h"
 #include "kinograph/planning/io/scene.h"
 #include "tools/command_registry.h"
+#include "tools/number_list.h"
 
 namespace kinograph::tools {
 namespace {
 
 struct CheckTogetherArgs {
   std::vector<std::string> files;  // scene, plan, scene, plan, ...
-  std::vector<double> start;       // s on the common clock, one per robot
+  std::string start;               // s on the common clock, one per robot, comma-separated
   double clearance = 0.0;
   int samples = 10;
 };
@@ -52,11 +53,8 @@ void run_check_together(const CheckTogetherArgs& args) {
                          kExitUsage);
   }
   const size_t n = args.files.size() / 2;
-  if (!args.start.empty() && args.start.size() != n) {
-    throw CommandFailure("--start needs one time per robot (" + std::to_string(n) + "), got " +
-                             std::to_string(args.start.size()),
-                         kExitUsage);
-  }
+  const std::vector<double> start =
+      args.start.empty() ? std::vector<double>{} : parse_number_list(args.start, "--start", n);
   std::vector<fleet::RobotPlan> robots;
   std::vector<std::optional<std::int64_t>> utimes;
   for (size_t i = 0; i < n; ++i) {
@@ -74,8 +72,8 @@ void run_check_together(const CheckTogetherArgs& args) {
     for (const fleet::RobotPlan& other : robots) {
       if (other.name == robot.name) robot.name += "#" + std::to_string(i + 1);
     }
-    utimes.push_back(args.start.empty() ? plan_start_utime(plan_path) : std::nullopt);
-    robot.offset = args.start.empty() ? 0.0 : args.start[i];
+    utimes.push_back(start.empty() ? plan_start_utime(plan_path) : std::nullopt);
+    robot.offset = start.empty() ? 0.0 : start[i];
     robots.push_back(std::move(robot));
   }
   // Plans that say when they start (on the robots' common clock) are placed there, relative
@@ -119,9 +117,7 @@ const bool kRegistered = register_command([](CLI::App& root) {
       ->required();
   cmd->add_option("--start", args->start,
                   "Common-clock time (s) of each plan's t = 0, one per robot; default: the plan "
-                  "files' start_utime relative to the earliest, else 0")
-      ->delimiter(',')
-      ->expected(1);
+                  "files' start_utime relative to the earliest, else 0");
   cmd->add_option("--clearance", args->clearance,
                   "Required distance (m) between robots (default 0: no contact)");
   cmd->add_option("--samples", args->samples,

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "kinograph/planner_status_v2_t.hpp"
+#include "lcmtypes/safe_decode.h"
 #include "tests/lcmtypes/sample_messages.h"
 
 namespace {
@@ -136,6 +138,28 @@ TEST(LcmTypes, PlannerStatusRoundTrip) {
   EXPECT_EQ(out.num_goals_answered, 4);
   EXPECT_EQ(out.num_goals_superseded, 1);
   EXPECT_EQ(out.num_goals_dropped, 2);
+  EXPECT_EQ(out.model_id, m.model_id);
+  EXPECT_EQ(out.base_position[0], 1.3);
+  EXPECT_EQ(out.base_quaternion[0], 1.0);
+  EXPECT_EQ(out.goal_utime, 42);
+  EXPECT_EQ(out.valid_plan_id, 1);
+  EXPECT_EQ(out.num_neighbour_replans, 3);
+  EXPECT_EQ(out.neighbours, m.neighbours);
+}
+
+// Version 3 of the heartbeat has its own fingerprint; version 2 stays readable as
+// planner_status_v2_t and is refused as a version 3.
+TEST(LcmTypes, PlannerStatusVersions) {
+  EXPECT_NE(kinograph::planner_status_t::getHash(), kinograph::planner_status_v2_t::getHash());
+  kinograph::planner_status_v2_t v2;
+  v2.robot = "rr";
+  v2.message = "";
+  const std::vector<uint8_t> bytes = encode(v2);
+  kinograph::planner_status_v2_t back;
+  EXPECT_TRUE(kinograph::lcmtypes::safe_decode(bytes.data(), static_cast<int>(bytes.size()), back).ok);
+  planner_status_t as_v3;
+  EXPECT_FALSE(
+      kinograph::lcmtypes::safe_decode(bytes.data(), static_cast<int>(bytes.size()), as_v3).ok);
 }
 
 TEST(LcmTypes, TruncatedBuffersAreRejected) {

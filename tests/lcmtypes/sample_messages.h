@@ -322,6 +322,13 @@ inline planner_status_t make_planner_status() {
   m.num_goals_answered = 4;
   m.num_goals_superseded = 1;
   m.num_goals_dropped = 2;
+  m.model_id = "acrobot:0123456789abcdef";
+  m.base_position[0] = 1.3;
+  m.base_quaternion[0] = 1.0;
+  m.goal_utime = 42;
+  m.valid_plan_id = 1;
+  m.num_neighbour_replans = 3;
+  m.neighbours = "right: plan 3, followed";
   return m;
 }
 
