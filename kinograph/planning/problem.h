@@ -57,10 +57,11 @@ struct Objectives {
   /// and the floor: smaller than ε, since an arm's own links pass close by design (links two
   /// joints apart are 4.5 cm apart on the iiwa) and it works close to the floor it stands on.
   double self_collision_epsilon = 0.01;
-  /// Number of interior points per interval (evenly spaced) where the planner enforces the
-  /// effort, q and q̇ limits on the interpolant, raised to one per RK4 node of the interpolant
-  /// (limit_points in interpolant.h); 0 = only at the knots. The default matches the
-  /// validator's 10 samples per interval.
+  /// Interior limit points per interval (evenly spaced, limit_points in interpolant.h raises
+  /// them to one per RK4 node): where the interval factor can enforce the effort, q and q̇
+  /// limits on the interpolant; 0 = only at the knots. The batch planner adds them only on
+  /// intervals that came near a limit (batch/interval_limits.h), the incremental planner on
+  /// every interval. The default matches the validator's 10 samples per interval.
   int limit_substeps = 9;
 };
 

@@ -45,6 +45,8 @@ TEST(Interpolant, IntegrationStepsFollowTheLongestStep) {
   EXPECT_EQ(integration_steps(0.2), 20);
   EXPECT_EQ(integration_steps(0.025), 3);
   EXPECT_EQ(integration_steps(1e-4), 1);
+  EXPECT_EQ(integration_steps(0.1, 0.05), 2);  // the batch planner's warm-up step
+  EXPECT_EQ(integration_steps(0.025, 0.05), 1);
 }
 
 TEST(Interpolant, FullyActuatedIsTheCollocationCubic) {
@@ -189,9 +191,10 @@ graph::Values off_defect_interval(int n, double dt, std::mt19937& rng) {
 }
 
 void expect_raw_jacobians(std::shared_ptr<const dynamics::Model> model, int checks,
-                          unsigned seed) {
+                          unsigned seed, double integration_step = kMaxIntegrationStep) {
   IntervalDynamicsOptions o;
   o.checks = checks;
+  o.integration_step = integration_step;
   const double dt = 0.1;
   IntervalDynamicsFactor f(0, dt, model, o);
   std::mt19937 rng(seed);
@@ -206,6 +209,11 @@ void expect_raw_jacobians(std::shared_ptr<const dynamics::Model> model, int chec
 
 TEST(IntervalDynamicsFactor, JacobiansUnderactuated) {
   expect_raw_jacobians(testing::acrobot_model(), 3, 21);
+}
+// The batch planner's warm-up rows: two RK4 steps per interval, check points between the nodes
+// (each reached by a shorter step).
+TEST(IntervalDynamicsFactor, JacobiansWithTheWarmUpStep) {
+  expect_raw_jacobians(testing::acrobot_model(), 4, 23, 0.05);
 }
 TEST(IntervalDynamicsFactor, JacobiansFullyActuated) {
   expect_raw_jacobians(load_robot("robots/rr/rr.urdf"), 2, 22);
