@@ -8,9 +8,9 @@ PACKAGES=(
   cmake ninja-build pkg-config g++ git
   # messaging
   liblcm-dev liblcm-bin libglib2.0-dev
-  # lcm-spy with kinograph's types (the jar is built when a JDK, e.g. openjdk-17-jdk-headless,
-  # is present too; this script does not install one)
-  liblcm-java libjchart2d-java
+  # lcm-spy with kinograph's types: the jar is built, and its test run, when a JDK is present
+  # (the build skips both without one)
+  liblcm-java libjchart2d-java openjdk-17-jdk-headless
   # numerics, collision, models, meshes
   libeigen3-dev libsuitesparse-dev libbullet-dev liburdfdom-dev libassimp-dev
   # rendering and plots
