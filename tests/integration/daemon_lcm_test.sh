@@ -43,17 +43,23 @@ logger_ready() {
   fail "lcm-logger writing $2 did not start"
 }
 
-# Waits (bounded) until the log $1 holds an answer log-plans reports as matching $2, so the
-# logger is stopped only once the plan is written (it flushes every 100 ms).
+# Waits (bounded) until the log $1, written by the logger on URL $3, holds an answer log-plans
+# reports as matching $2, so the logger is stopped only once the plan is written. lcm-logger
+# flushes its file when a message arrives, so each try sends it a probe: without traffic (the
+# daemon stopped) the last plan would stay in its buffer.
 logged_answer() {
   for _ in $(seq 300); do
+    "$KG" send-raw RR_LOGGER_PROBE --text probe --lcm-url "$3" >/dev/null
     rm -rf "$WORK/snapshot"
     cp "$1" "$WORK/snapshot.lcmlog"
+    # Into a file, not a pipe: grep -q leaving early would end log-plans by SIGPIPE, and
+    # pipefail would then count a match as a miss.
     "$KG" log-plans "$WORK/snapshot.lcmlog" --channel RR_PLAN --scene "$SCENE" \
-      --out-dir "$WORK/snapshot" 2>/dev/null | grep -Eq "$2" && return 0
+      --out-dir "$WORK/snapshot" >"$WORK/snapshot.txt" 2>/dev/null || true
+    grep -Eq "$2" "$WORK/snapshot.txt" && return 0
     sleep 0.1
   done
-  fail "no answer matching '$2' in $1"
+  fail "no answer matching '$2' in $1: $(cat "$WORK/snapshot.txt")"
 }
 
 # lcm-logger 1.3.1 lists -l in its help but rejects it: the long option works.
@@ -92,7 +98,7 @@ grep -q '"elbow" is not a joint of rr' "$WORK/daemon1.log" || fail "unknown join
 
 kill -TERM "$DAEMON"
 wait "$DAEMON" || fail "daemon did not exit cleanly on SIGTERM"
-logged_answer "$WORK/session.lcmlog" "for goal 5: "
+logged_answer "$WORK/session.lcmlog" "for goal 5: " "$URL"
 kill -INT "$LOGGER"
 wait "$LOGGER" || true
 
@@ -111,7 +117,7 @@ PIDS+=($LOGGER2)
 logger_ready "$URL2" "$WORK/replay.lcmlog"
 start_daemon "$URL2" "$WORK/daemon2.log"
 lcm-logplayer --speed=1 --regexp="^RR_(GOAL|OBSTACLES)$" --lcm-url="$URL2" "$WORK/session.lcmlog"
-logged_answer "$WORK/replay.lcmlog" "for goal 2: SUCCESS"
+logged_answer "$WORK/replay.lcmlog" "for goal 2: SUCCESS" "$URL2"
 kill -INT "$LOGGER2"
 wait "$LOGGER2" || true
 "$KG" log-plans "$WORK/replay.lcmlog" --channel RR_PLAN --scene "$SCENE" --out-dir "$WORK/replayed" \
