@@ -62,7 +62,6 @@ std::tuple<int64_t, std::string> key(const Robot& r) {
   return {g < 0 ? std::numeric_limits<int64_t>::max() : g, r.prefix};
 }
 
-// Why the fleet has not settled yet, or empty.
 // The "plan_id" of the plan file `path`, -1 when there is none.
 int64_t kept_plan_id(const std::string& path) {
   std::ifstream in(path);
@@ -71,6 +70,7 @@ int64_t kept_plan_id(const std::string& path) {
   return json.is_object() && json.contains("plan_id") ? json["plan_id"].get<int64_t>() : -1;
 }
 
+// Why the fleet has not settled yet, or empty.
 std::string unsettled(const std::vector<Robot>& robots) {
   for (const Robot& r : robots) {
     if (!r.heartbeat) return r.prefix + ": no heartbeat";
