@@ -280,6 +280,10 @@ TEST(ReplanChange, BadInputNamesTheKey) {
             "remove[0]");
   EXPECT_NE(key_of("goal: {q: [1, 2, 3]}"), "no error");
   EXPECT_NE(key_of("[1, 2"), "no error");
+  // Keys and names that are not strings (a fuzzer's finding: yaml-cpp's conversion escaped).
+  EXPECT_EQ(key_of("? {q: [1, 1]}\n: 2"), "");
+  EXPECT_EQ(key_of("obstacles: [{id: {a: 1}, shape: sphere, size: [0.1]}]"), "obstacles[0].id");
+  EXPECT_EQ(key_of("remove: [[ball]]"), "remove[0]");
   EXPECT_THROW(load_change("/nonexistent/change.yaml", scene), SceneError);
 }
 

@@ -4,13 +4,14 @@
 
 #include <algorithm>
 #include <fstream>
-#include <set>
 #include <sstream>
+
+#include "kinograph/planning/io/yaml_reader.h"
 
 namespace kinograph::planning {
 namespace {
 
-int line_of(const YAML::Node& n) { return n.Mark().line >= 0 ? n.Mark().line + 1 : 0; }
+using yaml::line_of;
 
 int index_of(const std::vector<std::string>& names, const std::string& name) {
   const auto it = std::find(names.begin(), names.end(), name);
@@ -27,14 +28,8 @@ SceneChange parse_change(const std::string& yaml, const Scene& scene, const std:
     throw SceneError(source, "", e.mark.line >= 0 ? e.mark.line + 1 : 0, e.msg);
   }
   if (!root.IsMap()) throw SceneError(source, "", 0, "a change file must be a YAML map");
-  static const std::set<std::string> kKeys{"goal", "start", "horizon", "obstacles", "remove"};
-  for (const auto& kv : root) {
-    const std::string key = kv.first.as<std::string>();
-    if (kKeys.count(key) == 0) {
-      throw SceneError(source, key, line_of(kv.first),
-                       "unknown key (expected goal, start, horizon, obstacles or remove)");
-    }
-  }
+  const yaml::Reader reader(source);
+  reader.expect_map(root, "", {"goal", "start", "horizon", "obstacles", "remove"});
 
   // The scene with the change's entries in place, parsed by the scene parser (one schema).
   YAML::Node merged = YAML::Load(scene_to_yaml(scene));
@@ -56,7 +51,7 @@ SceneChange parse_change(const std::string& yaml, const Scene& scene, const std:
       if (!list[i].IsMap() || !list[i]["id"]) {
         throw SceneError(source, key, line_of(list[i]), "an obstacle needs an id");
       }
-      const std::string name = list[i]["id"].as<std::string>();
+      const std::string name = reader.string(list[i]["id"], key + ".id");
       if (std::find(changed.begin(), changed.end(), name) != changed.end()) {
         throw SceneError(source, key + ".id", line_of(list[i]["id"]),
                          "obstacle '" + name + "' appears twice");
@@ -80,7 +75,7 @@ SceneChange parse_change(const std::string& yaml, const Scene& scene, const std:
     }
     for (size_t i = 0; i < list.size(); ++i) {
       const std::string key = "remove[" + std::to_string(i) + "]";
-      const std::string name = list[i].as<std::string>();
+      const std::string name = reader.string(list[i], key);
       const int idx = index_of(scene.obstacle_names, name);
       if (idx < 0) {
         throw SceneError(source, key, line_of(list[i]),
