@@ -151,7 +151,8 @@ PathCheckResult SegmentChecker::check_path(CollisionWorld& world, dynamics::Data
       u = 0;
       if (i == m - 1 || budget <= 0 || time_budget <= 0) break;
     }
-    if (result.samples >= options_.max_path_samples) {
+    result.swept += swept / relative;
+    if (result.samples >= options_.max_path_samples || result.swept > options_.max_path_sweep) {
       result.complete = false;
       result.stopped_segment = i;
       result.stopped_s = u;

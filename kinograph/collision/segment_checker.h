@@ -27,6 +27,10 @@ struct SegmentCheckOptions {
   // Most configurations check_path queries. A path that sweeps kilometres (a plan file with
   // q = 1e308) would otherwise take forever; the walk stops there and says so. Default 200,000.
   int max_path_samples = 200000;
+  // Most distance (m) check_path lets a point of the robot sweep along a path: no arm's plan
+  // moves its geometry a kilometre, and a plan file that does (q̇ = 1e7) would spend the whole
+  // query budget on it. The walk stops there and says so. Default 1,000 m.
+  double max_path_sweep = 1000;
 };
 
 // The smallest signed distance found along a segment.
@@ -56,8 +60,10 @@ struct PathCheckResult {
   Proximity closest;
   // Number of configurations checked.
   int samples = 0;
-  // False when the walk stopped at max_path_samples: the distances cover only the path up to
-  // segment `stopped_segment`, fraction `stopped_s`.
+  // Distance (m) the walk let a point of the robot sweep, up to where it stopped.
+  double swept = 0;
+  // False when the walk stopped at max_path_samples or max_path_sweep: the distances cover only
+  // the path up to segment `stopped_segment`, fraction `stopped_s`.
   bool complete = true;
   int stopped_segment = 0;
   double stopped_s = 0;
@@ -82,7 +88,8 @@ class SegmentChecker {
   // the robot could come closer than `clearance` is skipped, yet clear stretches cost one
   // query. With self-collision pairs in the world the budget is halved: both geometries of a
   // pair move, so their distance changes up to twice the sweep. Allocates nothing after the
-  // first call with a given joint count. Stops after max_path_samples queries (complete false).
+  // first call with a given joint count. Stops after max_path_samples queries or max_path_sweep
+  // of sweep (complete false).
   PathCheckResult check_path(CollisionWorld& world, dynamics::Data& data,
                              const Eigen::Ref<const Eigen::MatrixXd>& path,
                              const std::vector<double>& times = {}, double clearance = 0);

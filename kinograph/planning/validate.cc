@@ -359,8 +359,8 @@ void check_collision(const Problem& problem, const Plan& plan,
     const double t =
         at + 1 < times.size() ? times[at] + r.stopped_s * (times[at + 1] - times[at]) : times[at];
     std::ostringstream os;
-    os << "collision: not checked after t = " << t << " s: the path sweeps too far for "
-       << r.samples << " collision queries (q or q̇ far beyond what the robot can move)";
+    os << "collision: not checked after t = " << t << " s: the path sweeps too far (" << r.swept
+       << " m in " << r.samples << " collision queries; q or q̇ far beyond what the robot can move)";
     add_failure(v, os.str());
   }
   if (r.min_distance < thresholds.min_clearance) {

@@ -233,6 +233,7 @@ TEST_F(RrSegment, PathCheckStopsAtItsQueryBound) {
   path << 0, 0, 1e6, 0, 0, 0;
   SegmentCheckOptions options;
   options.max_path_samples = 1000;
+  options.max_path_sweep = std::numeric_limits<double>::infinity();
   SegmentChecker checker(model, options);
   const PathCheckResult r = checker.check_path(world, data, path);
   EXPECT_FALSE(r.complete);
@@ -243,6 +244,31 @@ TEST_F(RrSegment, PathCheckStopsAtItsQueryBound) {
   // The same path within the bound is walked whole.
   path << 0, 0, 1, 0, 0, 0;
   EXPECT_TRUE(checker.check_path(world, data, path).complete);
+}
+
+// A path whose geometry sweeps further than max_path_sweep stops once it has, long before the
+// query bound (a plan file with q̇ = 1e7: every query there is wasted).
+TEST_F(RrSegment, PathCheckStopsAtItsSweepBound) {
+  CollisionWorld world(model);
+  Obstacle o;
+  o.id = 1;
+  o.shape = Shape::sphere(0.05);
+  o.pose = at(0, 0, -1.5);
+  ASSERT_TRUE(world.add_obstacle(o));
+  Eigen::MatrixXd path(3, 2);
+  path << 0, 0, 1e6, 0, 0, 0;
+  SegmentChecker checker(model, {.max_path_sweep = 50});
+  const PathCheckResult r = checker.check_path(world, data, path);
+  EXPECT_FALSE(r.complete);
+  EXPECT_GT(r.swept, 50);
+  EXPECT_LT(r.swept, 52);  // stopped at the first sample past the bound (steps under 1 m)
+  EXPECT_LT(r.samples, 1000);
+  EXPECT_EQ(r.stopped_segment, 0);
+  // Within the bound the same path is walked whole, and its sweep counted.
+  path << 0, 0, 1, 0, 0, 0;
+  const PathCheckResult whole = checker.check_path(world, data, path);
+  EXPECT_TRUE(whole.complete);
+  EXPECT_NEAR(whole.swept, 2 * checker.lever()[0], 1e-9);
 }
 
 // Moving obstacles: samples at most max_time_step apart in time, and the sphere that passes
