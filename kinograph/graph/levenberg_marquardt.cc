@@ -189,6 +189,7 @@ LevenbergMarquardt::Trial LevenbergMarquardt::try_step(const FactorGraph& graph,
   s.rhs = -equations_->gradient();
   cholesky_->solve(s.rhs, s.step);
   stats.solve_s = seconds_since(t);
+  throw_if_cancelled();  // the factorization of a long trajectory is a large part of a trial
   s.result.solve_s += stats.solve_s;
   stats.step_norm = s.step.norm();
   const double x_norm = values.vector().norm();
@@ -229,12 +230,17 @@ void LevenbergMarquardt::evaluate_step(const FactorGraph& graph, Values& values,
   s.x_backup = values.vector();
   eq.add_step(s.step, values.vector());
   double new_error = 0;
-  trial.candidate_ready =
-      options_.linearize_at_evaluation && candidate_->linearize(graph, values, &new_error, nullptr);
-  // Without the candidate (or when its Jacobian is not finite) the error alone decides, and a
-  // non-finite Jacobian is reported by the linearization after acceptance.
-  const bool finite =
-      trial.candidate_ready || eq.evaluate_error(graph, values, &new_error, nullptr);
+  bool finite = false;
+  try {
+    trial.candidate_ready = options_.linearize_at_evaluation &&
+                            candidate_->linearize(graph, values, &new_error, nullptr);
+    // Without the candidate (or when its Jacobian is not finite) the error alone decides, and a
+    // non-finite Jacobian is reported by the linearization after acceptance.
+    finite = trial.candidate_ready || eq.evaluate_error(graph, values, &new_error, nullptr);
+  } catch (const Cancelled&) {
+    values.vector() = s.x_backup;  // a cancelled solve leaves the last accepted point
+    throw;
+  }
   stats.evaluate_s = seconds_since(t);
   s.result.evaluate_s += stats.evaluate_s;
   stats.error = finite ? new_error : std::numeric_limits<double>::infinity();

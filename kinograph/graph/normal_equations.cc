@@ -4,9 +4,14 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "kinograph/graph/cancellation.h"
+
 namespace kinograph::graph {
 
 namespace {
+
+// Factors linearized between two looks at the cancellation flag: a few hundred microseconds.
+constexpr size_t kFactorsPerCancellationCheck = 256;
 
 // How messages name a factor: "factor 3 (Name)".
 std::string factor_label(size_t index, const Factor& f) {
@@ -240,6 +245,11 @@ bool NormalEquations::run(const FactorGraph& graph, const Values& values, double
   const double* base = values.vector().data();
   double total = 0;
   for (size_t fi = 0; fi < factors_.size(); ++fi) {
+    // A linearization of a long trajectory is most of a solver iteration: a shutdown asked for
+    // meanwhile must not wait for its end.
+    if (fi % kFactorsPerCancellationCheck == kFactorsPerCancellationCheck - 1) {
+      throw_if_cancelled();
+    }
     const FactorInfo& info = factors_[fi];
     const Factor& f = *graph[info.slot];
     const int m = f.residual_dim();

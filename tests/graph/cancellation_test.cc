@@ -72,6 +72,43 @@ TEST(Cancellation, TheFlagIsThisThreadsAndScopesNest) {
   EXPECT_FALSE(other_thread_threw);
 }
 
+// e = x² − 4 on one scalar; every evaluation counts, and the call numbered `trip` sets the flag
+// (a shutdown asked for while the solver is inside a linearization).
+class Tripwire final : public Factor {
+ public:
+  Tripwire(Key key, int* calls, int trip, std::atomic<bool>* flag)
+      : Factor({key}, {1}, 1), calls_(calls), trip_(trip), flag_(flag) {}
+  void evaluate(const FactorValues& x, Eigen::Ref<Eigen::VectorXd> e,
+                const Jacobians* J) const override {
+    if (++*calls_ == trip_) flag_->store(true);
+    e(0) = x[0](0) * x[0](0) - 4;
+    if (J) J->block(0)(0, 0) = 2 * x[0](0);
+  }
+
+ private:
+  int* calls_;
+  int trip_;
+  std::atomic<bool>* flag_;
+};
+
+// A long linearization looks at the flag on its way, not only at its end: set in the middle of
+// the first trial's evaluation of a 600-factor graph, LM stops there, with the values it had.
+TEST(Cancellation, ALinearizationUnderWayStopsAndKeepsTheLastAcceptedPoint) {
+  constexpr int kFactors = 600;
+  std::atomic<bool> cancel{false};
+  int calls = 0;
+  FactorGraph g;
+  Values v;
+  for (int i = 0; i < kFactors; ++i) {
+    g.emplace<Tripwire>(Key('x', i, 0), &calls, kFactors + 100, &cancel);
+    v.insert(Key('x', i, 0), Eigen::VectorXd::Constant(1, 1.0));
+  }
+  CancellationScope scope(cancel);
+  EXPECT_THROW(LevenbergMarquardt().optimize(g, v), Cancelled);
+  EXPECT_LT(calls, 2 * kFactors);  // the trial's pass over the graph did not finish
+  for (int i = 0; i < kFactors; ++i) EXPECT_EQ(v.at(Key('x', i, 0))(0), 1.0);
+}
+
 // The planners turn a std::exception from a solve into a failed plan; a cancellation must not
 // be one of them.
 TEST(Cancellation, IsNotAStdException) {
