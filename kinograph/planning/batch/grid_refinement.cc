@@ -23,6 +23,10 @@ Trajectory refined_start(const Problem& fine, const Plan& coarse) {
   }
   const SampledPath path = sample_plan(*fine.model, coarse, fine.steps / intervals);
   Trajectory tr{path.q, path.qd, path.qdd};
+  // The last knot is the coarse plan's own (its goal), not where its interpolant arrives.
+  tr.q.row(fine.steps) = coarse.q.row(intervals);
+  tr.qd.row(fine.steps) = coarse.qd.row(intervals);
+  tr.qdd.row(fine.steps) = coarse.qdd.row(intervals);
   tr.q.row(0) = fine.start_q.transpose();
   if (fine.start_qd.size() == n) tr.qd.row(0) = fine.start_qd.transpose();
   return tr;
