@@ -78,9 +78,9 @@ struct BatchPlannerOptions {
   /// intervals at most this long (s) is first planned on that grid, by this planner (so
   /// recursively, down to intervals of about this length), and its first attempt starts from the
   /// coarse plan's interpolant at its knots, on the interpolant from its first solve; the other
-  /// initializations follow if that does not validate. The shipped scenes' 0.1 s grids are not
-  /// refined; an Acrobot swing-up over 10 s in 400 steps is planned from 100 and 200 steps.
-  /// 0 = off.
+  /// initializations follow if that does not validate. The plan's stats count the coarse
+  /// plans' iterations and attempts. The shipped scenes' 0.1 s grids are not refined; an Acrobot
+  /// swing-up over 10 s in 400 steps is planned from 100 and 200 steps. 0 = off.
   double refine_max_interval = 0.1;
 };
 
