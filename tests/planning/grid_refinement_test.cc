@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "kinograph/planning/formulation/planning_graph.h"
 #include "kinograph/planning/trajectory_sampler.h"
 #include "tests/planning/test_problems.h"
 
@@ -40,12 +41,8 @@ TEST(GridRefinement, CoarseGridHalvesTheStepsDownToTheLongestInterval) {
 // on the fine grid, and the unpowered shoulder's integrated motion nearly so.
 TEST(GridRefinement, FineStartLiesOnTheCoarseInterpolant) {
   const Problem coarse = acrobot_at(100), fine = acrobot_at(200);
-  Plan plan;
   const Trajectory line = straight_line(coarse, coarse.goal.q);
-  for (int k = 0; k <= coarse.steps; ++k) plan.t.push_back(k * coarse.dt());
-  plan.q = line.q;
-  plan.qd = line.qd;
-  plan.qdd = line.qdd;
+  const Plan plan = plan_from_trajectory(coarse, line);
   const Trajectory tr = refined_start(fine, plan);
   ASSERT_EQ(tr.q.rows(), fine.steps + 1);
   TrajectorySampler on_coarse(*coarse.model, plan);
@@ -59,11 +56,7 @@ TEST(GridRefinement, FineStartLiesOnTheCoarseInterpolant) {
     }
   }
   EXPECT_NEAR((tr.q.row(fine.steps) - line.q.row(coarse.steps)).norm(), 0, 1e-12);  // the goal
-  Plan refined;
-  for (int k = 0; k <= fine.steps; ++k) refined.t.push_back(k * fine.dt());
-  refined.q = tr.q;
-  refined.qd = tr.qd;
-  refined.qdd = tr.qdd;
+  const Plan refined = plan_from_trajectory(fine, tr);
   TrajectorySampler on_fine(*fine.model, refined);
   double elbow = 0, shoulder = 0;
   for (double t = 0.013; t < coarse.horizon; t += 0.031) {
@@ -77,12 +70,8 @@ TEST(GridRefinement, FineStartLiesOnTheCoarseInterpolant) {
 
 TEST(GridRefinement, RefusesAPlanWhoseGridDoesNotDivide) {
   const Problem coarse = acrobot_at(100);
-  Plan plan;
   const Trajectory line = straight_line(coarse, coarse.goal.q);
-  for (int k = 0; k <= coarse.steps; ++k) plan.t.push_back(k * coarse.dt());
-  plan.q = line.q;
-  plan.qd = line.qd;
-  plan.qdd = line.qdd;
+  const Plan plan = plan_from_trajectory(coarse, line);
   EXPECT_THROW(refined_start(acrobot_at(150), plan), std::invalid_argument);
   EXPECT_NO_THROW(refined_start(acrobot_at(300), plan));
 }

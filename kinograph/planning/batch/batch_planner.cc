@@ -212,17 +212,6 @@ bool add_flags(std::vector<char>& flags, const std::vector<char>& near) {
   return added;
 }
 
-// A trajectory on the problem's grid as a plan (its knots' q, q̇, q̈), for reading its
-// interpolant.
-Plan trajectory_plan(const Problem& problem, const Trajectory& tr) {
-  Plan plan;
-  for (int k = 0; k <= problem.steps; ++k) plan.t.push_back(k * problem.dt());
-  plan.q = tr.q;
-  plan.qd = tr.qd;
-  plan.qdd = tr.qdd;
-  return plan;
-}
-
 // Carries the multipliers of the shooting-defect rows (the first `defect_rows` of every
 // interval factor) into a record of the factor's new size, which bind() then keeps; the limit
 // rows of a new layout start from zero.
@@ -266,7 +255,7 @@ Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init, const s
   if (from_interpolant) {  // no knot-only solve to leave the interpolant and come back to it
     between.knots_only = false;
     warmup = false;
-    between.limits = intervals_near_limits(problem, trajectory_plan(problem, init), kNearLimit);
+    between.limits = intervals_near_limits(problem, plan_from_trajectory(problem, init), kNearLimit);
   }
   for (int round = 0;; ++round) {
     PlanningGraph next;
