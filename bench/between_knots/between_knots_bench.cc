@@ -95,14 +95,14 @@ int run(int argc, char** argv) {
     std::cerr << row.dump() << "\n";
     result.push_back(row);
   }
-  const json out = {{"acrobot", result},
-                    {"settings",
-                     {{"scene", "robots/scenes/acrobot_swingup.yaml"},
-                      {"repeats", repeats},
-                      {"points_per_interval", points},
-                      {"time", "wall time of BatchPlanner::plan (coarse grids, build, solve, "
-                               "validate)"},
-                      {"measure", "RNEA on central differences (±dt/200) of the interpolant's q"}}}};
+  const json out = {
+      {"acrobot", result},
+      {"settings",
+       {{"scene", "robots/scenes/acrobot_swingup.yaml"},
+        {"repeats", repeats},
+        {"points_per_interval", points},
+        {"time", "wall time of BatchPlanner::plan (coarse grids, build, solve, validate)"},
+        {"measure", "RNEA on central differences (±dt/200) of the interpolant's q"}}}};
   std::cout << out.dump(2) << "\n\n";
   if (!json_path.empty()) std::ofstream(json_path) << out.dump(2) << "\n";
   std::cout << "| steps | planner | success | solver status | LM iterations | median time (ms) | "

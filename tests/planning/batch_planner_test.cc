@@ -80,7 +80,7 @@ TEST(BatchPlanner, AcrobotFineGridPlansByRefinement) {
   EXPECT_TRUE(plan.success()) << plan.stats.reason;
   EXPECT_EQ(plan.stats.status, PlanStatus::kConverged) << plan.stats.reason;
   EXPECT_EQ(plan.q.rows(), 401);
-  EXPECT_EQ(plan.stats.attempts, 3);       // 100, 200 and 400 steps
+  EXPECT_EQ(plan.stats.attempts, 3);      // 100, 200 and 400 steps
   EXPECT_LT(plan.stats.iterations, 200);  // the 100-step plan's 111 and a few more
   EXPECT_LT(plan.validation.max_unactuated_torque_between, 1e-3);
   EXPECT_LT(plan.validation.max_tau_violation_between, 0.08);  // 1 % of 8 N·m

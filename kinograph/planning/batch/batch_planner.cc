@@ -154,10 +154,9 @@ Plan BatchPlanner::plan(const Problem& problem, const Plan* warm, BatchSolution*
   // each barely coupled to the objective), a coarse plan's interpolant a nearly feasible one.
   SolveStats coarse_stats;
   coarse_stats.attempts = 0;
-  const int coarse_steps =
-      warm == nullptr && options_.refine_max_interval > 0
-          ? coarser_grid(problem, options_.refine_max_interval)
-          : 0;
+  const int coarse_steps = warm == nullptr && options_.refine_max_interval > 0
+                               ? coarser_grid(problem, options_.refine_max_interval)
+                               : 0;
   if (coarse_steps > 0) {
     std::optional<Plan> p = solve_refined(problem, coarse_steps, method, coarse_stats,
                                           solution != nullptr ? &attempt : nullptr);
@@ -255,7 +254,8 @@ Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init, const s
   if (from_interpolant) {  // no knot-only solve to leave the interpolant and come back to it
     between.knots_only = false;
     warmup = false;
-    between.limits = intervals_near_limits(problem, plan_from_trajectory(problem, init), kNearLimit);
+    between.limits =
+        intervals_near_limits(problem, plan_from_trajectory(problem, init), kNearLimit);
   }
   for (int round = 0;; ++round) {
     PlanningGraph next;

@@ -19,7 +19,8 @@ int coarser_grid(const Problem& problem, double max_interval) {
 Trajectory refined_start(const Problem& fine, const Plan& coarse) {
   const int n = fine.model->nq(), intervals = static_cast<int>(coarse.q.rows()) - 1;
   if (coarse.q.cols() != n || intervals < 1 || fine.steps % intervals != 0) {
-    throw std::invalid_argument("grid refinement: the coarse plan's grid does not divide the steps");
+    throw std::invalid_argument(
+        "grid refinement: the coarse plan's grid does not divide the steps");
   }
   const SampledPath path = sample_plan(*fine.model, coarse, fine.steps / intervals);
   Trajectory tr{path.q, path.qd, path.qdd};

@@ -16,8 +16,8 @@ int coarser_grid(const Problem& problem, double max_interval);
 
 /// The initial trajectory of `fine` from a plan of the same motion on a grid that divides it:
 /// the coarse plan's interpolant (TrajectorySampler) at the fine knots but the last (the coarse
-/// plan's last knot), with the fine problem's start state. Throws std::invalid_argument when the coarse plan's intervals do not divide
-/// fine.steps or its joints differ.
+/// plan's last knot), with the fine problem's start state. Throws std::invalid_argument when the
+/// coarse plan's intervals do not divide fine.steps or its joints differ.
 Trajectory refined_start(const Problem& fine, const Plan& coarse);
 
 }  // namespace kinograph::planning
