@@ -117,22 +117,6 @@ TEST(BatchPlanner, RrReachAvoidsTheBall) {
               plan.validation.min_clearance);
 }
 
-// refine_max_interval = 0 plans a fine grid directly; by default the RR arm's 60 steps in 3 s
-// are planned from 30.
-TEST(BatchPlanner, RefinementCanBeSwitchedOff) {
-  Problem p = rr_reach();
-  p.steps = 60;
-  BatchPlannerOptions direct;
-  direct.refine_max_interval = 0;
-  const Plan refined = BatchPlanner().plan(p), plain = BatchPlanner(direct).plan(p);
-  for (const Plan* plan : {&refined, &plain}) {
-    EXPECT_TRUE(plan->success()) << plan->stats.reason;
-    EXPECT_EQ(plan->q.rows(), 61);
-  }
-  EXPECT_EQ(refined.stats.attempts, 2);
-  EXPECT_EQ(plain.stats.attempts, 1);
-}
-
 std::shared_ptr<const dynamics::Model> iiwa_with_block() {
   return std::make_shared<const dynamics::Model>(dynamics::attach_box_payload(
       *load("robots/iiwa14/iiwa14.urdf"), "iiwa_link_ee_kuka", 2.0, {0.1, 0.1, 0.1},
