@@ -30,7 +30,8 @@ TEST(GridRefinement, CoarseGridHalvesTheStepsDownToTheLongestInterval) {
   EXPECT_EQ(coarser_grid(acrobot_at(300), 0.05), 0);
   EXPECT_EQ(coarser_grid(acrobot_at(401), 0.1), 0);  // prime: nothing divides it
   EXPECT_EQ(coarser_grid(acrobot_at(400), 0), 0);    // off
-  Problem iiwa = testing::iiwa_swing(30);            // 2 s: 15 steps are 0.133 s apart
+  EXPECT_EQ(coarser_grid(acrobot_at(400), -1), 0);
+  Problem iiwa = testing::iiwa_swing(30);  // 2 s: 15 steps are 0.133 s apart
   EXPECT_EQ(coarser_grid(iiwa, 0.1), 0);
   iiwa.steps = 40;
   EXPECT_EQ(coarser_grid(iiwa, 0.1), 20);

@@ -7,6 +7,7 @@
 namespace kinograph::planning {
 
 int coarser_grid(const Problem& problem, double max_interval) {
+  if (!(max_interval > 0)) return 0;
   const int steps = problem.steps;
   for (int f = 2; f * f <= steps; ++f) {
     if (steps % f != 0) continue;

@@ -11,7 +11,7 @@ namespace kinograph::planning {
 
 /// The coarse grid a refinement of `problem` solves first: problem.steps / f for the smallest
 /// factor f ≥ 2 of the steps, provided its intervals are at most `max_interval` long (s); 0 when
-/// there is none (a prime number of steps, intervals already that long, or max_interval ≤ 0).
+/// there is none (a prime number of steps, longer intervals, or max_interval ≤ 0).
 int coarser_grid(const Problem& problem, double max_interval);
 
 /// The initial trajectory of `fine` from a plan of the same motion on a grid that divides it:
