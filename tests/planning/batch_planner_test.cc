@@ -69,6 +69,23 @@ TEST(BatchPlanner, AcrobotWarmUpSolveKeepsThePlanValid) {
   EXPECT_NEAR(a.stats.cost, b.stats.cost, 0.05 * b.stats.cost);
 }
 
+// A grid four times finer than the scene's: the straight line does not plan it (the knot-only
+// solve stalls), the refinement through 100 and 200 steps does, each refined solve a short
+// projection.
+TEST(BatchPlanner, AcrobotFineGridPlansByRefinement) {
+  Problem p = acrobot_swingup();
+  p.steps = 400;
+  const Plan plan = BatchPlanner().plan(p);
+  for (const auto& f : plan.validation.failures) ADD_FAILURE() << f;
+  EXPECT_TRUE(plan.success()) << plan.stats.reason;
+  EXPECT_EQ(plan.stats.status, PlanStatus::kConverged) << plan.stats.reason;
+  EXPECT_EQ(plan.q.rows(), 401);
+  EXPECT_EQ(plan.stats.attempts, 3);      // 100, 200 and 400 steps
+  EXPECT_LT(plan.stats.iterations, 200);  // the 100-step plan's 111 and a few more
+  EXPECT_LT(plan.validation.max_unactuated_torque_between, 1e-3);
+  EXPECT_LT(plan.validation.max_tau_violation_between, 0.08);  // 1 % of 8 N·m
+}
+
 Problem rr_reach() {
   Problem p;
   p.name = "rr_reach";

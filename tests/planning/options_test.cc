@@ -855,6 +855,26 @@ TEST(BatchPlannerOptions, EffortContinuationSolvesEachFactor) {
   EXPECT_GT(two, one);
 }
 
+// The RR reach at 3 s: 120 steps are planned from 60 and 30 steps by default (one attempt per
+// grid), from 60 only when grids of 0.1 s intervals are too coarse, and directly when off.
+TEST(BatchPlannerOptions, RefineMaxInterval) {
+  Problem p = testing::rr_reach();
+  p.steps = 120;
+  BatchPlannerOptions o;
+  const Plan by_default = BatchPlanner(o).plan(p);
+  o.refine_max_interval = 0.05;
+  const Plan finer = BatchPlanner(o).plan(p);
+  o.refine_max_interval = 0;
+  const Plan direct = BatchPlanner(o).plan(p);
+  for (const Plan* plan : {&by_default, &finer, &direct}) {
+    EXPECT_TRUE(plan->success()) << plan->stats.reason;
+    EXPECT_EQ(plan->q.rows(), 121);
+  }
+  EXPECT_EQ(by_default.stats.attempts, 3);
+  EXPECT_EQ(finer.stats.attempts, 2);
+  EXPECT_EQ(direct.stats.attempts, 1);
+}
+
 TEST(BatchPlannerOptions, DetourCandidatesBoundTheRestarts) {
   BatchPlannerOptions o;
   o.validation.final_velocity = -1;

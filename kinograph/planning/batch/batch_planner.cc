@@ -8,6 +8,7 @@
 #include <optional>
 #include <sstream>
 
+#include "kinograph/planning/batch/grid_refinement.h"
 #include "kinograph/planning/batch/interval_limits.h"
 #include "kinograph/planning/formulation/initialization.h"
 #include "kinograph/planning/solver/violation_text.h"
@@ -54,6 +55,15 @@ std::optional<Trajectory> searched_path(const Problem& problem, const Eigen::Vec
   const std::optional<std::vector<Eigen::VectorXd>> path = search_path(problem, q_goal, options);
   if (!path || 2 * (path->size() - 1) > static_cast<size_t>(problem.steps)) return std::nullopt;
   return path_trajectory(problem, *path);
+}
+
+// Adds the work counts of `from` (LM iterations, outer iterations, linear solves, attempts)
+// to `into`.
+void add_counts(SolveStats& into, const SolveStats& from) {
+  into.iterations += from.iterations;
+  into.outer_iterations += from.outer_iterations;
+  into.linear_solves += from.linear_solves;
+  into.attempts += from.attempts;
 }
 
 }  // namespace
@@ -130,10 +140,7 @@ Plan BatchPlanner::plan(const Problem& problem, const Plan* warm, BatchSolution*
     if (first) {
       total = p.stats;
     } else {
-      total.iterations += p.stats.iterations;
-      total.outer_iterations += p.stats.outer_iterations;
-      total.linear_solves += p.stats.linear_solves;
-      total.attempts += p.stats.attempts;
+      add_counts(total, p.stats);
     }
     spdlog::debug("plan {}: attempt {}: {}", problem.name, made,
                   p.success() ? std::string("valid") : to_string(p.stats.status));
@@ -143,7 +150,19 @@ Plan BatchPlanner::plan(const Problem& problem, const Plan* warm, BatchSolution*
       if (solution != nullptr) *solution = std::move(attempt);
     }
   };
-  for (size_t a = 0; a < inits.size(); ++a) {
+  // Grid refinement first: the straight line on a fine grid is a poor start (many variables,
+  // each barely coupled to the objective), a coarse plan's interpolant a nearly feasible one.
+  SolveStats coarse_stats;
+  coarse_stats.attempts = 0;
+  const int coarse_steps = warm == nullptr && options_.refine_max_interval > 0
+                               ? coarser_grid(problem, options_.refine_max_interval)
+                               : 0;
+  if (coarse_steps > 0) {
+    std::optional<Plan> p = solve_refined(problem, coarse_steps, method, coarse_stats,
+                                          solution != nullptr ? &attempt : nullptr);
+    if (p) consider(std::move(*p));
+  }
+  for (size_t a = 0; a < inits.size() && !best.success(); ++a) {
     if (!inits[a]) inits[a] = searched_path(problem, q_goal, options_.path_search);
     if (!inits[a]) continue;  // no path found: on to the next initialization
     consider(solve(problem, *inits[a], method, solution != nullptr ? &attempt : nullptr));
@@ -155,6 +174,7 @@ Plan BatchPlanner::plan(const Problem& problem, const Plan* warm, BatchSolution*
     consider(solve_by_effort_continuation(problem, q_goal, method,
                                           solution != nullptr ? &attempt : nullptr));
   }
+  add_counts(total, coarse_stats);
   const SolveStats own = best.stats;
   best.stats = total;
   best.stats.status = own.status;
@@ -211,7 +231,7 @@ void resize_interval_records(ConstraintState& state, const PlanningGraph& pg, in
 }  // namespace
 
 Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init, const std::string& method,
-                         BatchSolution* solution) const {
+                         BatchSolution* solution, bool from_interpolant) const {
   const auto t0 = std::chrono::steady_clock::now();
   if (solution != nullptr) *solution = BatchSolution();  // empty unless the solve runs
   // Between-knot rows by constraint generation: the knot-only graph first, then the intervals'
@@ -228,9 +248,15 @@ Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init, const s
   ConstraintState state;
   OuterLoopResult r;
   const double warmup_step = options_.warmup_integration_step;
-  const bool warmup = shooting && warmup_step > 0 &&
-                      integration_steps(problem.dt(), warmup_step) <
-                          integration_steps(problem.dt(), kMaxIntegrationStep);
+  bool warmup = shooting && warmup_step > 0 &&
+                integration_steps(problem.dt(), warmup_step) <
+                    integration_steps(problem.dt(), kMaxIntegrationStep);
+  if (from_interpolant) {  // no knot-only solve to leave the interpolant and come back to it
+    between.knots_only = false;
+    warmup = false;
+    between.limits =
+        intervals_near_limits(problem, plan_from_trajectory(problem, init), kNearLimit);
+  }
   for (int round = 0;; ++round) {
     PlanningGraph next;
     std::vector<DfgConstraintStep> dfg_steps;
@@ -254,7 +280,7 @@ Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init, const s
     // A re-solve starts feasible but for the rows just added: at the largest penalty it is a
     // projection onto them (the multipliers carry the objective's balance), where a smaller one
     // lets LM trade feasibility for the objective first and spend many more linearizations.
-    if (round > 0) state.set_penalty(options_.augmented_lagrangian.max_penalty);
+    if (round > 0 || from_interpolant) state.set_penalty(options_.augmented_lagrangian.max_penalty);
     const OuterLoopResult stage = solve_outer_loop(pg.graph, pg.values, al, loop, problem.name);
     const int before = r.iterations, before_outer = r.outer_iterations,
               before_solves = r.linear_solves;
@@ -325,6 +351,19 @@ Plan BatchPlanner::solve_by_effort_continuation(const Problem& problem,
   plan.stats.outer_iterations += stages.outer_iterations;
   plan.stats.linear_solves += stages.linear_solves;
   return plan;
+}
+
+std::optional<Plan> BatchPlanner::solve_refined(const Problem& problem, int coarse_steps,
+                                                const std::string& method, SolveStats& coarse_stats,
+                                                BatchSolution* solution) const {
+  Problem coarse = problem;
+  coarse.steps = coarse_steps;
+  const Plan c = plan(coarse);
+  add_counts(coarse_stats, c.stats);
+  spdlog::debug("plan {}: refinement from {} steps: coarse plan {}", problem.name, coarse_steps,
+                c.success() ? std::string("valid") : to_string(c.stats.status));
+  if (!c.success()) return std::nullopt;
+  return solve(problem, refined_start(problem, c), method, solution, true);
 }
 
 }  // namespace kinograph::planning

@@ -1,6 +1,7 @@
 #pragma once
 // DFGP batch planning: the problem's factor graph solved by Levenberg–Marquardt inside an
 // augmented-Lagrangian outer loop, then validated independently.
+#include <optional>
 #include <vector>
 
 #include "kinograph/planning/batch/effort_continuation.h"
@@ -73,6 +74,14 @@ struct BatchPlannerOptions {
   /// kMaxIntegrationStep and leave the final solve a short projection. Used only when it takes
   /// fewer steps per interval than the interpolant; 0 = off.
   double warmup_integration_step = 0.05;
+  /// Grid refinement (grid_refinement.h): a problem whose steps have a coarser grid with
+  /// intervals at most this long (s) is first planned on that grid, by this planner (so
+  /// recursively, down to intervals of about this length), and its first attempt starts from the
+  /// coarse plan's interpolant at its knots, on the interpolant from its first solve; the other
+  /// initializations follow if that does not validate. The plan's stats count the coarse
+  /// plans' iterations and attempts. The shipped scenes' 0.1 s grids are not refined; an Acrobot
+  /// swing-up over 10 s in 400 steps is planned from 100 and 200 steps. 0 = off.
+  double refine_max_interval = 0.1;
 };
 
 /// Where the solve of a plan ended: its graph, values and the constraint state (final
@@ -109,13 +118,22 @@ class BatchPlanner {
 
  private:
   /// One augmented-Lagrangian solve from `init`, validated; its final state goes to `solution`
-  /// when that is non-null.
+  /// when that is non-null. With `from_interpolant`, `init` is already feasible on the interpolant
+  /// (a coarse plan's): the knot-only and warm-up solves are skipped, and the first solve is a
+  /// projection onto the rows on the interpolant at the largest penalty.
   Plan solve(const Problem& problem, const Trajectory& init, const std::string& method,
-             BatchSolution* solution = nullptr) const;
+             BatchSolution* solution = nullptr, bool from_interpolant = false) const;
   /// The continuation attempt (options().effort_continuation), its stats summed over every
   /// stage; the final solve's state goes to `solution` when that is non-null.
   Plan solve_by_effort_continuation(const Problem& problem, const Eigen::VectorXd& q_goal,
                                     const std::string& method, BatchSolution* solution) const;
+
+  /// The grid-refinement attempt: the problem planned on `coarse_steps`, then solved from that
+  /// plan's interpolant; empty when the coarse plan does not validate. The coarse plan's own
+  /// iterations and attempts are added to `coarse_stats`.
+  std::optional<Plan> solve_refined(const Problem& problem, int coarse_steps,
+                                    const std::string& method, SolveStats& coarse_stats,
+                                    BatchSolution* solution) const;
 
   BatchPlannerOptions options_;
 };
