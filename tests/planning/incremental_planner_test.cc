@@ -284,6 +284,9 @@ TEST(ReplanChange, BadInputNamesTheKey) {
   EXPECT_EQ(key_of("? {q: [1, 1]}\n: 2"), "");
   EXPECT_EQ(key_of("obstacles: [{id: {a: 1}, shape: sphere, size: [0.1]}]"), "obstacles[0].id");
   EXPECT_EQ(key_of("remove: [[ball]]"), "remove[0]");
+  EXPECT_EQ(key_of("obstacles: [{id: \"b\xff\xfe\", shape: sphere, size: [0.1]}]"),
+            "obstacles[0].id");  // not UTF-8: its written-back name was another one
+  EXPECT_EQ(key_of("obstacles: [{id: \"ball ü 球 🎱\", shape: sphere, size: [0.1]}]"), "no error");
   EXPECT_THROW(load_change("/nonexistent/change.yaml", scene), SceneError);
 }
 

@@ -101,7 +101,11 @@ SceneChange parse_change(const std::string& yaml, const Scene& scene, const std:
   }
   if (root["horizon"]) out.change.horizon = next.problem.horizon;
   for (const std::string& name : changed) {
-    out.change.add_or_move.push_back(next.problem.obstacles[index_of(next.obstacle_names, name)]);
+    const int idx = index_of(next.obstacle_names, name);
+    if (idx < 0) {  // the merged scene's writer changed the name: never index with it
+      throw SceneError(source, "obstacles", 0, "obstacle '" + name + "' cannot be read back");
+    }
+    out.change.add_or_move.push_back(next.problem.obstacles[idx]);
   }
   return out;
 }
