@@ -55,9 +55,65 @@ WaitPlan wait_for(double blocking_end, double own_start, double horizon) {
   return w;
 }
 
-std::string deadlock_reason(const std::string& neighbour, const std::string& why) {
-  return "deadlock: no plan around neighbour '" + neighbour +
-         "', not even after waiting for its plan to end: " + why;
+Remedy remedy(const std::string& own, const Blocker& blocker, double own_start, double horizon,
+              bool may_wait, const std::string& why) {
+  Remedy r;
+  if (blocker.treatment == Treatment::kAlongPlan) {
+    // A plan ending within a microsecond (the clock's resolution) has ended.
+    if (may_wait && blocker.plan_end > own_start + 1e-6) {
+      r.kind = Remedy::Kind::kWait;
+      r.wait = wait_for(blocker.plan_end, 0.0, horizon);
+      r.reason = "waiting " + std::to_string(r.wait.wait) + " s for neighbour '" + blocker.name +
+                 "''s plan to end";
+      return r;
+    }
+    r.reason = blocked_reason(blocker.name, blocker.prefix, blocker.treatment, own_start, why);
+    if (!may_wait) r.reason += " (waiting is off: --no-neighbour-wait)";
+    return r;
+  }
+  if (blocker.blocked_by_own) {
+    r.kind = Remedy::Kind::kDeadlock;
+    r.reason = deadlock_reason(own, blocker.name, blocker.prefix, why);
+    return r;
+  }
+  r.reason = blocked_reason(blocker.name, blocker.prefix, blocker.treatment, 0.0, why);
+  return r;
+}
+
+namespace {
+// What blocker_prefix reads: the neighbour's name, then its prefix in brackets.
+std::string tagged(const std::string& name, const std::string& prefix) {
+  return "neighbour '" + name + "' [" + prefix + "]";
+}
+}  // namespace
+
+std::string blocked_reason(const std::string& name, const std::string& prefix,
+                           Treatment treatment, double waited, const std::string& why) {
+  std::string s = "blocked by " + tagged(name, prefix);
+  if (treatment == Treatment::kAlongPlan) {
+    s += waited > 0 ? ", even after waiting " + std::to_string(waited) + " s for its plan to end"
+                    : ", moving along its plan";
+  } else {
+    s += ", held at its state";
+  }
+  return s + ": " + why;
+}
+
+std::string deadlock_reason(const std::string& own, const std::string& name,
+                            const std::string& prefix, const std::string& why) {
+  return "deadlock with " + tagged(name, prefix) + ": robots '" + own + "' and '" + prefix +
+         "' each stand where the other must go, and neither can move first: " + why;
+}
+
+std::string blocker_prefix(const std::string& reason) {
+  for (const char* lead : {"blocked by neighbour '", "deadlock with neighbour '"}) {
+    const std::size_t at = reason.find(lead);
+    if (at == std::string::npos) continue;
+    const std::size_t open = reason.find("' [", at + std::string(lead).size());
+    const std::size_t close = open == std::string::npos ? open : reason.find(']', open);
+    if (close != std::string::npos) return reason.substr(open + 3, close - open - 3);
+  }
+  return "";
 }
 
 }  // namespace kinograph::fleet

@@ -25,6 +25,9 @@ struct JointClearanceOptions {
   /// Points per interval of every robot's plan (its knot and samples_per_interval − 1 evenly
   /// between); all robots are posed at the union of these times. Default 10, as the validator.
   int samples_per_interval = 10;
+  /// Common-clock time (s) from which on the robots are checked: what lies before (a neighbour's
+  /// motion already past) is left out. Default −∞: the whole span.
+  double from = -std::numeric_limits<double>::infinity();
 };
 
 /// The closest approach of two different robots over the common span of their plans (each one
