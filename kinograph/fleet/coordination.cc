@@ -28,10 +28,10 @@ Decision coordinate(const PriorityKey& own, const std::vector<NeighbourView>& ne
     // Only a higher-priority neighbour's change moves this robot; a lower one yields to it.
     const auto was = planned.find(n.name);
     if (was == planned.end() || was->second != entry) {
-      trigger = follow ? "neighbour '" + n.name + "' (higher priority) has plan " +
-                             std::to_string(entry)
-                       : "neighbour '" + n.name + "' (higher priority) is " +
-                             (n.silent ? "silent" : "without a plan") + ", held at its state";
+      trigger =
+          follow ? "neighbour '" + n.name + "' (higher priority) has plan " + std::to_string(entry)
+                 : "neighbour '" + n.name + "' (higher priority) is " +
+                       (n.silent ? "silent" : "without a plan") + ", held at its state";
     }
   }
   if (own_goal_changed) {
@@ -87,8 +87,8 @@ std::string tagged(const std::string& name, const std::string& prefix) {
 }
 }  // namespace
 
-std::string blocked_reason(const std::string& name, const std::string& prefix,
-                           Treatment treatment, double waited, const std::string& why) {
+std::string blocked_reason(const std::string& name, const std::string& prefix, Treatment treatment,
+                           double waited, const std::string& why) {
   std::string s = "blocked by " + tagged(name, prefix);
   if (treatment == Treatment::kAlongPlan) {
     s += waited > 0 ? ", even after waiting " + std::to_string(waited) + " s for its plan to end"

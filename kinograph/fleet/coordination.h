@@ -105,8 +105,8 @@ Remedy remedy(const std::string& own, const Blocker& blocker, double own_start, 
 /// The failure reason of a plan blocked by neighbour `name` (channel prefix `prefix`) as
 /// `treatment` says, e.g. "blocked by neighbour 'b' [B], held at its state: ..."; after
 /// `waited` s of waiting (0: none), it says so.
-std::string blocked_reason(const std::string& name, const std::string& prefix,
-                           Treatment treatment, double waited, const std::string& why);
+std::string blocked_reason(const std::string& name, const std::string& prefix, Treatment treatment,
+                           double waited, const std::string& why);
 
 /// The FAILED reason of a deadlock of robot `own` (its prefix) and neighbour `name` (`prefix`):
 /// each is held where the other must go, so neither can move first.

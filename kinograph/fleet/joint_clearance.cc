@@ -39,8 +39,8 @@ std::vector<double> common_times(const std::vector<RobotPlan>& robots, int per_i
 std::string describe(const JointClearance& c) {
   std::ostringstream os;
   if (c.robot_a.empty()) return "no two robots have collision geometry";
-  os << "robots '" << c.robot_a << "' (link '" << c.link_a << "') and '" << c.robot_b
-     << "' (link '" << c.link_b << "') ";
+  os << "robots '" << c.robot_a << "' (link '" << c.link_a << "') and '" << c.robot_b << "' (link '"
+     << c.link_b << "') ";
   if (c.min_distance < 0) {
     os << "overlap by " << -c.min_distance << " m";
   } else {
@@ -71,7 +71,8 @@ JointClearance joint_clearance(const std::vector<RobotPlan>& robots,
     }
   }
   JointClearance result;
-  const std::vector<double> times = common_times(robots, options.samples_per_interval, options.from);
+  const std::vector<double> times =
+      common_times(robots, options.samples_per_interval, options.from);
   result.samples = static_cast<int>(times.size());
   // Robot i's bodies in a world whose obstacles are robot j's bodies along its plan, sampled at
   // the same common times, so both are posed exactly at every time checked.

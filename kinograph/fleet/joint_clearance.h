@@ -36,10 +36,10 @@ struct JointClearance {
   /// Smallest signed distance (m) between bodies of two different robots; negative inside,
   /// +inf when no two robots have collision geometry.
   double min_distance = std::numeric_limits<double>::infinity();
-  double t = 0;                  ///< common-clock time (s) of the closest approach
-  std::string robot_a, link_a;   ///< one robot of the closest pair and its link
-  std::string robot_b, link_b;   ///< the other
-  int samples = 0;               ///< common times checked
+  double t = 0;                 ///< common-clock time (s) of the closest approach
+  std::string robot_a, link_a;  ///< one robot of the closest pair and its link
+  std::string robot_b, link_b;  ///< the other
+  int samples = 0;              ///< common times checked
 
   /// True when the robots keep at least `required` metres apart.
   bool clear(double required = 0.0) const { return min_distance >= required; }

@@ -30,9 +30,9 @@ TEST(Coordinate, FollowsHigherNeighboursAndHoldsTheOthers) {
                                         {"planless", {120, "planless"}, std::nullopt, false}};
   const Decision d = coordinate(own, n, {}, true);
   EXPECT_TRUE(d.replan);
-  EXPECT_EQ(d.treatment, (std::vector<Treatment>{Treatment::kAlongPlan, Treatment::kHeldAtState,
-                                                 Treatment::kHeldAtState,
-                                                 Treatment::kHeldAtState}));
+  EXPECT_EQ(d.treatment,
+            (std::vector<Treatment>{Treatment::kAlongPlan, Treatment::kHeldAtState,
+                                    Treatment::kHeldAtState, Treatment::kHeldAtState}));
   EXPECT_EQ(d.around.at("first"), 7);
   EXPECT_EQ(d.around.at("last"), kHeldMark);
   EXPECT_EQ(d.around.at("quiet"), kHeldMark);

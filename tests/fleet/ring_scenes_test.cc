@@ -63,8 +63,7 @@ TEST(RingScenes, TheStraightMotionsTogetherCollide) {
   std::vector<RobotPlan> robots;
   for (const planning::Scene& s : scenes) {
     robots.push_back({s.problem.name, s.problem.model,
-                      line(s.problem.start_q, s.problem.goal.q, s.problem.horizon,
-                           s.problem.steps),
+                      line(s.problem.start_q, s.problem.goal.q, s.problem.horizon, s.problem.steps),
                       0.0});
   }
   const JointClearance c = joint_clearance(robots);
