@@ -332,10 +332,7 @@ std::optional<fleet::Blocker> Neighbours::blocker(const fleet::Decision& decisio
       other.offset = fleet::clock_offset(h.plan_start_utime, origin_utime);
       plan_end = other.offset + h.plan->t.back();
     } else if (const std::optional<Eigen::VectorXd> q = held_q_locked(i)) {
-      const int n = specs_[i].model->nq();
-      other.plan.t = {0.0, 1.0};
-      other.plan.q = other.plan.qd = other.plan.qdd = other.plan.tau = Eigen::MatrixXd::Zero(2, n);
-      other.plan.q.row(0) = other.plan.q.row(1) = q->transpose();
+      other.plan = fleet::standing_plan(*q);
     } else {
       continue;
     }

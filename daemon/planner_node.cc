@@ -20,6 +20,7 @@
 #include "daemon/state_file.h"
 #include "daemon/state_limits.h"
 #include "daemon/wire_strings.h"
+#include "kinograph/fleet/joint_clearance.h"
 #include "kinograph/fleet/model_id.h"
 #include "kinograph/graph/cancellation.h"
 #include "kinograph/lcm/drake_convert.h"
@@ -756,13 +757,18 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t
     // A valid plan must also stay clear of the neighbours it follows while they still move after
     // it ends (the planner sees only its own span); a failed one that comes within the margin of
     // a neighbour ran into it.
+    // A problem refused before solving (a goal in collision) has no trajectory: its goal, held
+    // from the start, is what ran into the neighbour.
+    const bool refused = plan.q.rows() < 2 && problem.goal.kind == planning::Goal::Kind::kJoint;
     std::string why;
-    const std::optional<fleet::Blocker> blocker =
-        neighbours_->blocker(*around, *origin, *problem.model, plan, wait_s,
-                             plan.success() ? 0.0 : problem.objectives.collision_epsilon, why);
+    const std::optional<fleet::Blocker> blocker = neighbours_->blocker(
+        *around, *origin, *problem.model,
+        refused ? fleet::standing_plan(problem.goal.q, problem.horizon) : plan, wait_s,
+        plan.success() ? 0.0 : problem.objectives.collision_epsilon, why);
+    if (refused) why = "its goal: " + why;
     if (!blocker) break;
     // A robot joining a motion under way does not wait: the executor would go on meanwhile.
-    const bool may_wait = options_.wait_for_neighbours && !join && attempt < neighbours_->size();
+    const bool may_wait = options_.wait_for_neighbours && !join && attempt <= neighbours_->size();
     const fleet::Remedy r =
         fleet::remedy(identity_.channel_prefix, *blocker, wait_s, problem.horizon, may_wait, why);
     if (r.kind == fleet::Remedy::Kind::kWait) {

@@ -68,7 +68,7 @@ Remedy remedy(const std::string& own, const Blocker& blocker, double own_start, 
       return r;
     }
     r.reason = blocked_reason(blocker.name, blocker.prefix, blocker.treatment, own_start, why);
-    if (!may_wait) r.reason += " (waiting is off: --no-neighbour-wait)";
+    if (!may_wait && own_start <= 0) r.reason += " (waiting is off: --no-neighbour-wait)";
     return r;
   }
   if (blocker.blocked_by_own) {

@@ -36,6 +36,14 @@ std::vector<double> common_times(const std::vector<RobotPlan>& robots, int per_i
 
 }  // namespace
 
+planning::Plan standing_plan(const Eigen::VectorXd& q, double duration) {
+  planning::Plan p;
+  p.t = {0.0, duration};
+  p.q = p.qd = p.qdd = p.tau = Eigen::MatrixXd::Zero(2, q.size());
+  p.q.row(0) = p.q.row(1) = q.transpose();
+  return p;
+}
+
 std::string describe(const JointClearance& c) {
   std::ostringstream os;
   if (c.robot_a.empty()) return "no two robots have collision geometry";

@@ -45,6 +45,10 @@ struct JointClearance {
   bool clear(double required = 0.0) const { return min_distance >= required; }
 };
 
+/// A plan standing still at configuration q from time 0 to `duration` s (two knots, at rest): a
+/// robot held at a state, for joint_clearance.
+planning::Plan standing_plan(const Eigen::VectorXd& q, double duration = 1.0);
+
 /// One line: "robots 'a' (link 'l') and 'b' (link 'm') are 0.12 m apart at t = 1.4 s" (or
 /// "overlap by ...").
 std::string describe(const JointClearance& clearance);
