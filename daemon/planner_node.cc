@@ -765,7 +765,11 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t
         *around, *origin, *problem.model,
         refused ? fleet::standing_plan(problem.goal.q, problem.horizon) : plan, wait_s,
         plan.success() ? 0.0 : problem.objectives.collision_epsilon, why);
-    if (refused) why = "its goal: " + why;
+    if (refused) {
+      why = "its goal: " + why;
+    } else if (!plan.success() && !plan.stats.reason.empty()) {
+      why += " (" + neighbours_->name_bodies(plan.stats.reason) + ")";
+    }
     if (!blocker) break;
     // A robot joining a motion under way does not wait: the executor would go on meanwhile.
     const bool may_wait = options_.wait_for_neighbours && !join && attempt <= neighbours_->size();
