@@ -795,10 +795,7 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t
     std::lock_guard lock(mutex_);
     if (new_state) --used_state_count_;
   }
-  const std::string wait_note = valid && wait_s > 0 ? "starts " + std::to_string(wait_s) +
-                                                          " s late: waits for neighbour '" +
-                                                          waited_for + "''s plan to end"
-                                                    : "";
+  const std::string wait_note = valid && wait_s > 0 ? fleet::wait_note(waited_for, wait_s) : "";
 
   int64_t plan_id;
   messages::PlanTime time;

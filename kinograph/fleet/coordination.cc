@@ -1,6 +1,8 @@
 #include "kinograph/fleet/coordination.h"
 
 #include <algorithm>
+#include <iomanip>
+#include <sstream>
 #include <tuple>
 
 namespace kinograph::fleet {
@@ -63,8 +65,7 @@ Remedy remedy(const std::string& own, const Blocker& blocker, double own_start, 
     if (may_wait && blocker.plan_end > own_start + 1e-6) {
       r.kind = Remedy::Kind::kWait;
       r.wait = wait_for(blocker.plan_end, 0.0, horizon);
-      r.reason = "waiting " + std::to_string(r.wait.wait) + " s for neighbour '" + blocker.name +
-                 "''s plan to end";
+      r.reason = wait_note(blocker.name, r.wait.wait);
       return r;
     }
     r.reason = blocked_reason(blocker.name, blocker.prefix, blocker.treatment, own_start, why);
@@ -81,6 +82,20 @@ Remedy remedy(const std::string& own, const Blocker& blocker, double own_start, 
 }
 
 namespace {
+// Seconds with millisecond digits: "3.000".
+std::string seconds(double s) {
+  std::ostringstream os;
+  os << std::fixed << std::setprecision(3) << s;
+  return os.str();
+}
+}  // namespace
+
+std::string wait_note(const std::string& neighbour, double wait) {
+  return "starts " + seconds(wait) + " s late: waits for neighbour '" + neighbour +
+         "''s plan to end";
+}
+
+namespace {
 // What blocker_prefix reads: the neighbour's name, then its prefix in brackets.
 std::string tagged(const std::string& name, const std::string& prefix) {
   return "neighbour '" + name + "' [" + prefix + "]";
@@ -91,7 +106,7 @@ std::string blocked_reason(const std::string& name, const std::string& prefix, T
                            double waited, const std::string& why) {
   std::string s = "blocked by " + tagged(name, prefix);
   if (treatment == Treatment::kAlongPlan) {
-    s += waited > 0 ? ", even after waiting " + std::to_string(waited) + " s for its plan to end"
+    s += waited > 0 ? ", even after waiting " + seconds(waited) + " s for its plan to end"
                     : ", moving along its plan";
   } else {
     s += ", held at its state";

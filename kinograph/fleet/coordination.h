@@ -102,6 +102,10 @@ struct Remedy {
 Remedy remedy(const std::string& own, const Blocker& blocker, double own_start, double horizon,
               bool may_wait, const std::string& why);
 
+/// What a plan that waits says (its status message, the heartbeat): "starts 3.000 s late: waits
+/// for neighbour 'a''s plan to end".
+std::string wait_note(const std::string& neighbour, double wait);
+
 /// The failure reason of a plan blocked by neighbour `name` (channel prefix `prefix`) as
 /// `treatment` says, e.g. "blocked by neighbour 'b' [B], held at its state: ..."; after
 /// `waited` s of waiting (0: none), it says so.

@@ -127,7 +127,7 @@ TEST(Remedy, FailsWhenStillBlockedAfterWaitingOrWhenWaitingIsOff) {
   const Blocker a{"a", "A", Treatment::kAlongPlan, 2.5, false};
   const Remedy after = remedy("B", a, 2.5, 1.0, true, "overlap at the goal");
   EXPECT_EQ(after.kind, Remedy::Kind::kFail);
-  EXPECT_NE(after.reason.find("even after waiting 2.5"), std::string::npos) << after.reason;
+  EXPECT_NE(after.reason.find("even after waiting 2.500 s"), std::string::npos) << after.reason;
   EXPECT_EQ(blocker_prefix(after.reason), "A");
   const Remedy off = remedy("B", a, 0.0, 1.0, false, "overlap");
   EXPECT_EQ(off.kind, Remedy::Kind::kFail);

@@ -37,7 +37,7 @@ send_goal sweep 1 "-1.0,0" "$SWEEP" $((T + 100))
 send_goal hanging 1 "-0.767,0" "$HANGING" $((T + 200))
 await_settled
 check_plans "sweep=$SWEEP" "hanging=$HANGING"
-grep -q "starts 3.0* s late: waits for neighbour 'sweep''s plan to end" \
+grep -q "starts 3.000 s late: waits for neighbour 'sweep''s plan to end" \
   "$WORK/hanging_goal_1.out" || fail "hanging's plan does not say it waits: $(cat "$WORK/hanging_goal_1.out")"
 [ "$(start_utime "$WORK/sweep.json")" = "$T" ] || fail "sweep's plan does not start at the state"
 [ "$(start_utime "$WORK/hanging.json")" = "$((T + 3000000))" ] \
