@@ -2,9 +2,11 @@
 # Four iiwa arms in a ring around a round table with crossing goals (robots/scenes/iiwa_ring_*.yaml:
 # the four straight joint-space motions together collide, every goal is clear of the other arms'
 # starts and goals), one kinographd each with the other three as neighbours, over real UDP
-# multicast in a private network namespace. The goals go out in the order of their priority
-# (goal time), each awaited; once the fleet has settled under the coordination rule every plan
-# validates and all four, checked together at and between the knots, keep clear.
+# multicast in a private network namespace. All four get measured states at their starts on one
+# robot clock, so every plan starts there at the same time. The goals go out in the order of
+# their priority (goal time), each awaited; once the fleet has settled under the coordination
+# rule every plan validates and all four, checked together at and between the knots, keep clear.
+# Then the first arm's goal moves, keeping its priority, and the fleet settles again, clear.
 # Usage: fleet_ring_udpm_test.sh BUILD_DIR SOURCE_DIR. Exit 77 (skipped) when not root.
 set -euo pipefail
 BUILD=$1
@@ -25,14 +27,24 @@ for arm in "${ARMS[@]}"; do
   plans+=("$arm=$SCENES/iiwa_ring_$arm.yaml")
 done
 
-# Each arm's goal is its scene's; the goal times are one second apart, so a outranks b, c, d.
+# scene_q SCENE KEY: the scene's start or goal q, comma-separated.
+scene_q() { sed -n "/^$2:/,/^[a-z]/ s/^  q: \[\(.*\)\]/\1/p" "$1" | tr -d ' '; }
+# send_states UTIME: every arm at its scene's start at UTIME on the robots' common clock.
+send_states() {
+  for arm in "${ARMS[@]}"; do
+    "$KG" send-state --prefix "${arm^^}" --lcm-url "$URL" --scene "$SCENES/iiwa_ring_$arm.yaml" \
+      --q "$(scene_q "$SCENES/iiwa_ring_$arm.yaml" start)" --utime "$1" >/dev/null
+  done
+}
+
+# 1. Each arm's goal is its scene's, a's first: a outranks b, c, d, b outranks c, d, ...
+T=1000000000000
+send_states $T
 watch "${robots[@]}"
-T0=$(date +%s%6N)
 for k in "${!ARMS[@]}"; do
   arm=${ARMS[$k]}
   scene="$SCENES/iiwa_ring_$arm.yaml"
-  goal=$(sed -n '/^goal:/,/^[a-z]/ s/^  q: \[\(.*\)\]/\1/p' "$scene" | tr -d ' ')
-  send_goal "$arm" 1 "$goal" "$scene" $((T0 + k * 1000000))
+  send_goal "$arm" 1 "$(scene_q "$scene" goal)" "$scene" $((T + 100 * (k + 1)))
 done
 await_settled
 check_plans "${plans[@]}"
@@ -41,4 +53,22 @@ for arm in b c d; do
     || fail "$arm does not follow a's plan"
 done
 echo "PASS: four arms in a ring"
-echo "1 passed, 0 failed"
+
+# 2. a's goal moves (its first joint by 0.15 rad, still clear of the others' starts and goals),
+# keeping its priority: b, c and d replan around a's new plan, each also around the replans above
+# it.
+A2="-2.583,-0.9678,-1.7097,1.4194,-1.1171,1.5201,-2.6013"
+newer=()
+for arm in "${ARMS[@]}"; do newer+=(--newer "${arm^^}=$(current_plan "${arm^^}")"); done
+T=$((T + 10000000))
+send_states $T
+watch "${robots[@]}" "${newer[@]}"
+send_goal a 2 "$A2" "$SCENES/iiwa_ring_a.yaml" $((1000000000000 + 100))
+await_settled
+check_plans "a=$(with_goal "$SCENES/iiwa_ring_a.yaml" "$A2" a2)" "${plans[@]:1}"
+for arm in b c d; do
+  grep -q "^${arm^^}: .* [1-9][0-9]* neighbour replans" "$WORK/probe.out" \
+    || fail "$arm did not replan around a's new plan"
+done
+echo "PASS: the first arm's goal moved, the others replanned"
+echo "2 passed, 0 failed"
