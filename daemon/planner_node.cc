@@ -13,8 +13,8 @@
 #include <lcm/lcm-cpp.hpp>
 #include <stdexcept>
 #include <string_view>
-#include <thread>
 #include <utility>
+#include <thread>
 
 #include "daemon/robot_payload.h"
 #include "daemon/state_file.h"
@@ -25,8 +25,8 @@
 #include "kinograph/graph/cancellation.h"
 #include "kinograph/lcm/drake_convert.h"
 #include "kinograph/lcm/lcm_connection.h"
-#include "kinograph/payload_t.hpp"
 #include "kinograph/planner_status_t.hpp"
+#include "kinograph/payload_t.hpp"
 #include "lcmtypes/safe_decode.h"
 
 namespace kinograph::daemon {
@@ -73,9 +73,9 @@ PlannerNode::PlannerNode(planning::Scene scene, PlannerNodeOptions options, lcm:
       lcm_->subscribe(channel("PLANNER_STATUS"), &PlannerNode::on_heartbeat, this));
   subscriptions_.push_back(lcm_->subscribe(channel("COMMAND"), &PlannerNode::on_command, this));
   subscriptions_.push_back(lcm_->subscribe(channel("PAYLOAD"), &PlannerNode::on_payload, this));
-  std::vector<int> capacities = {kGoalQueueCapacity,  kObstacleQueueCapacity,
-                                 kStateQueueCapacity, kHeartbeatQueueCapacity,
-                                 kStateQueueCapacity, kPayloadQueueCapacity};
+  std::vector<int> capacities = {kGoalQueueCapacity,      kObstacleQueueCapacity,
+                                 kStateQueueCapacity,     kHeartbeatQueueCapacity,
+                                 kStateQueueCapacity,     kPayloadQueueCapacity};
   if (!options_.iiwa_status_channel.empty()) {
     subscriptions_.push_back(
         lcm_->subscribe(options_.iiwa_status_channel, &PlannerNode::on_iiwa_status, this));
@@ -314,9 +314,7 @@ DecodedGoal decode_goal(const char* type, const lcm::ReceiveBuffer* rbuf) {
   }
   out.goal_id = msg->goal_id;
   out.convert = [msg](const dynamics::Model& model, const RobotIdentity& identity,
-                      GoalRequest& request) {
-    return convert_goal(*msg, model, identity, request);
-  };
+                      GoalRequest& request) { return convert_goal(*msg, model, identity, request); };
   return out;
 }
 
@@ -756,9 +754,8 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t
     if (threw || !neighbours_) break;
     // A valid plan must also stay clear of the neighbours it follows while they still move after
     // it ends (the planner sees only its own span); a failed one that comes within the margin of
-    // a neighbour ran into it.
-    // A problem refused before solving (a goal in collision) has no trajectory: its goal, held
-    // from the start, is what ran into the neighbour.
+    // a neighbour ran into it. A problem refused before solving (a goal in collision) has no
+    // trajectory: its goal, held from the start, is what ran into the neighbour.
     const bool refused = plan.q.rows() < 2 && problem.goal.kind == planning::Goal::Kind::kJoint;
     std::string why;
     const std::optional<fleet::Blocker> blocker = neighbours_->blocker(
@@ -825,9 +822,9 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t
   if (around && valid) neighbours_->planned(*around);
   // Knot 0 is the measured state, at its own time, or where the motion under way will be at
   // the take-over; without a state the plan starts when it is published (with neighbours, when
-  // planning began: the time their bodies were placed on).
+  // planning began: the time their bodies were placed on); after a wait, that much later, the
+  // robot holding its start until then.
   time.state_utime = state_utime.value_or(-1);
-  // after a wait, that much later: the robot holds its start until then.
   time.start_utime =
       (join ? join->takeover_utime : state_utime.value_or(origin.value_or(time.utime))) +
       std::llround(wait_s * 1e6);
