@@ -320,28 +320,36 @@ std::optional<fleet::Blocker> Neighbours::blocker(const fleet::Decision& decisio
   // The own model as the fleet check wants it: shared, without owning it.
   const std::shared_ptr<const dynamics::Model> own(std::shared_ptr<void>(), &own_model);
   const fleet::RobotPlan self{own_prefix_, own, plan, wait_s};
-  std::lock_guard lock(mutex_);
+  // Each neighbour as the decision treats it, copied under the lock; checked outside it, so that
+  // the LCM thread's handlers are not held up.
+  std::vector<std::pair<fleet::RobotPlan, fleet::Blocker>> others;
+  {
+    std::lock_guard lock(mutex_);
+    for (std::size_t i = 0; i < specs_.size(); ++i) {
+      const Heard& h = heard_[i];
+      fleet::RobotPlan other{specs_[i].name, specs_[i].model, {}, 0.0};
+      fleet::Blocker b{specs_[i].name, specs_[i].channel_prefix, decision.treatment[i], 0.0,
+                       h.blocked_by == own_prefix_};
+      if (decision.treatment[i] == fleet::Treatment::kAlongPlan && h.plan) {
+        other.plan = *h.plan;
+        other.offset = fleet::clock_offset(h.plan_start_utime, origin_utime);
+        b.plan_end = other.offset + h.plan->t.back();
+      } else if (const std::optional<Eigen::VectorXd> q = held_q_locked(i)) {
+        other.plan = fleet::standing_plan(*q);
+      } else {
+        continue;
+      }
+      others.emplace_back(std::move(other), std::move(b));
+    }
+  }
   std::optional<fleet::Blocker> found;
   double closest = contact;
-  for (std::size_t i = 0; i < specs_.size(); ++i) {
-    const Heard& h = heard_[i];
-    fleet::RobotPlan other{specs_[i].name, specs_[i].model, {}, 0.0};
-    double plan_end = 0;
-    if (decision.treatment[i] == fleet::Treatment::kAlongPlan && h.plan) {
-      other.plan = *h.plan;
-      other.offset = fleet::clock_offset(h.plan_start_utime, origin_utime);
-      plan_end = other.offset + h.plan->t.back();
-    } else if (const std::optional<Eigen::VectorXd> q = held_q_locked(i)) {
-      other.plan = fleet::standing_plan(*q);
-    } else {
-      continue;
-    }
+  for (const auto& [other, b] : others) {
     const fleet::JointClearance c = fleet::joint_clearance({self, other}, {.from = 0.0});
     if (c.min_distance >= closest) continue;
     closest = c.min_distance;
     why = fleet::describe(c);
-    found = fleet::Blocker{specs_[i].name, specs_[i].channel_prefix, decision.treatment[i],
-                           plan_end, h.blocked_by == own_prefix_};
+    found = b;
   }
   return found;
 }

@@ -13,8 +13,8 @@
 #include <lcm/lcm-cpp.hpp>
 #include <stdexcept>
 #include <string_view>
-#include <utility>
 #include <thread>
+#include <utility>
 
 #include "daemon/robot_payload.h"
 #include "daemon/state_file.h"
@@ -25,8 +25,8 @@
 #include "kinograph/graph/cancellation.h"
 #include "kinograph/lcm/drake_convert.h"
 #include "kinograph/lcm/lcm_connection.h"
-#include "kinograph/planner_status_t.hpp"
 #include "kinograph/payload_t.hpp"
+#include "kinograph/planner_status_t.hpp"
 #include "lcmtypes/safe_decode.h"
 
 namespace kinograph::daemon {
@@ -73,9 +73,9 @@ PlannerNode::PlannerNode(planning::Scene scene, PlannerNodeOptions options, lcm:
       lcm_->subscribe(channel("PLANNER_STATUS"), &PlannerNode::on_heartbeat, this));
   subscriptions_.push_back(lcm_->subscribe(channel("COMMAND"), &PlannerNode::on_command, this));
   subscriptions_.push_back(lcm_->subscribe(channel("PAYLOAD"), &PlannerNode::on_payload, this));
-  std::vector<int> capacities = {kGoalQueueCapacity,      kObstacleQueueCapacity,
-                                 kStateQueueCapacity,     kHeartbeatQueueCapacity,
-                                 kStateQueueCapacity,     kPayloadQueueCapacity};
+  std::vector<int> capacities = {kGoalQueueCapacity,  kObstacleQueueCapacity,
+                                 kStateQueueCapacity, kHeartbeatQueueCapacity,
+                                 kStateQueueCapacity, kPayloadQueueCapacity};
   if (!options_.iiwa_status_channel.empty()) {
     subscriptions_.push_back(
         lcm_->subscribe(options_.iiwa_status_channel, &PlannerNode::on_iiwa_status, this));
@@ -314,7 +314,9 @@ DecodedGoal decode_goal(const char* type, const lcm::ReceiveBuffer* rbuf) {
   }
   out.goal_id = msg->goal_id;
   out.convert = [msg](const dynamics::Model& model, const RobotIdentity& identity,
-                      GoalRequest& request) { return convert_goal(*msg, model, identity, request); };
+                      GoalRequest& request) {
+    return convert_goal(*msg, model, identity, request);
+  };
   return out;
 }
 
@@ -769,9 +771,12 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t
     }
     if (!blocker) break;
     // A robot joining a motion under way does not wait: the executor would go on meanwhile.
-    const bool may_wait = options_.wait_for_neighbours && !join && attempt <= neighbours_->size();
+    const std::string no_wait = !options_.wait_for_neighbours   ? "waiting is off"
+                                : join                          ? "it joins a motion under way"
+                                : attempt > neighbours_->size() ? "it waited for every neighbour"
+                                                                : "";
     const fleet::Remedy r =
-        fleet::remedy(identity_.channel_prefix, *blocker, wait_s, problem.horizon, may_wait, why);
+        fleet::remedy(identity_.channel_prefix, *blocker, wait_s, problem.horizon, no_wait, why);
     if (r.kind == fleet::Remedy::Kind::kWait) {
       spdlog::info("goal {}: {} ({})", goal.goal_id, r.reason, why);
       wait_s = r.wait.wait;

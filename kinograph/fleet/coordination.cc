@@ -58,18 +58,18 @@ WaitPlan wait_for(double blocking_end, double own_start, double horizon) {
 }
 
 Remedy remedy(const std::string& own, const Blocker& blocker, double own_start, double horizon,
-              bool may_wait, const std::string& why) {
+              const std::string& no_wait, const std::string& why) {
   Remedy r;
   if (blocker.treatment == Treatment::kAlongPlan) {
     // A plan ending within a microsecond (the clock's resolution) has ended.
-    if (may_wait && blocker.plan_end > own_start + 1e-6) {
+    if (no_wait.empty() && blocker.plan_end > own_start + 1e-6) {
       r.kind = Remedy::Kind::kWait;
       r.wait = wait_for(blocker.plan_end, 0.0, horizon);
       r.reason = wait_note(blocker.name, r.wait.wait);
       return r;
     }
     r.reason = blocked_reason(blocker.name, blocker.prefix, blocker.treatment, own_start, why);
-    if (!may_wait && own_start <= 0) r.reason += " (waiting is off: --no-neighbour-wait)";
+    if (!no_wait.empty() && own_start <= 0) r.reason += " (not waiting: " + no_wait + ")";
     return r;
   }
   if (blocker.blocked_by_own) {

@@ -95,12 +95,13 @@ struct Remedy {
 };
 
 /// The rule for a blocked plan (docs/multi_robot.md). Blocked by a followed neighbour's plan
-/// that ends after `own_start` (own clock, s; the wait already taken, 0 for none) and with
-/// `may_wait`: wait until it ends. Blocked by it after waiting, or without waiting: fail. Blocked
-/// by a neighbour held at its state that is itself blocked by this robot: deadlock. Otherwise
-/// fail. `own` is this robot's channel prefix, `why` what the planner or the check found.
+/// that ends after `own_start` (own clock, s; the wait already taken, 0 for none), and `no_wait`
+/// empty: wait until it ends. Blocked by it after waiting, or with `no_wait` saying why the robot
+/// may not wait: fail. Blocked by a neighbour held at its state that is itself blocked by this
+/// robot: deadlock. Otherwise fail. `own` is this robot's channel prefix, `why` what the planner
+/// or the check found.
 Remedy remedy(const std::string& own, const Blocker& blocker, double own_start, double horizon,
-              bool may_wait, const std::string& why);
+              const std::string& no_wait, const std::string& why);
 
 /// What a plan that waits says (its status message, the heartbeat): "starts 3.000 s late: waits
 /// for neighbour 'a''s plan to end".

@@ -116,7 +116,7 @@ TEST(WaitFor, HoldsTheStartUntilTheBlockingPlanEnds) {
 
 TEST(Remedy, WaitsForAFollowedPlanThatEndsLater) {
   const Blocker a{"a", "A", Treatment::kAlongPlan, 2.5, false};
-  const Remedy r = remedy("B", a, 0.0, 1.0, true, "overlap");
+  const Remedy r = remedy("B", a, 0.0, 1.0, "", "overlap");
   EXPECT_EQ(r.kind, Remedy::Kind::kWait);
   EXPECT_DOUBLE_EQ(r.wait.wait, 2.5);
   EXPECT_DOUBLE_EQ(r.wait.horizon, 3.5);
@@ -125,23 +125,23 @@ TEST(Remedy, WaitsForAFollowedPlanThatEndsLater) {
 
 TEST(Remedy, FailsWhenStillBlockedAfterWaitingOrWhenWaitingIsOff) {
   const Blocker a{"a", "A", Treatment::kAlongPlan, 2.5, false};
-  const Remedy after = remedy("B", a, 2.5, 1.0, true, "overlap at the goal");
+  const Remedy after = remedy("B", a, 2.5, 1.0, "", "overlap at the goal");
   EXPECT_EQ(after.kind, Remedy::Kind::kFail);
   EXPECT_NE(after.reason.find("even after waiting 2.500 s"), std::string::npos) << after.reason;
   EXPECT_EQ(blocker_prefix(after.reason), "A");
-  const Remedy off = remedy("B", a, 0.0, 1.0, false, "overlap");
+  const Remedy off = remedy("B", a, 0.0, 1.0, "waiting is off", "overlap");
   EXPECT_EQ(off.kind, Remedy::Kind::kFail);
   EXPECT_NE(off.reason.find("waiting is off"), std::string::npos) << off.reason;
 }
 
 TEST(Remedy, AHeldNeighbourBlockedByThisRobotIsADeadlockNamingBoth) {
   Blocker b{"right", "RIGHT", Treatment::kHeldAtState, 0.0, false};
-  const Remedy blocked = remedy("LEFT", b, 0.0, 3.0, true, "goal overlaps it");
+  const Remedy blocked = remedy("LEFT", b, 0.0, 3.0, "", "goal overlaps it");
   EXPECT_EQ(blocked.kind, Remedy::Kind::kFail);
   EXPECT_EQ(blocked.reason.find("deadlock"), std::string::npos) << blocked.reason;
   EXPECT_EQ(blocker_prefix(blocked.reason), "RIGHT");
   b.blocked_by_own = true;  // its answer says it is blocked by LEFT
-  const Remedy dead = remedy("LEFT", b, 0.0, 3.0, true, "goal overlaps it");
+  const Remedy dead = remedy("LEFT", b, 0.0, 3.0, "", "goal overlaps it");
   EXPECT_EQ(dead.kind, Remedy::Kind::kDeadlock);
   EXPECT_EQ(dead.reason.rfind("deadlock", 0), 0u) << dead.reason;
   EXPECT_NE(dead.reason.find("'LEFT'"), std::string::npos) << dead.reason;
