@@ -3,7 +3,8 @@
 //              [--batch-only] [--max-goal-change RAD] [--formulation condensed|dfg]
 //              [--ignore-goal-id-gaps] [--max-state-age 0.5] [--takeover-latency 0.3]
 //              [--iiwa-status-channel IIWA_STATUS] [--drake-plan-channel COMMITTED_ROBOT_PLAN]
-//              [--state-file FILE]
+//              [--state-file FILE] [--neighbour NAME=SCENE[@PREFIX] ...]
+//              [--neighbour-timeout 3] [--no-neighbour-wait]
 // The scene gives the robot, default horizon and steps, start, fixed obstacles, objective
 // weights and the batch formulation; goals, obstacle updates and measured states arrive over
 // LCM.
@@ -88,7 +89,13 @@ int main(int argc, char** argv) {
                  "a neighbour heard from neither in heartbeats nor in states for this long (s) is "
                  "held still at its last known state and reported (default 3)")
       ->check(CLI::PositiveNumber);
+  bool no_wait = false;
+  app.add_flag("--no-neighbour-wait", no_wait,
+               "answer a goal whose plan runs into a higher-priority neighbour's plan with the "
+               "failure, instead of holding the start until that plan ends and planning from "
+               "there (default: wait)");
   CLI11_PARSE(app, argc, argv);
+  options.wait_for_neighbours = !no_wait;
   options.answer_goal_id_gaps = !ignore_gaps;
   options.replanning.use_incremental = !batch_only;
   spdlog::set_level(spdlog::level::from_str(level));
@@ -116,10 +123,10 @@ int main(int argc, char** argv) {
     spdlog::info(
         "kinographd: stopped after {} goals ({} answered, {} superseded, {} cancelled, {} "
         "dropped in transport), {} plans ({} failed, {} incremental replans, {} fallbacks, {} for "
-        "neighbours), {} rejected messages",
+        "neighbours, {} waiting for one), {} rejected messages",
         c.goals_received, c.goals_answered, c.goals_superseded, c.goals_cancelled, c.goals_dropped,
         c.plans_published, c.failures, c.incremental, c.fallbacks, c.neighbour_replans,
-        c.messages_rejected);
+        c.neighbour_waits, c.messages_rejected);
   } catch (const std::exception& e) {
     std::cerr << "kinographd: error: " << e.what() << "\n";
     return 1;

@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "kinograph/fleet/joint_clearance.h"
 #include "kinograph/fleet/model_id.h"
 #include "kinograph/fleet/neighbour_bodies.h"
 #include "kinograph/lcm/message_convert.h"
@@ -61,8 +62,8 @@ Neighbours::Neighbours(std::vector<NeighbourSpec> specs, std::string own_prefix,
                        NeighboursOptions options)
     : specs_(std::move(specs)), own_prefix_(std::move(own_prefix)), options_(options) {
   if (specs_.size() > static_cast<std::size_t>(kMaxNeighbours)) {
-    throw std::invalid_argument("at most " + std::to_string(kMaxNeighbours) +
-                                " neighbours, got " + std::to_string(specs_.size()));
+    throw std::invalid_argument("at most " + std::to_string(kMaxNeighbours) + " neighbours, got " +
+                                std::to_string(specs_.size()));
   }
   for (std::size_t i = 0; i < specs_.size(); ++i) {
     const NeighbourSpec& s = specs_[i];
@@ -135,7 +136,8 @@ void Neighbours::on_plan(std::size_t i, const lcm::ReceiveBuffer* rbuf) {
   }
   if (!order_ok) {
     std::lock_guard lock(mutex_);
-    heard_[i].mismatch = "its plans' joints are not those of its scene's robot '" + model.name + "'";
+    heard_[i].mismatch =
+        "its plans' joints are not those of its scene's robot '" + model.name + "'";
     return;
   }
   planning::Plan plan = messages::plan_from_message(msg);
@@ -190,8 +192,8 @@ void Neighbours::on_heartbeat(std::size_t i, const lcm::ReceiveBuffer* rbuf) {
     mismatch = "its model is " + msg.model_id + ", its scene's is " + model_ids_[i];
   } else {
     Eigen::Isometry3d base = Eigen::Isometry3d::Identity();
-    base.translation() = Eigen::Vector3d(msg.base_position[0], msg.base_position[1],
-                                         msg.base_position[2]);
+    base.translation() =
+        Eigen::Vector3d(msg.base_position[0], msg.base_position[1], msg.base_position[2]);
     base.linear() = Eigen::Quaterniond(msg.base_quaternion[0], msg.base_quaternion[1],
                                        msg.base_quaternion[2], msg.base_quaternion[3])
                         .normalized()
@@ -210,9 +212,13 @@ void Neighbours::on_heartbeat(std::size_t i, const lcm::ReceiveBuffer* rbuf) {
     h.mismatch = mismatch;
     if (!h.last_heard || h.silent) joined_ = true;
     h.last_heard = std::chrono::steady_clock::now();
-    changed = h.silent || h.goal_utime != goal_utime;
+    const std::string blocked_by = fleet::blocker_prefix(msg.message);
+    // A neighbour newly blocked by this robot may make this robot's failure a deadlock.
+    changed = h.silent || h.goal_utime != goal_utime ||
+              (blocked_by != h.blocked_by && blocked_by == own_prefix_);
     h.silent = false;
     h.goal_utime = goal_utime;
+    h.blocked_by = blocked_by;
     changed_ = changed_ || changed;
   }
   if (changed) notify();
@@ -225,8 +231,8 @@ bool Neighbours::update_silence_locked() {
     if (!h.silent && h.last_heard && seconds_since(*h.last_heard) > options_.timeout_s) {
       h.silent = true;
       any = true;
-      spdlog::warn("neighbour '{}': silent for {} s, held at its last known state",
-                   specs_[i].name, options_.timeout_s);
+      spdlog::warn("neighbour '{}': silent for {} s, held at its last known state", specs_[i].name,
+                   options_.timeout_s);
     }
   }
   return any;
@@ -282,23 +288,78 @@ void Neighbours::add_obstacles(const fleet::Decision& decision, std::int64_t ori
       // knows, so a new plan of the neighbour must come as new obstacles.
       const int first = kFirstObstacleId + (1 << 20) +
                         static_cast<int>(rebuilds_ % 1000) * kMaxNeighbours * kMaxBodies + slot;
-      bodies = fleet::bodies_along(n, *h.plan, fleet::clock_offset(h.plan_start_utime, origin_utime),
-                                   fleet::SweepOptions{.first_id = first});
-    } else if (h.state) {
-      bodies = fleet::bodies_at(n, *h.state, kFirstObstacleId + slot);
-    } else if (h.plan) {
-      // Heard a plan but no state: it comes to rest where the plan ends.
-      bodies = fleet::bodies_at(n, h.plan->q.row(h.plan->q.rows() - 1).transpose(),
-                                kFirstObstacleId + slot);
-    } else if (specs_[i].start_q.size() == specs_[i].model->nq()) {
-      // Nothing heard yet: it stands at its scene's start.
-      bodies = fleet::bodies_at(n, specs_[i].start_q, kFirstObstacleId + slot);
+      bodies =
+          fleet::bodies_along(n, *h.plan, fleet::clock_offset(h.plan_start_utime, origin_utime),
+                              fleet::SweepOptions{.first_id = first});
+    } else if (const std::optional<Eigen::VectorXd> q = held_q_locked(i)) {
+      bodies = fleet::bodies_at(n, *q, kFirstObstacleId + slot);
     }
     for (fleet::NeighbourBody& b : bodies) {
       body_names_[b.obstacle.id] = b.name;
       obstacles.push_back(std::move(b.obstacle));
     }
   }
+}
+
+std::optional<Eigen::VectorXd> Neighbours::held_q_locked(std::size_t i) const {
+  const Heard& h = heard_[i];
+  if (h.state) return h.state;
+  // Heard a plan but no state: it comes to rest where the plan ends.
+  if (h.plan) return h.plan->q.row(h.plan->q.rows() - 1).transpose();
+  // Nothing heard yet: it stands at its scene's start.
+  if (specs_[i].start_q.size() == specs_[i].model->nq()) return specs_[i].start_q;
+  return std::nullopt;
+}
+
+std::optional<fleet::Blocker> Neighbours::blocker(const fleet::Decision& decision,
+                                                  std::int64_t origin_utime,
+                                                  const dynamics::Model& own_model,
+                                                  const planning::Plan& plan, double wait_s,
+                                                  double contact, std::string& why) const {
+  if (plan.q.rows() < 2) return std::nullopt;
+  // The own model as the fleet check wants it: shared, without owning it.
+  const std::shared_ptr<const dynamics::Model> own(std::shared_ptr<void>(), &own_model);
+  const fleet::RobotPlan self{own_prefix_, own, plan, wait_s};
+  // Each neighbour as the decision treats it, copied under the lock; checked outside it, so that
+  // the LCM thread's handlers are not held up.
+  std::vector<std::pair<fleet::RobotPlan, fleet::Blocker>> others;
+  {
+    std::lock_guard lock(mutex_);
+    for (std::size_t i = 0; i < specs_.size(); ++i) {
+      const Heard& h = heard_[i];
+      fleet::RobotPlan other{specs_[i].name, specs_[i].model, {}, 0.0};
+      fleet::Blocker b{specs_[i].name, specs_[i].channel_prefix, decision.treatment[i], 0.0,
+                       h.blocked_by == own_prefix_};
+      if (decision.treatment[i] == fleet::Treatment::kAlongPlan && h.plan) {
+        other.plan = *h.plan;
+        other.offset = fleet::clock_offset(h.plan_start_utime, origin_utime);
+        b.plan_end = other.offset + h.plan->t.back();
+      } else if (const std::optional<Eigen::VectorXd> q = held_q_locked(i)) {
+        other.plan = fleet::standing_plan(*q);
+      } else {
+        continue;
+      }
+      others.emplace_back(std::move(other), std::move(b));
+    }
+  }
+  std::optional<fleet::Blocker> found;
+  double closest = contact;
+  for (const auto& [other, b] : others) {
+    const fleet::JointClearance c = fleet::joint_clearance({self, other}, {.from = 0.0});
+    if (c.min_distance >= closest) continue;
+    closest = c.min_distance;
+    why = fleet::describe(c);
+    found = b;
+  }
+  return found;
+}
+
+bool Neighbours::blocked_by_own(const std::string& name) const {
+  std::lock_guard lock(mutex_);
+  for (std::size_t i = 0; i < specs_.size(); ++i) {
+    if (specs_[i].name == name) return heard_[i].blocked_by == own_prefix_;
+  }
+  return false;
 }
 
 void Neighbours::planned(const fleet::Decision& decision) {
@@ -336,7 +397,7 @@ std::string Neighbours::summary() const {
       os << "plan " << h.plan_id;
       const auto it = planned_.find(specs_[i].name);
       os << (it != planned_.end() && it->second == h.generation ? ", followed"
-                                                                   : ", held at its state");
+                                                                : ", held at its state");
     } else {
       os << "no plan, held at its state";
     }

@@ -84,6 +84,16 @@ class Neighbours {
   /// True once when a neighbour was heard for the first time or after being silent (a started
   /// or restarted daemon, which has missed this robot's current plan). Worker thread.
   bool take_joined();
+  /// The neighbour, as `decision` treats it, that `plan` (own clock: knot 0 at `origin_utime`
+  /// plus `wait_s`, standing at its first knot before and its last after) comes within `contact`
+  /// metres of, from `origin_utime` on: the closest such one, with `why` saying where; none
+  /// when it keeps clear of all. Worker thread.
+  std::optional<fleet::Blocker> blocker(const fleet::Decision& decision, std::int64_t origin_utime,
+                                        const dynamics::Model& own_model,
+                                        const planning::Plan& plan, double wait_s, double contact,
+                                        std::string& why) const;
+  /// True when neighbour `name`'s latest heartbeat reports a failure blocked by this robot.
+  bool blocked_by_own(const std::string& name) const;
   /// Records that a valid plan was made as `decision` says (what later changes are judged by).
   void planned(const fleet::Decision& decision);
   /// `text` with "obstacle <id>" of a neighbour body replaced by its name ("neighbour 'right'
@@ -104,13 +114,17 @@ class Neighbours {
     std::int64_t plan_id = -1;    // as the neighbour numbers it
     std::optional<Eigen::VectorXd> state;
     std::int64_t goal_utime = std::numeric_limits<std::int64_t>::max();
-    std::string mismatch;  // why its heartbeat does not fit the scene, or empty
+    std::string mismatch;    // why its heartbeat does not fit the scene, or empty
+    std::string blocked_by;  // prefix its latest failure names as blocker (fleet::blocker_prefix)
     std::optional<std::chrono::steady_clock::time_point> last_heard;
     bool silent = false;
   };
   void on_plan(std::size_t i, const lcm::ReceiveBuffer* rbuf);
   void on_state(std::size_t i, const lcm::ReceiveBuffer* rbuf);
   void on_heartbeat(std::size_t i, const lcm::ReceiveBuffer* rbuf);
+  // Where neighbour i stands when held still: its latest state, else the last knot of its plan,
+  // else its scene's start; none without any. Caller holds mutex_.
+  std::optional<Eigen::VectorXd> held_q_locked(std::size_t i) const;
   // Marks neighbours silent after the timeout; true when one became silent. Caller holds mutex_.
   bool update_silence_locked();
   void notify();
@@ -134,8 +148,8 @@ class Neighbours {
   bool changed_ = false;
   bool joined_ = false;
   fleet::PlannedAround planned_;
-  std::int64_t rebuilds_ = 0;               // obstacle sets made (moving bodies get new ids)
-  std::map<int, std::string> body_names_;   // obstacle id -> name, of the last set made
+  std::int64_t rebuilds_ = 0;              // obstacle sets made (moving bodies get new ids)
+  std::map<int, std::string> body_names_;  // obstacle id -> name, of the last set made
 };
 
 }  // namespace kinograph::daemon

@@ -13,19 +13,20 @@
 #include <lcm/lcm-cpp.hpp>
 #include <stdexcept>
 #include <string_view>
-#include <utility>
 #include <thread>
+#include <utility>
 
 #include "daemon/robot_payload.h"
 #include "daemon/state_file.h"
 #include "daemon/state_limits.h"
 #include "daemon/wire_strings.h"
+#include "kinograph/fleet/joint_clearance.h"
 #include "kinograph/fleet/model_id.h"
 #include "kinograph/graph/cancellation.h"
 #include "kinograph/lcm/drake_convert.h"
 #include "kinograph/lcm/lcm_connection.h"
-#include "kinograph/planner_status_t.hpp"
 #include "kinograph/payload_t.hpp"
+#include "kinograph/planner_status_t.hpp"
 #include "lcmtypes/safe_decode.h"
 
 namespace kinograph::daemon {
@@ -72,9 +73,9 @@ PlannerNode::PlannerNode(planning::Scene scene, PlannerNodeOptions options, lcm:
       lcm_->subscribe(channel("PLANNER_STATUS"), &PlannerNode::on_heartbeat, this));
   subscriptions_.push_back(lcm_->subscribe(channel("COMMAND"), &PlannerNode::on_command, this));
   subscriptions_.push_back(lcm_->subscribe(channel("PAYLOAD"), &PlannerNode::on_payload, this));
-  std::vector<int> capacities = {kGoalQueueCapacity,      kObstacleQueueCapacity,
-                                 kStateQueueCapacity,     kHeartbeatQueueCapacity,
-                                 kStateQueueCapacity,     kPayloadQueueCapacity};
+  std::vector<int> capacities = {kGoalQueueCapacity,  kObstacleQueueCapacity,
+                                 kStateQueueCapacity, kHeartbeatQueueCapacity,
+                                 kStateQueueCapacity, kPayloadQueueCapacity};
   if (!options_.iiwa_status_channel.empty()) {
     subscriptions_.push_back(
         lcm_->subscribe(options_.iiwa_status_channel, &PlannerNode::on_iiwa_status, this));
@@ -313,7 +314,9 @@ DecodedGoal decode_goal(const char* type, const lcm::ReceiveBuffer* rbuf) {
   }
   out.goal_id = msg->goal_id;
   out.convert = [msg](const dynamics::Model& model, const RobotIdentity& identity,
-                      GoalRequest& request) { return convert_goal(*msg, model, identity, request); };
+                      GoalRequest& request) {
+    return convert_goal(*msg, model, identity, request);
+  };
   return out;
 }
 
@@ -707,45 +710,94 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t
   }
   spdlog::debug("goal {}: planning{}", goal.goal_id, replan ? " (replan)" : "");
   for (const auto& [name, obstacle] : live_obstacles_) problem.obstacles.push_back(obstacle);
+  // Joints a goal does not name stay where this plan starts.
+  problem.goal = messages::goal_for_start(goal, problem.start_q);
+  problem.task_constraints.insert(problem.task_constraints.end(), goal.task_constraints.begin(),
+                                  goal.task_constraints.end());
+  if (goal.duration_s > 0) problem.horizon = goal.duration_s;
   // Neighbours' bodies on this plan's clock: knot 0 is the state, the take-over, or now.
   std::optional<fleet::Decision> around;
   std::optional<int64_t> origin;  // without a state, the plan then starts when planning began
   if (neighbours_) {
     around = neighbours_->decide({goal.utime, ""}, !replan);
     origin = join ? join->takeover_utime : state_utime.value_or(wall_utime());
-    neighbours_->add_obstacles(*around, *origin, problem.obstacles);
   }
-  // Joints a goal does not name stay where this plan starts.
-  problem.goal = messages::goal_for_start(goal, problem.start_q);
-  problem.task_constraints.insert(problem.task_constraints.end(), goal.task_constraints.begin(),
-                                  goal.task_constraints.end());
-  if (goal.duration_s > 0) problem.horizon = goal.duration_s;
+  const std::size_t own_obstacles = problem.obstacles.size();
+  blocked_.reset();
 
   planning::Plan plan;
   bool threw = false;
   std::string error;
-  try {
-    plan = replanner_.plan(problem, /*new_goal=*/!replan);
-  } catch (const graph::Cancelled&) {
-    spdlog::info("goal {}: planning cancelled: {}", goal.goal_id, kShutdownReason);
-    answer_with_failure(plan_t::CANCELLED, std::string("planning cancelled: ") + kShutdownReason,
-                        goal.goal_id, /*first_answer=*/!replan);
-    {
-      std::lock_guard lock(mutex_);
-      state_ = planner_status_t::IDLE;
-      last_message_ = kShutdownReason;
+  double wait_s = 0;       // the start held for a followed neighbour's plan to end
+  std::string waited_for;  // that neighbour
+  std::string refusal;     // the coordination rule's failure reason for a plan that ran into one
+  // Each wait goes to a later plan end, so there are at most as many as neighbours.
+  for (std::size_t attempt = 0;; ++attempt) {
+    if (neighbours_) {
+      problem.obstacles.resize(own_obstacles);
+      neighbours_->add_obstacles(*around, *origin + std::llround(wait_s * 1e6), problem.obstacles);
     }
-    return;
-  } catch (const std::exception& e) {
-    threw = true;
-    error = e.what();
+    try {
+      plan = replanner_.plan(problem, /*new_goal=*/!replan && attempt == 0);
+    } catch (const graph::Cancelled&) {
+      spdlog::info("goal {}: planning cancelled: {}", goal.goal_id, kShutdownReason);
+      answer_with_failure(plan_t::CANCELLED, std::string("planning cancelled: ") + kShutdownReason,
+                          goal.goal_id, /*first_answer=*/!replan);
+      {
+        std::lock_guard lock(mutex_);
+        state_ = planner_status_t::IDLE;
+        last_message_ = kShutdownReason;
+      }
+      return;
+    } catch (const std::exception& e) {
+      threw = true;
+      error = e.what();
+    }
+    if (threw || !neighbours_) break;
+    // A valid plan must also stay clear of the neighbours it follows while they still move after
+    // it ends (the planner sees only its own span); a failed one that comes within the margin of
+    // a neighbour ran into it. A problem refused before solving (a goal in collision) has no
+    // trajectory: its goal, held from the start, is what ran into the neighbour.
+    const bool refused = plan.q.rows() < 2 && problem.goal.kind == planning::Goal::Kind::kJoint;
+    std::string why;
+    const std::optional<fleet::Blocker> blocker = neighbours_->blocker(
+        *around, *origin, *problem.model,
+        refused ? fleet::standing_plan(problem.goal.q, problem.horizon) : plan, wait_s,
+        plan.success() ? 0.0 : problem.objectives.collision_epsilon, why);
+    if (refused) {
+      why = "its goal: " + why;
+    } else if (!plan.success() && !plan.stats.reason.empty()) {
+      why += " (" + neighbours_->name_bodies(plan.stats.reason) + ")";
+    }
+    if (!blocker) break;
+    // A robot joining a motion under way does not wait: the executor would go on meanwhile.
+    const std::string no_wait = !options_.wait_for_neighbours   ? "waiting is off"
+                                : join                          ? "it joins a motion under way"
+                                : attempt > neighbours_->size() ? "it waited for every neighbour"
+                                                                : "";
+    const fleet::Remedy r =
+        fleet::remedy(identity_.channel_prefix, *blocker, wait_s, problem.horizon, no_wait, why);
+    if (r.kind == fleet::Remedy::Kind::kWait) {
+      spdlog::info("goal {}: {} ({})", goal.goal_id, r.reason, why);
+      wait_s = r.wait.wait;
+      waited_for = blocker->name;
+      continue;
+    }
+    refusal = r.reason;
+    if (r.kind == fleet::Remedy::Kind::kFail &&
+        blocker->treatment == fleet::Treatment::kHeldAtState) {
+      blocked_ = BlockedAnswer{goal.goal_id, blocker->name, blocker->prefix, why};
+    }
+    break;
   }
+  const bool valid = !threw && plan.success() && refusal.empty();
   const planning::ReplanReport& report = replanner_.last_report();
   // A state the incremental planner refused (or never saw, after an exception) is offered again.
-  if (threw || !plan.success()) {
+  if (!valid) {
     std::lock_guard lock(mutex_);
     if (new_state) --used_state_count_;
   }
+  const std::string wait_note = valid && wait_s > 0 ? fleet::wait_note(waited_for, wait_s) : "";
 
   int64_t plan_id;
   messages::PlanTime time;
@@ -759,36 +811,47 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t
     if (replan) ++counters_.replans;
     if (!threw && report.incremental) ++counters_.incremental;
     if (!threw && report.fell_back) ++counters_.fallbacks;
-    if (threw || !plan.success()) ++counters_.failures;
+    if (!valid) ++counters_.failures;
+    if (valid && wait_s > 0) ++counters_.neighbour_waits;
     state_ = threw ? planner_status_t::ERROR : planner_status_t::IDLE;
-    last_message_ = threw ? error : (plan.success() ? "" : plan.stats.reason);
+    last_message_ = threw              ? error
+                    : !refusal.empty() ? refusal
+                    : plan.success()   ? wait_note
+                                       : plan.stats.reason;
     if (neighbours_) last_message_ = neighbours_->name_bodies(last_message_);
-    if (!threw && plan.success()) {
+    if (valid) {
       valid_plan_id_ = plan_id;
       valid_goal_utime_ = goal.utime;
     }
   }
-  if (around && !threw && plan.success()) neighbours_->planned(*around);
+  if (around && valid) neighbours_->planned(*around);
   // Knot 0 is the measured state, at its own time, or where the motion under way will be at
   // the take-over; without a state the plan starts when it is published (with neighbours, when
-  // planning began: the time their bodies were placed on).
+  // planning began: the time their bodies were placed on); after a wait, that much later, the
+  // robot holding its start until then.
   time.state_utime = state_utime.value_or(-1);
   time.start_utime =
-      join ? join->takeover_utime : state_utime.value_or(origin.value_or(time.utime));
+      (join ? join->takeover_utime : state_utime.value_or(origin.value_or(time.utime))) +
+      std::llround(wait_s * 1e6);
   time.takeover_utime = time.start_utime;
   plan_t msg;
   if (threw) {
     spdlog::error("goal {}: planner error: {}", goal.goal_id, error);
     msg = messages::failure_message(plan_t::FAILED, "planner error: " + error, identity_.model_name,
                                     plan_id, goal.goal_id, time);
+  } else if (!refusal.empty()) {
+    spdlog::warn("goal {}: plan {} refused: {}", goal.goal_id, plan_id, refusal);
+    msg = messages::failure_message(plan_t::FAILED, refusal, identity_.model_name, plan_id,
+                                    goal.goal_id, time);
   } else {
     msg = messages::plan_to_message(plan, *problem.model, identity_.model_name, plan_id,
                                     goal.goal_id, time);
     msg.method = report.method;
     if (neighbours_) msg.status_message = neighbours_->name_bodies(msg.status_message);
-    spdlog::info("goal {}: plan {} {} ({}, {} iterations, {:.1f} ms)", goal.goal_id, plan_id,
+    if (!wait_note.empty()) msg.status_message = wait_note;
+    spdlog::info("goal {}: plan {} {} ({}, {} iterations, {:.1f} ms){}", goal.goal_id, plan_id,
                  plan.success() ? "valid" : "INVALID", msg.method, plan.stats.iterations,
-                 plan.stats.solve_time_s * 1e3);
+                 plan.stats.solve_time_s * 1e3, wait_note.empty() ? "" : "; " + wait_note);
   }
   // Recorded before it is sent, so that the executor's first command of it is recognised.
   if (msg.status == plan_t::SUCCESS) {
@@ -873,7 +936,10 @@ void PlannerNode::republish_current_plan() {
 
 void PlannerNode::replan_for_neighbours() {
   const fleet::Decision d = neighbours_->decide({current_goal_->utime, ""}, false);
-  if (!d.replan) return;
+  if (!d.replan) {
+    answer_deadlock();
+    return;
+  }
   int64_t trigger_utime = current_goal_->utime;
   {
     std::lock_guard lock(mutex_);
@@ -882,6 +948,23 @@ void PlannerNode::replan_for_neighbours() {
   }
   spdlog::info("goal {}: replanning: {}", current_goal_->goal_id, d.reason);
   plan_and_publish(*current_goal_, /*replan=*/true, trigger_utime);
+}
+
+void PlannerNode::answer_deadlock() {
+  if (!blocked_ || !current_goal_ || blocked_->goal_id != current_goal_->goal_id ||
+      !neighbours_->blocked_by_own(blocked_->name)) {
+    return;
+  }
+  const std::string reason = fleet::deadlock_reason(identity_.channel_prefix, blocked_->name,
+                                                    blocked_->prefix, blocked_->why);
+  spdlog::warn("goal {}: {}", blocked_->goal_id, reason);
+  {
+    std::lock_guard lock(mutex_);
+    last_message_ = reason;
+  }
+  answer_with_failure(plan_t::FAILED, reason, blocked_->goal_id, /*first_answer=*/false);
+  blocked_.reset();
+  publish_status();
 }
 
 void PlannerNode::publish_status() {

@@ -85,6 +85,10 @@ struct PlannerNodeOptions {
   std::vector<NeighbourSpec> neighbours;
   /// How neighbours are watched (their timeout).
   NeighboursOptions neighbour_watch;
+  /// A plan that runs into a higher-priority neighbour's plan is made again with the start held
+  /// until that plan ends, and published that much later (docs/multi_robot.md); off: such a goal
+  /// is answered with the failure. On by default.
+  bool wait_for_neighbours = true;
 };
 
 /// What a node has done since it started (for its status and for tests).
@@ -107,6 +111,7 @@ struct NodeCounters {
   int64_t late_takeovers = 0;      ///< of which published after their take-over time had passed
   int64_t payload_changes = 0;     ///< payload_t attaches and detaches taken
   int64_t neighbour_replans = 0;   ///< replans because a higher-priority neighbour changed
+  int64_t neighbour_waits = 0;     ///< valid plans that hold their start for a neighbour's plan
 };
 
 /// The planner daemon's node: scene (robot, defaults, fixed obstacles) + LCM + worker thread.
@@ -219,6 +224,9 @@ class PlannerNode {
   /// Replans the current goal when the coordination rule says a neighbour's change calls for
   /// it (worker thread).
   void replan_for_neighbours();
+  /// Answers the current goal again, as a deadlock, when its failure was a neighbour held at its
+  /// state that now reports being blocked by this robot (worker thread).
+  void answer_deadlock();
   /// Sends the current valid plan again on PREFIX_PLAN_CURRENT, for a neighbour that joined
   /// after it was published (worker thread).
   void republish_current_plan();
@@ -288,6 +296,13 @@ class PlannerNode {
   std::optional<GoalRequest> current_goal_;
   std::optional<RobotWithPayload> robot_;  // the robot since the last payload_t; unset: the scene's
   planning::Replanner replanner_;
+  // The current goal's failure when a neighbour held at its state blocked it: a deadlock once
+  // that neighbour says this robot blocks it.
+  struct BlockedAnswer {
+    int64_t goal_id;
+    std::string name, prefix, why;
+  };
+  std::optional<BlockedAnswer> blocked_;
   std::uint64_t used_state_count_ = 0;  // state_count_ when the planner's start was last set
 };
 

@@ -1,6 +1,8 @@
 #include "kinograph/fleet/coordination.h"
 
 #include <algorithm>
+#include <iomanip>
+#include <sstream>
 #include <tuple>
 
 namespace kinograph::fleet {
@@ -28,10 +30,10 @@ Decision coordinate(const PriorityKey& own, const std::vector<NeighbourView>& ne
     // Only a higher-priority neighbour's change moves this robot; a lower one yields to it.
     const auto was = planned.find(n.name);
     if (was == planned.end() || was->second != entry) {
-      trigger = follow ? "neighbour '" + n.name + "' (higher priority) has plan " +
-                             std::to_string(entry)
-                       : "neighbour '" + n.name + "' (higher priority) is " +
-                             (n.silent ? "silent" : "without a plan") + ", held at its state";
+      trigger =
+          follow ? "neighbour '" + n.name + "' (higher priority) has plan " + std::to_string(entry)
+                 : "neighbour '" + n.name + "' (higher priority) is " +
+                       (n.silent ? "silent" : "without a plan") + ", held at its state";
     }
   }
   if (own_goal_changed) {
@@ -55,9 +57,78 @@ WaitPlan wait_for(double blocking_end, double own_start, double horizon) {
   return w;
 }
 
-std::string deadlock_reason(const std::string& neighbour, const std::string& why) {
-  return "deadlock: no plan around neighbour '" + neighbour +
-         "', not even after waiting for its plan to end: " + why;
+Remedy remedy(const std::string& own, const Blocker& blocker, double own_start, double horizon,
+              const std::string& no_wait, const std::string& why) {
+  Remedy r;
+  if (blocker.treatment == Treatment::kAlongPlan) {
+    // A plan ending within a microsecond (the clock's resolution) has ended.
+    if (no_wait.empty() && blocker.plan_end > own_start + 1e-6) {
+      r.kind = Remedy::Kind::kWait;
+      r.wait = wait_for(blocker.plan_end, 0.0, horizon);
+      r.reason = wait_note(blocker.name, r.wait.wait);
+      return r;
+    }
+    r.reason = blocked_reason(blocker.name, blocker.prefix, blocker.treatment, own_start, why);
+    if (!no_wait.empty() && own_start <= 0) r.reason += " (not waiting: " + no_wait + ")";
+    return r;
+  }
+  if (blocker.blocked_by_own) {
+    r.kind = Remedy::Kind::kDeadlock;
+    r.reason = deadlock_reason(own, blocker.name, blocker.prefix, why);
+    return r;
+  }
+  r.reason = blocked_reason(blocker.name, blocker.prefix, blocker.treatment, 0.0, why);
+  return r;
+}
+
+namespace {
+// Seconds with millisecond digits: "3.000".
+std::string seconds(double s) {
+  std::ostringstream os;
+  os << std::fixed << std::setprecision(3) << s;
+  return os.str();
+}
+}  // namespace
+
+std::string wait_note(const std::string& neighbour, double wait) {
+  return "starts " + seconds(wait) + " s late: waits for neighbour '" + neighbour +
+         "''s plan to end";
+}
+
+namespace {
+// What blocker_prefix reads: the neighbour's name, then its prefix in brackets.
+std::string tagged(const std::string& name, const std::string& prefix) {
+  return "neighbour '" + name + "' [" + prefix + "]";
+}
+}  // namespace
+
+std::string blocked_reason(const std::string& name, const std::string& prefix, Treatment treatment,
+                           double waited, const std::string& why) {
+  std::string s = "blocked by " + tagged(name, prefix);
+  if (treatment == Treatment::kAlongPlan) {
+    s += waited > 0 ? ", even after waiting " + seconds(waited) + " s for its plan to end"
+                    : ", moving along its plan";
+  } else {
+    s += ", held at its state";
+  }
+  return s + ": " + why;
+}
+
+std::string deadlock_reason(const std::string& own, const std::string& name,
+                            const std::string& prefix, const std::string& why) {
+  return "deadlock with " + tagged(name, prefix) + ": robots '" + own + "' and '" + prefix +
+         "' each stand where the other must go, and neither can move first: " + why;
+}
+
+std::string blocker_prefix(const std::string& reason) {
+  for (const char* lead : {"blocked by neighbour '", "deadlock with neighbour '"}) {
+    const std::size_t at = reason.find(lead);
+    if (at == std::string::npos) continue;
+    const std::size_t open = reason.find("' [", at + std::string(lead).size());
+    const std::size_t close = open == std::string::npos ? open : reason.find(']', open);
+    if (close != std::string::npos) return reason.substr(open + 3, close - open - 3);
+  }
+  return "";
 }
 
 }  // namespace kinograph::fleet

@@ -71,7 +71,55 @@ struct WaitPlan {
 /// start at `own_start` with `horizon` s of motion.
 WaitPlan wait_for(double blocking_end, double own_start, double horizon);
 
-/// The FAILED reason of a deadlock: no plan around `neighbour`, even after waiting for it.
-std::string deadlock_reason(const std::string& neighbour, const std::string& why);
+/// The neighbour a plan ran into (its bodies, as the rule treated them, within contact of the
+/// plan's), and what is known of it.
+struct Blocker {
+  std::string name;    ///< its name in this robot's configuration
+  std::string prefix;  ///< its channel prefix: its name in the priority order and in reasons
+  Treatment treatment = Treatment::kHeldAtState;
+  double plan_end = 0;  ///< kAlongPlan: own-clock time (s) at which its followed plan ends
+  /// Its own latest answer is a failure blocked by this robot (blocker_prefix of its reason).
+  bool blocked_by_own = false;
+};
+
+/// What a robot whose plan ran into a neighbour does.
+struct Remedy {
+  enum class Kind {
+    kWait,      ///< plan again with the start held for `wait.wait` s: the blocking plan ends then
+    kFail,      ///< answer the goal with a failure, `reason`
+    kDeadlock,  ///< answer with a failure, `reason`: the two robots block each other
+  };
+  Kind kind = Kind::kFail;
+  WaitPlan wait;
+  std::string reason;
+};
+
+/// The rule for a blocked plan (docs/multi_robot.md). Blocked by a followed neighbour's plan
+/// that ends after `own_start` (own clock, s; the wait already taken, 0 for none), and `no_wait`
+/// empty: wait until it ends. Blocked by it after waiting, or with `no_wait` saying why the robot
+/// may not wait: fail. Blocked by a neighbour held at its state that is itself blocked by this
+/// robot: deadlock. Otherwise fail. `own` is this robot's channel prefix, `why` what the planner
+/// or the check found.
+Remedy remedy(const std::string& own, const Blocker& blocker, double own_start, double horizon,
+              const std::string& no_wait, const std::string& why);
+
+/// What a plan that waits says (its status message, the heartbeat): "starts 3.000 s late: waits
+/// for neighbour 'a''s plan to end".
+std::string wait_note(const std::string& neighbour, double wait);
+
+/// The failure reason of a plan blocked by neighbour `name` (channel prefix `prefix`) as
+/// `treatment` says, e.g. "blocked by neighbour 'b' [B], held at its state: ..."; after
+/// `waited` s of waiting (0: none), it says so.
+std::string blocked_reason(const std::string& name, const std::string& prefix, Treatment treatment,
+                           double waited, const std::string& why);
+
+/// The FAILED reason of a deadlock of robot `own` (its prefix) and neighbour `name` (`prefix`):
+/// each is held where the other must go, so neither can move first.
+std::string deadlock_reason(const std::string& own, const std::string& name,
+                            const std::string& prefix, const std::string& why);
+
+/// The channel prefix of the neighbour that blocked a plan, as blocked_reason or deadlock_reason
+/// wrote it into `reason` (a failure answer, a heartbeat's message); empty when none.
+std::string blocker_prefix(const std::string& reason);
 
 }  // namespace kinograph::fleet

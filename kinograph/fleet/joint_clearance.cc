@@ -1,6 +1,7 @@
 #include "kinograph/fleet/joint_clearance.h"
 
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 #include <stdexcept>
 
@@ -13,13 +14,17 @@
 namespace kinograph::fleet {
 namespace {
 
-// The union of every robot's sample times on the common clock, without near-duplicates (which
-// would break PoseTrajectory's strictly increasing times).
-std::vector<double> common_times(const std::vector<RobotPlan>& robots, int per_interval) {
+// The union of every robot's sample times on the common clock from `from` on (`from` itself
+// included when finite), without near-duplicates (which would break PoseTrajectory's strictly
+// increasing times).
+std::vector<double> common_times(const std::vector<RobotPlan>& robots, int per_interval,
+                                 double from) {
   std::vector<double> times;
+  if (std::isfinite(from)) times.push_back(from);
   for (const RobotPlan& r : robots) {
-    const std::vector<double> own = sweep_times(r.plan, r.offset, per_interval);
-    times.insert(times.end(), own.begin(), own.end());
+    for (const double t : sweep_times(r.plan, r.offset, per_interval)) {
+      if (t >= from) times.push_back(t);
+    }
   }
   std::sort(times.begin(), times.end());
   std::vector<double> unique;
@@ -31,11 +36,19 @@ std::vector<double> common_times(const std::vector<RobotPlan>& robots, int per_i
 
 }  // namespace
 
+planning::Plan standing_plan(const Eigen::VectorXd& q, double duration) {
+  planning::Plan p;
+  p.t = {0.0, duration};
+  p.q = p.qd = p.qdd = p.tau = Eigen::MatrixXd::Zero(2, q.size());
+  p.q.row(0) = p.q.row(1) = q.transpose();
+  return p;
+}
+
 std::string describe(const JointClearance& c) {
   std::ostringstream os;
   if (c.robot_a.empty()) return "no two robots have collision geometry";
-  os << "robots '" << c.robot_a << "' (link '" << c.link_a << "') and '" << c.robot_b
-     << "' (link '" << c.link_b << "') ";
+  os << "robots '" << c.robot_a << "' (link '" << c.link_a << "') and '" << c.robot_b << "' (link '"
+     << c.link_b << "') ";
   if (c.min_distance < 0) {
     os << "overlap by " << -c.min_distance << " m";
   } else {
@@ -66,7 +79,8 @@ JointClearance joint_clearance(const std::vector<RobotPlan>& robots,
     }
   }
   JointClearance result;
-  const std::vector<double> times = common_times(robots, options.samples_per_interval);
+  const std::vector<double> times =
+      common_times(robots, options.samples_per_interval, options.from);
   result.samples = static_cast<int>(times.size());
   // Robot i's bodies in a world whose obstacles are robot j's bodies along its plan, sampled at
   // the same common times, so both are posed exactly at every time checked.

@@ -25,6 +25,9 @@ struct JointClearanceOptions {
   /// Points per interval of every robot's plan (its knot and samples_per_interval − 1 evenly
   /// between); all robots are posed at the union of these times. Default 10, as the validator.
   int samples_per_interval = 10;
+  /// Common-clock time (s) from which on the robots are checked: what lies before (a neighbour's
+  /// motion already past) is left out. Default −∞: the whole span.
+  double from = -std::numeric_limits<double>::infinity();
 };
 
 /// The closest approach of two different robots over the common span of their plans (each one
@@ -33,14 +36,18 @@ struct JointClearance {
   /// Smallest signed distance (m) between bodies of two different robots; negative inside,
   /// +inf when no two robots have collision geometry.
   double min_distance = std::numeric_limits<double>::infinity();
-  double t = 0;                  ///< common-clock time (s) of the closest approach
-  std::string robot_a, link_a;   ///< one robot of the closest pair and its link
-  std::string robot_b, link_b;   ///< the other
-  int samples = 0;               ///< common times checked
+  double t = 0;                 ///< common-clock time (s) of the closest approach
+  std::string robot_a, link_a;  ///< one robot of the closest pair and its link
+  std::string robot_b, link_b;  ///< the other
+  int samples = 0;              ///< common times checked
 
   /// True when the robots keep at least `required` metres apart.
   bool clear(double required = 0.0) const { return min_distance >= required; }
 };
+
+/// A plan standing still at configuration q from time 0 to `duration` s (two knots, at rest): a
+/// robot held at a state, for joint_clearance.
+planning::Plan standing_plan(const Eigen::VectorXd& q, double duration = 1.0);
 
 /// One line: "robots 'a' (link 'l') and 'b' (link 'm') are 0.12 m apart at t = 1.4 s" (or
 /// "overlap by ...").

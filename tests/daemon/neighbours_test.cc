@@ -7,6 +7,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "kinograph/fleet/joint_clearance.h"
 #include "kinograph/fleet/model_id.h"
 #include "kinograph/lcm/message_convert.h"
 #include "kinograph/plan_t.hpp"
@@ -124,8 +125,7 @@ TEST_F(NeighboursTest, ReportsAHeartbeatThatDoesNotFitTheScene) {
   planner_status_t wrong_model = heartbeat(1);
   wrong_model.model_id = "iiwa14:0000000000000000";
   send("RIGHT_PLANNER_STATUS", wrong_model);
-  EXPECT_NE(neighbours_->summary().find("its model is iiwa14:0000000000000000"),
-            std::string::npos)
+  EXPECT_NE(neighbours_->summary().find("its model is iiwa14:0000000000000000"), std::string::npos)
       << neighbours_->summary();
   planner_status_t moved = heartbeat(1);
   moved.base_position[1] = 0.5;
@@ -134,13 +134,53 @@ TEST_F(NeighboursTest, ReportsAHeartbeatThatDoesNotFitTheScene) {
       << neighbours_->summary();
 }
 
+TEST_F(NeighboursTest, FindsTheNeighbourAPlanRunsIntoAndWhetherItIsBlockedByThisRobot) {
+  send("RIGHT_PLANNER_STATUS", heartbeat(3'000'000));
+  const fleet::Decision d = neighbours_->decide({2'000'000, ""}, true);
+  ASSERT_EQ(d.treatment[0], fleet::Treatment::kHeldAtState);
+  // Standing where right stands (its scene's start, no state heard): right blocks it.
+  std::string why;
+  const std::optional<fleet::Blocker> b = neighbours_->blocker(
+      d, 4'000'000, *spec_.model, fleet::standing_plan(spec_.start_q), 0.0, 0.0, why);
+  ASSERT_TRUE(b.has_value());
+  EXPECT_EQ(b->name, "right");
+  EXPECT_EQ(b->prefix, "RIGHT");
+  EXPECT_EQ(b->treatment, fleet::Treatment::kHeldAtState);
+  EXPECT_FALSE(b->blocked_by_own);
+  EXPECT_NE(why.find("overlap"), std::string::npos) << why;
+  // Left's own start, across the table, is clear of it.
+  const planning::Scene left = planning::load_scene(std::string(KINOGRAPH_SOURCE_DIR) +
+                                                    "/robots/scenes/iiwa_pair_left.yaml");
+  EXPECT_FALSE(neighbours_
+                   ->blocker(d, 4'000'000, *left.problem.model,
+                             fleet::standing_plan(left.problem.start_q), 0.0, 0.0, why)
+                   .has_value())
+      << why;
+
+  // Right's heartbeat says LEFT blocks its goal: a change, and the blocker is now blocked by it.
+  neighbours_->take_changed();
+  planner_status_t blocked = heartbeat(3'000'000);
+  blocked.message = fleet::blocked_reason("left", "LEFT", fleet::Treatment::kHeldAtState, 0, "x");
+  send("RIGHT_PLANNER_STATUS", blocked);
+  EXPECT_TRUE(neighbours_->take_changed());
+  EXPECT_TRUE(neighbours_->blocked_by_own("right"));
+  EXPECT_TRUE(
+      neighbours_
+          ->blocker(d, 4'000'000, *spec_.model, fleet::standing_plan(spec_.start_q), 0.0, 0.0, why)
+          ->blocked_by_own);
+  // Blocked by another robot: not by this one.
+  blocked.message = fleet::blocked_reason("x", "OTHER", fleet::Treatment::kHeldAtState, 0, "x");
+  send("RIGHT_PLANNER_STATUS", blocked);
+  EXPECT_FALSE(neighbours_->blocked_by_own("right"));
+}
+
 TEST(NeighbourOption, NeedsANameAndAScene) {
   EXPECT_THROW(neighbour_from_option("right"), std::invalid_argument);
   EXPECT_THROW(neighbour_from_option("=x.yaml"), std::invalid_argument);
   EXPECT_THROW(neighbour_from_option("right=x.yaml@"), std::invalid_argument);
   EXPECT_THROW(neighbour_from_option("right=/nonexistent/scene.yaml"), planning::SceneError);
-  const NeighbourSpec s = neighbour_from_option(
-      "r=" + std::string(KINOGRAPH_SOURCE_DIR) + "/robots/scenes/iiwa_pair_right.yaml@ARM2");
+  const NeighbourSpec s = neighbour_from_option("r=" + std::string(KINOGRAPH_SOURCE_DIR) +
+                                                "/robots/scenes/iiwa_pair_right.yaml@ARM2");
   EXPECT_EQ(s.channel_prefix, "ARM2");
   EXPECT_NEAR(s.base.translation().x(), 1.3, 1e-12);
 }

@@ -30,9 +30,9 @@ TEST(Coordinate, FollowsHigherNeighboursAndHoldsTheOthers) {
                                         {"planless", {120, "planless"}, std::nullopt, false}};
   const Decision d = coordinate(own, n, {}, true);
   EXPECT_TRUE(d.replan);
-  EXPECT_EQ(d.treatment, (std::vector<Treatment>{Treatment::kAlongPlan, Treatment::kHeldAtState,
-                                                 Treatment::kHeldAtState,
-                                                 Treatment::kHeldAtState}));
+  EXPECT_EQ(d.treatment,
+            (std::vector<Treatment>{Treatment::kAlongPlan, Treatment::kHeldAtState,
+                                    Treatment::kHeldAtState, Treatment::kHeldAtState}));
   EXPECT_EQ(d.around.at("first"), 7);
   EXPECT_EQ(d.around.at("last"), kHeldMark);
   EXPECT_EQ(d.around.at("quiet"), kHeldMark);
@@ -103,6 +103,59 @@ TEST(Coordinate, FleetSettlesWithinNMinusOneRounds) {
     }
     EXPECT_LE(last_active, N - 1) << "trial " << trial << " with " << N << " robots";
   }
+}
+
+TEST(WaitFor, HoldsTheStartUntilTheBlockingPlanEnds) {
+  const WaitPlan w = wait_for(2.5, 0.5, 3.0);
+  EXPECT_DOUBLE_EQ(w.wait, 2.0);
+  EXPECT_DOUBLE_EQ(w.horizon, 5.0);
+  const WaitPlan ended = wait_for(1.0, 2.0, 3.0);  // ended before the own start: no wait
+  EXPECT_DOUBLE_EQ(ended.wait, 0.0);
+  EXPECT_DOUBLE_EQ(ended.horizon, 3.0);
+}
+
+TEST(Remedy, WaitsForAFollowedPlanThatEndsLater) {
+  const Blocker a{"a", "A", Treatment::kAlongPlan, 2.5, false};
+  const Remedy r = remedy("B", a, 0.0, 1.0, "", "overlap");
+  EXPECT_EQ(r.kind, Remedy::Kind::kWait);
+  EXPECT_DOUBLE_EQ(r.wait.wait, 2.5);
+  EXPECT_DOUBLE_EQ(r.wait.horizon, 3.5);
+  EXPECT_NE(r.reason.find("neighbour 'a'"), std::string::npos) << r.reason;
+}
+
+TEST(Remedy, FailsWhenStillBlockedAfterWaitingOrWhenWaitingIsOff) {
+  const Blocker a{"a", "A", Treatment::kAlongPlan, 2.5, false};
+  const Remedy after = remedy("B", a, 2.5, 1.0, "", "overlap at the goal");
+  EXPECT_EQ(after.kind, Remedy::Kind::kFail);
+  EXPECT_NE(after.reason.find("even after waiting 2.500 s"), std::string::npos) << after.reason;
+  EXPECT_EQ(blocker_prefix(after.reason), "A");
+  const Remedy off = remedy("B", a, 0.0, 1.0, "waiting is off", "overlap");
+  EXPECT_EQ(off.kind, Remedy::Kind::kFail);
+  EXPECT_NE(off.reason.find("waiting is off"), std::string::npos) << off.reason;
+}
+
+TEST(Remedy, AHeldNeighbourBlockedByThisRobotIsADeadlockNamingBoth) {
+  Blocker b{"right", "RIGHT", Treatment::kHeldAtState, 0.0, false};
+  const Remedy blocked = remedy("LEFT", b, 0.0, 3.0, "", "goal overlaps it");
+  EXPECT_EQ(blocked.kind, Remedy::Kind::kFail);
+  EXPECT_EQ(blocked.reason.find("deadlock"), std::string::npos) << blocked.reason;
+  EXPECT_EQ(blocker_prefix(blocked.reason), "RIGHT");
+  b.blocked_by_own = true;  // its answer says it is blocked by LEFT
+  const Remedy dead = remedy("LEFT", b, 0.0, 3.0, "", "goal overlaps it");
+  EXPECT_EQ(dead.kind, Remedy::Kind::kDeadlock);
+  EXPECT_EQ(dead.reason.rfind("deadlock", 0), 0u) << dead.reason;
+  EXPECT_NE(dead.reason.find("'LEFT'"), std::string::npos) << dead.reason;
+  EXPECT_NE(dead.reason.find("'RIGHT'"), std::string::npos) << dead.reason;
+  // The partner reads the deadlock answer as blocked by LEFT too: no third state, no loop.
+  EXPECT_EQ(blocker_prefix(deadlock_reason("RIGHT", "left", "LEFT", "x")), "LEFT");
+}
+
+TEST(BlockerPrefix, OnlyFromTheRulesReasons) {
+  EXPECT_EQ(blocker_prefix(""), "");
+  EXPECT_EQ(blocker_prefix("infeasible: neighbour 'a' link 'l' at t = 1 s"), "");
+  EXPECT_EQ(blocker_prefix("blocked by neighbour 'a' [A"), "");
+  EXPECT_EQ(blocker_prefix("x; " + blocked_reason("n", "N2", Treatment::kHeldAtState, 0, "y")),
+            "N2");
 }
 
 }  // namespace

@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "tests/fleet/slider.h"
 
 namespace kinograph::fleet {
@@ -29,6 +31,17 @@ TEST(JointClearance, FindsTheClosestApproachBetweenTheKnots) {
   EXPECT_TRUE(c.clear());
   EXPECT_FALSE(c.clear(0.1));
   EXPECT_EQ(c.samples, 11);
+}
+
+TEST(JointClearance, LeavesOutWhatLiesBeforeFrom) {
+  // As above, checked from t = 0.75 s on: 'a' has passed x = 0 and is closest at 0.75 s, at
+  // x = 0.5: sqrt(0.5² + 0.25²) − 2r.
+  const std::vector<RobotPlan> robots = {
+      {"a", slider(Eigen::Vector3d(0, 0, 0)), constant_velocity(-1.0, 2.0, 1.0, 1), 0.0},
+      {"b", slider(Eigen::Vector3d(0, 0.25, 0)), constant_velocity(0.0, 0.0, 1.0, 1), 0.0}};
+  const JointClearance c = joint_clearance(robots, {.from = 0.75});
+  EXPECT_NEAR(c.min_distance, std::sqrt(0.5 * 0.5 + 0.25 * 0.25) - 2 * kSphereRadius, 1e-6);
+  EXPECT_NEAR(c.t, 0.75, 1e-12);
 }
 
 TEST(JointClearance, PutsEveryPlanOnTheCommonClockAndHoldsItsEnds) {

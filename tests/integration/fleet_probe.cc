@@ -8,8 +8,11 @@
 //   lower-cased), and with --newer a current plan id above ID. Then writes each robot's current
 //   plan as DIR/<prefix>.json (with start_utime and plan_id; a file of an earlier run with the
 //   current plan's id is kept) and prints per robot its plans and replans.
-//   fleet_probe heartbeat --url URL --prefix PREFIX --contains TEXT [--timeout S]
-//   waits for a heartbeat of PREFIX whose neighbours field contains TEXT, and prints that field.
+//   fleet_probe heartbeat --url URL --prefix PREFIX (--contains TEXT | --message TEXT)
+//       [--steady K] [--timeout S]
+//   waits for a heartbeat of PREFIX whose neighbours field (--contains) or message (--message)
+//   contains TEXT, and prints that field; with --steady, then for K more heartbeats of PREFIX,
+//   and fails when its count of published plans changes meanwhile (a robot replanning).
 // Prints "ready" once subscribed.
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -110,14 +113,21 @@ int main(int argc, char** argv) {
   settle->add_option("--newer", newer_args, "PREFIX=ID: its current plan must be above ID");
   settle->add_option("--out-dir", out_dir);
   settle->add_option("--timeout", timeout_s);
-  std::string prefix, contains;
+  std::string prefix, contains, message;
+  int steady = 0;
   CLI::App* beat = app.add_subcommand("heartbeat", "wait for a heartbeat saying TEXT");
   beat->add_option("--url", url)->required();
   beat->add_option("--prefix", prefix)->required();
-  beat->add_option("--contains", contains)->required();
+  auto* in_neighbours = beat->add_option("--contains", contains, "TEXT in its neighbours field");
+  beat->add_option("--message", message, "TEXT in its message")->excludes(in_neighbours);
+  beat->add_option("--steady", steady, "then K more heartbeats without a new plan");
   beat->add_option("--timeout", timeout_s);
   CLI11_PARSE(app, argc, argv);
   if (beat->parsed()) {
+    if (contains.empty() && message.empty()) {
+      std::cerr << "fleet_probe heartbeat: give --contains or --message\n";
+      return 2;
+    }
     robot_args = {prefix + "=-"};
   }
 
@@ -157,8 +167,8 @@ int main(int argc, char** argv) {
            +[](const lcm::ReceiveBuffer* rbuf, const std::string&, Route* r) {
              if (r->plan) {
                kinograph::plan_t msg;
-               if (!kinograph::lcmtypes::safe_decode(rbuf->data,
-                                                     static_cast<int>(rbuf->data_size), msg)
+               if (!kinograph::lcmtypes::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size),
+                                                     msg)
                         .ok) {
                  return;
                }
@@ -166,8 +176,8 @@ int main(int argc, char** argv) {
                if (msg.status == kinograph::plan_t::SUCCESS) r->robot->plans[msg.plan_id] = msg;
              } else {
                kinograph::planner_status_t msg;
-               if (kinograph::lcmtypes::safe_decode(rbuf->data,
-                                                    static_cast<int>(rbuf->data_size), msg)
+               if (kinograph::lcmtypes::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size),
+                                                    msg)
                        .ok) {
                  r->robot->heartbeat = msg;
                }
@@ -180,15 +190,38 @@ int main(int argc, char** argv) {
   const auto deadline = Clock::now() + std::chrono::duration<double>(timeout_s);
   if (beat->parsed()) {
     const Robot& r = robots.front();
-    while (!r.heartbeat || r.heartbeat->neighbours.find(contains) == std::string::npos) {
+    const bool in_message = !message.empty();
+    const std::string& text = in_message ? message : contains;
+    const auto field = [&] { return in_message ? r.heartbeat->message : r.heartbeat->neighbours; };
+    while (!r.heartbeat || field().find(text) == std::string::npos) {
       if (Clock::now() > deadline) {
-        std::cerr << "fleet_probe: no heartbeat of " << prefix << " says '" << contains
-                  << "' within " << timeout_s << " s\n";
+        std::cerr << "fleet_probe: no heartbeat of " << prefix << " says '" << text << "' within "
+                  << timeout_s << " s\n";
         return 1;
       }
       lcm.handleTimeout(50);
     }
-    std::cout << r.heartbeat->neighbours << "\n";
+    std::cout << field() << "\n";
+    const int plans = r.heartbeat->num_plans;
+    for (int beats = 0; beats < steady;) {
+      const int64_t seen = r.heartbeat->utime;
+      if (Clock::now() > deadline) {
+        std::cerr << "fleet_probe: " << beats << " of " << steady << " heartbeats within "
+                  << timeout_s << " s\n";
+        return 1;
+      }
+      lcm.handleTimeout(50);
+      if (r.heartbeat->utime == seen) continue;
+      ++beats;
+      if (r.heartbeat->num_plans != plans) {
+        std::cerr << "fleet_probe: " << prefix << " published plan " << r.heartbeat->last_plan_id
+                  << " after saying '" << text << "': " << r.heartbeat->message << "\n";
+        return 1;
+      }
+    }
+    if (steady > 0) {
+      std::cout << prefix << ": " << plans << " plans, steady over " << steady << " heartbeats\n";
+    }
     return 0;
   }
   std::string why = "nothing heard";
@@ -214,8 +247,8 @@ int main(int argc, char** argv) {
     json["plan_id"] = msg.plan_id;
     const std::string path = out_dir + "/" + r.name + ".json";
     std::ofstream(path) << json.dump(1) << "\n";
-    std::cout << r.prefix << ": plan " << msg.plan_id << " (" << msg.method << "), "
-              << r.received << " plans received, " << r.heartbeat->num_neighbour_replans
+    std::cout << r.prefix << ": plan " << msg.plan_id << " (" << msg.method << "), " << r.received
+              << " plans received, " << r.heartbeat->num_neighbour_replans
               << " neighbour replans; neighbours: " << r.heartbeat->neighbours << "\n";
   }
   return 0;
