@@ -3,11 +3,13 @@
 #include <tinyxml.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <sstream>
 
 #include "kinograph/dynamics/urdf_error.h"
+#include "kinograph/dynamics/utf8.h"
 #include "kinograph/dynamics/xml_depth.h"
 
 namespace kinograph::dynamics {
@@ -73,6 +75,12 @@ class Outliner {
   explicit Outliner(std::string source) : source_(std::move(source)) {}
 
   UrdfOutline run(const std::string& xml) {
+    if (const auto bad = first_invalid_utf8(xml)) {
+      char byte[8];
+      std::snprintf(byte, sizeof byte, "0x%02X", static_cast<unsigned char>(xml[*bad]));
+      fail(line_at(xml, *bad), std::string("not UTF-8 text: byte ") + byte + " at offset " +
+                                   std::to_string(*bad));
+    }
     if (const XmlDepth deep = find_nesting_beyond(xml, kMaxUrdfNesting); deep.exceeded) {
       fail(deep.line, "elements nested deeper than " + std::to_string(kMaxUrdfNesting) +
                           " levels; a URDF needs a handful");

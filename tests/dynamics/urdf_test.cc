@@ -188,6 +188,25 @@ TEST(UrdfBadInput, DeepNestingIsRefusedWithItsLine) {
   }
 }
 
+// A text ending inside a multi-byte character made TinyXML read past its end (found by the
+// fuzzer, ASan: heap-buffer-overflow in TiXmlBase::ReadName); text that is not UTF-8 is refused
+// before TinyXML sees it, naming the line and the byte.
+TEST(UrdfBadInput, TextThatIsNotUtf8IsRefusedWithItsLine) {
+  for (const std::string tail : {"\xda", "\xc3\x28/>", "\xed\xa0\x80/>", "\xc0\xaf/>"}) {
+    const std::string xml = "<robot name='r'>\n<link name='base'/>\n<link name='b" + tail;
+    try {
+      Model::from_urdf_string(xml);
+      ADD_FAILURE() << "no UrdfError";
+    } catch (const UrdfError& e) {
+      EXPECT_NE(std::string(e.what()).find("<urdf string> line 3: not UTF-8 text: byte 0x"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  // Names in other scripts are fine.
+  EXPECT_NO_THROW(Model::from_urdf_string("<robot name='Roboter ü 机器人'><link name='base'/></robot>"));
+}
+
 // Joints that close a loop (which urdfdom turns into a cycle of shared pointers it never frees,
 // found by the fuzzer) or give a link two parents are refused, naming the joint and its line.
 TEST(UrdfBadInput, JointsMustFormATree) {

@@ -3,36 +3,10 @@
 #include <cmath>
 #include <set>
 
+#include "kinograph/dynamics/utf8.h"
 #include "kinograph/planning/io/number_text.h"
 
 namespace kinograph::planning::yaml {
-
-namespace {
-
-// Whether `s` is well-formed UTF-8 (no overlong forms, surrogates or code points past U+10FFFF).
-bool is_utf8(const std::string& s) {
-  const auto* p = reinterpret_cast<const unsigned char*>(s.data());
-  const auto* end = p + s.size();
-  while (p < end) {
-    const unsigned c = *p++;
-    if (c < 0x80) continue;
-    // Continuation bytes that follow, and the smallest code point of that length.
-    const int more = (c & 0xE0) == 0xC0 ? 1 : (c & 0xF0) == 0xE0 ? 2 : (c & 0xF8) == 0xF0 ? 3 : 0;
-    if (more == 0) return false;
-    const unsigned least = more == 1 ? 0x80 : more == 2 ? 0x800 : 0x10000;
-    unsigned cp = c & (0x3F >> more);
-    if (end - p < more) return false;
-    for (int k = 0; k < more; ++k) {
-      if ((p[k] & 0xC0) != 0x80) return false;
-      cp = (cp << 6) | (p[k] & 0x3F);
-    }
-    p += more;
-    if (cp < least || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) return false;
-  }
-  return true;
-}
-
-}  // namespace
 
 int line_of(const YAML::Node& node) {
   if (!node.IsDefined()) return 0;
@@ -127,7 +101,7 @@ bool Reader::boolean(const YAML::Node& node, const std::string& key) const {
 std::string Reader::string(const YAML::Node& node, const std::string& key) const {
   if (!node.IsScalar() || node.Scalar().empty()) fail(node, key, "must be a non-empty string");
   // YAML text is UTF-8; other bytes would not survive a scene written back (plan files, changes).
-  if (!is_utf8(node.Scalar())) fail(node, key, "is not UTF-8 text");
+  if (dynamics::first_invalid_utf8(node.Scalar())) fail(node, key, "is not UTF-8 text");
   return node.Scalar();
 }
 
