@@ -476,6 +476,7 @@ nlohmann::json run_fleet(const std::string& cell_path, const FleetRunOptions& o)
     nlohmann::json arm;
     arm["name"] = a.name;
     arm["plans_received"] = a.plan_messages;
+    if (!a.last_failure.empty()) arm["last_failure"] = a.last_failure;
     if (a.heartbeat) {
       replans += std::max(0, a.heartbeat->num_plans - 1);
       neighbour_replans += a.heartbeat->num_neighbour_replans;

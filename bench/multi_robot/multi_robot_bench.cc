@@ -135,63 +135,71 @@ std::vector<double> objective_ratios(const nlohmann::json& group) {
 }
 
 std::string markdown(const nlohmann::json& results) {
+  // Times, objectives and messages of successes; replans and daemons' CPU of every problem run.
   std::string t =
-      "| N arms | problems | centralized success | CPU time median / max [s] | summed objective "
-      "median | distributed success | time to mutually clear median / max [s] | time to settled "
-      "median / max [s] | daemons' CPU median [s] | replans median / max | messages median / "
-      "max | summed objective median | objective distributed / centralized median |\n"
+      "| N arms | problems | centralized success | CPU median / max [s] | objective median | "
+      "distributed success | mutually clear median / max [s] | settled median / max [s] | "
+      "daemons' CPU median [s] | replans median / max | messages median / max | objective "
+      "median | objective distributed / centralized median |\n"
       "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& group : results["groups"]) {
-    t += fmt::format(
-        "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
-        group["robots"].get<int>(), group["problems"].size(), successes(group, "centralized"),
-        median_max(figures(group, "centralized", "cpu_s", false), 2),
-        cell(median(figures(group, "centralized", "objective", true)), 1, 1),
-        successes(group, "distributed"),
-        median_max(figures(group, "distributed", "time_to_mutually_clear_s", false), 2),
-        median_max(figures(group, "distributed", "time_to_settled_s", true), 2),
-        cell(median(figures(group, "distributed", "daemons_cpu_s", false)), 1, 2),
-        median_max(figures(group, "distributed", "replans", false), 0),
-        median_max(figures(group, "distributed", "messages", false), 0),
-        cell(median(figures(group, "distributed", "objective", true)), 1, 1),
-        cell(median(objective_ratios(group)), 1, 2));
+    t += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
+                     group["robots"].get<int>(), group["problems"].size(),
+                     successes(group, "centralized"),
+                     median_max(figures(group, "centralized", "cpu_s", false), 2),
+                     cell(median(figures(group, "centralized", "objective", true)), 1, 1),
+                     successes(group, "distributed"),
+                     median_max(figures(group, "distributed", "time_to_mutually_clear_s", true), 2),
+                     median_max(figures(group, "distributed", "time_to_settled_s", true), 2),
+                     cell(median(figures(group, "distributed", "daemons_cpu_s", false)), 1, 2),
+                     median_max(figures(group, "distributed", "replans", false), 0),
+                     median_max(figures(group, "distributed", "messages", true), 0),
+                     cell(median(figures(group, "distributed", "objective", true)), 1, 1),
+                     cell(median(objective_ratios(group)), 1, 2));
   }
   return t;
 }
 
-// Per arm count two curves against the problem's index, log10 of the time (the times of 2 and 8
-// arms differ by two orders of magnitude): the centralized planner's CPU time, and the fleet's
-// wall time until its plans were first clear of each other. A problem without the figure (not
-// run, or never clear) is left out of its curve.
-void write_plot(const nlohmann::json& results, const std::string& path) {
+// One panel: per arm count, the successes' log10 times (the times of 2 and 8 arms differ by two
+// orders of magnitude) sorted, as steps: the k-th fastest spans [k − 1, k], so a curve ends at
+// the number of successes.
+render::Image time_panel(const nlohmann::json& results, const std::string& side,
+                         const std::string& key, const std::string& title) {
   std::vector<render::PlotSeries> series;
   for (const auto& group : results["groups"]) {
-    const int n = group["robots"].get<int>();
-    for (const auto& [side, key, label] :
-         {std::tuple<std::string, std::string, std::string>{"centralized", "cpu_s",
-                                                            "centralized CPU"},
-          {"distributed", "time_to_mutually_clear_s", "distributed wall"}}) {
-      render::PlotSeries s;
-      s.label = fmt::format("N = {}, {}", n, label);
-      int k = 0;
-      for (const auto& p : group["problems"]) {
-        const auto& v = p[side];
-        if (!v.is_null() && v.contains(key) && v[key].is_number()) {
-          s.t.push_back(k);
-          s.values.push_back(Eigen::VectorXd::Constant(1, std::log10(v[key].get<double>())));
-        }
-        ++k;
+    std::vector<double> v = figures(group, side, key, true);
+    std::sort(v.begin(), v.end());
+    render::PlotSeries s;
+    s.label = fmt::format("N = {} arms", group["robots"].get<int>());
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      for (double x : {double(k), k + 1.0}) {
+        s.t.push_back(x);
+        s.values.push_back(Eigen::VectorXd::Constant(1, std::log10(v[k])));
       }
-      if (!s.t.empty()) series.push_back(std::move(s));
     }
+    if (!s.t.empty()) series.push_back(std::move(s));
   }
   render::TorquePlotOptions o;
-  o.title = "Centralized planner and fleet of daemons";
+  o.title = title;
   o.y_label = "log10 time [s]";
-  o.x_label = "problem";
-  o.joint_names = {"centralized: CPU time to plan; distributed: wall time until mutually clear"};
-  o.height = 480;
-  render::write_png(render::plot_torques(series, o), path);
+  o.x_label = "problems solved";
+  o.joint_names = {""};
+  o.height = 380;
+  return render::plot_torques(series, o);
+}
+
+// The centralized planner's CPU time over the fleet's wall time until its plans were first
+// clear of each other, one panel each.
+void write_plot(const nlohmann::json& results, const std::string& path) {
+  const render::Image top =
+      time_panel(results, "centralized", "cpu_s", "Centralized planner: CPU time, sorted");
+  const render::Image bottom =
+      time_panel(results, "distributed", "time_to_mutually_clear_s",
+                 "Fleet of daemons: wall time until mutually clear, sorted");
+  render::Image both(top.width, top.height + bottom.height);
+  std::copy(top.rgba.begin(), top.rgba.end(), both.rgba.begin());
+  std::copy(bottom.rgba.begin(), bottom.rgba.end(), both.rgba.begin() + top.rgba.size());
+  render::write_png(both, path);
 }
 
 // The table (stdout and --table) and the plot (--plot) of a results file.
