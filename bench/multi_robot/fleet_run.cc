@@ -477,6 +477,8 @@ nlohmann::json run_fleet(const std::string& cell_path, const FleetRunOptions& o)
     arm["name"] = a.name;
     arm["plans_received"] = a.plan_messages;
     if (!a.last_failure.empty()) arm["last_failure"] = a.last_failure;
+    // Its latest answer was a valid plan (a failed one leaves the daemon on its older plan).
+    arm["holds_valid_plan"] = a.current.has_value() && a.last_failure.empty();
     if (a.heartbeat) {
       replans += std::max(0, a.heartbeat->num_plans - 1);
       neighbour_replans += a.heartbeat->num_neighbour_replans;
