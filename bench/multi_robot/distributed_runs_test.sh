@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The distributed half of multi_robot_bench on the first two 2-arm cells of seed 1, over udpm in
-# a private network namespace: p00 fails (arm0's goal collides with arm1 held at its start, the
+# a private network namespace: p00 fails (arm0's goal collides with arm1 held at its start: blocked,
 # rule's refusal) and p01 settles; the centralized-only run of the same cells merges into one
 # row per problem; --distributed-timeout and --quiet are obeyed; without a multicast route the
 # bench refuses. Usage: distributed_runs_test.sh BUILD_DIR SOURCE_DIR. Exit 77 when not root.
@@ -20,7 +20,7 @@ run() { "$BENCH" --robots 2 --problems 2 --seed 1 --cells-dir "$WORK/cells" "$@"
 run --distributed-only --quiet 0.5 --out "$WORK/d.json" >"$WORK/d.out" 2>"$WORK/d.err" \
   || fail "distributed run: $(cat "$WORK/d.err")"
 cat "$WORK/d.err"
-grep -q "^iiwa2_p00 distributed: FAILED .*no plan for 0.5 s.*goal configuration is in collision" \
+grep -q "^iiwa2_p00 distributed: FAILED .*no plan for 0.5 s.*blocked by neighbour .arm1. \[ARM1\].*its goal" \
   "$WORK/d.err" || fail "p00 did not fail on its goal, given up after --quiet 0.5 s"
 grep -q "^iiwa2_p01 distributed: ok clear after [0-9.]* s, settled after [0-9.]* s, [1-9]" \
   "$WORK/d.err" || fail "p01 did not settle with a replan"

@@ -26,7 +26,16 @@ exec "$KGD" "$RIGHT" --prefix RIGHT --lcm-url "$URL" --status-period 0.2 --neigh
 HOST
 unshare -n bash "$WORK/host_b.sh" >"$WORK/right.log" 2>&1 &
 PID[right]=$!
-# Host A (here): the other end, and multicast through it instead of the loopback.
+# Host A (here): the other end, and multicast through it instead of the loopback. The pair's
+# far end goes to host B only once its process has its own namespace (before that it would
+# land here, and host B would wait for it in vain).
+own_ns=$(readlink /proc/self/ns/net)
+for _ in $(seq 600); do
+  ns=$(readlink "/proc/${PID[right]}/ns/net" 2>/dev/null) || fail "host B ended before it began"
+  [ "$ns" != "$own_ns" ] && break
+  sleep 0.05
+done
+[ "$ns" != "$own_ns" ] || fail "host B has no network namespace of its own after 30 s"
 ip link add veth_a type veth peer name veth_b
 ip link set veth_b netns "${PID[right]}"
 ip addr add 10.77.0.1/24 dev veth_a
