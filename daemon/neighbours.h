@@ -75,7 +75,8 @@ class Neighbours {
   /// True once since the last call when a neighbour's plan, priority or liveness changed (a
   /// silence found here counts). Worker thread.
   bool take_changed();
-  /// The rule's decision for this robot (priority key `own`) now.
+  /// The rule's decision for this robot (priority key `own`) now; a changed own goal forgets the
+  /// previous goal's refusal and retries.
   fleet::Decision decide(const fleet::PriorityKey& own, bool own_goal_changed);
   /// Appends every neighbour's bodies as the decision treats them, timed from `origin_utime`
   /// (the own plan's knot 0 on the common clock), to `obstacles`.
@@ -94,8 +95,10 @@ class Neighbours {
                                         std::string& why) const;
   /// True when neighbour `name`'s latest heartbeat reports a failure blocked by this robot.
   bool blocked_by_own(const std::string& name) const;
-  /// Records that a valid plan was made as `decision` says (what later changes are judged by).
-  void planned(const fleet::Decision& decision);
+  /// Records that the current goal was planned as `decision` says (what later changes are judged
+  /// by), valid or not; `refused_by` is the neighbour that blocked it when its answer is that
+  /// failure (tried again once that neighbour has a new plan), null otherwise.
+  void planned(const fleet::Decision& decision, const fleet::Blocker* refused_by);
   /// `text` with "obstacle <id>" of a neighbour body replaced by its name ("neighbour 'right'
   /// link 'iiwa_link_4'").
   std::string name_bodies(std::string text) const;
@@ -148,6 +151,8 @@ class Neighbours {
   bool changed_ = false;
   bool joined_ = false;
   fleet::PlannedAround planned_;
+  std::optional<fleet::BlockedGoal> blocked_goal_;  // the current goal's refusal by a neighbour
+  int goal_retries_ = 0;                            // retries of the current goal for blockers
   std::int64_t rebuilds_ = 0;              // obstacle sets made (moving bodies get new ids)
   std::map<int, std::string> body_names_;  // obstacle id -> name, of the last set made
 };

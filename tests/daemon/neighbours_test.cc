@@ -174,6 +174,49 @@ TEST_F(NeighboursTest, FindsTheNeighbourAPlanRunsIntoAndWhetherItIsBlockedByThis
   EXPECT_FALSE(neighbours_->blocked_by_own("right"));
 }
 
+TEST_F(NeighboursTest, TriesARefusedGoalAgainOncePerNewPlanOfItsBlockerFollowingIt) {
+  send("RIGHT_PLANNER_STATUS", heartbeat(3'000'000));  // later than left's goal: lower
+  const fleet::PriorityKey own{2'000'000, ""};
+  const planning::Plan at_right = fleet::standing_plan(spec_.start_q);
+  std::string why;
+  // Left's goal where right stands (its scene's start): refused, blocked by right held there.
+  fleet::Decision d = neighbours_->decide(own, true);
+  std::optional<fleet::Blocker> b =
+      neighbours_->blocker(d, 4'000'000, *spec_.model, at_right, 0.0, 0.0, why);
+  ASSERT_TRUE(b.has_value());
+  ASSERT_EQ(b->treatment, fleet::Treatment::kHeldAtState);
+  neighbours_->planned(d, &*b);
+  EXPECT_FALSE(neighbours_->decide(own, false).replan);
+
+  for (int k = 1; k <= fleet::kMaxBlockedRetries; ++k) {
+    send("RIGHT_PLAN", plan(k));  // right planned: try again, right moving along its plan
+    d = neighbours_->decide(own, false);
+    EXPECT_TRUE(d.replan) << d.reason;
+    EXPECT_TRUE(d.retry);
+    ASSERT_EQ(d.treatment[0], fleet::Treatment::kAlongPlan);
+    b = neighbours_->blocker(d, 4'000'000, *spec_.model, at_right, 0.0, 0.0, why);
+    ASSERT_TRUE(b.has_value());
+    EXPECT_EQ(b->treatment, fleet::Treatment::kAlongPlan);
+    EXPECT_NEAR(b->plan_end, 2.0, 1e-9);  // starts 1 s after knot 0, lasts 1 s: a wait's end
+    neighbours_->planned(d, &*b);  // refused again: only right's next plan is a retry
+    EXPECT_FALSE(neighbours_->decide(own, false).replan);
+    send("RIGHT_PLAN_CURRENT", plan(k));  // the same plan sent again is nothing new
+    EXPECT_FALSE(neighbours_->decide(own, false).replan);
+  }
+  send("RIGHT_PLAN", plan(10));  // the bound per goal
+  EXPECT_FALSE(neighbours_->decide(own, false).replan);
+
+  // A new goal starts the count again; a valid plan for it forgets the refusal.
+  d = neighbours_->decide({2'500'000, ""}, true);
+  neighbours_->planned(d, &*b);
+  send("RIGHT_PLAN", plan(11));
+  d = neighbours_->decide({2'500'000, ""}, false);
+  EXPECT_TRUE(d.retry);
+  neighbours_->planned(d, nullptr);
+  send("RIGHT_PLAN", plan(12));
+  EXPECT_FALSE(neighbours_->decide({2'500'000, ""}, false).replan);
+}
+
 TEST(NeighbourOption, NeedsANameAndAScene) {
   EXPECT_THROW(neighbour_from_option("right"), std::invalid_argument);
   EXPECT_THROW(neighbour_from_option("=x.yaml"), std::invalid_argument);
