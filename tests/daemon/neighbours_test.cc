@@ -92,7 +92,7 @@ TEST_F(NeighboursTest, FollowsAHigherNeighboursPlanAndNamesItsBodies) {
   EXPECT_EQ(neighbours_->name_bodies("link 'a' and obstacle " + std::to_string(id) + " overlap"),
             "link 'a' and neighbour 'right' link '" + spec_.model->collision.back().link_name +
                 "' overlap");
-  neighbours_->planned(d);
+  neighbours_->planned(d, nullptr);
   EXPECT_NE(neighbours_->summary().find("right: plan 7, followed"), std::string::npos)
       << neighbours_->summary();
   EXPECT_FALSE(neighbours_->decide({2'000'000, ""}, false).replan);
@@ -116,7 +116,7 @@ TEST_F(NeighboursTest, HoldsALowerNeighbourAtItsState) {
   neighbours_->add_obstacles(d, 4'000'000, obstacles);
   ASSERT_EQ(obstacles.size(), spec_.model->collision.size());
   for (const auto& o : obstacles) EXPECT_FALSE(o.is_moving());
-  neighbours_->planned(d);
+  neighbours_->planned(d, nullptr);
   send("RIGHT_PLAN", plan(8));  // it yields: no replan here
   EXPECT_FALSE(neighbours_->decide({2'000'000, ""}, false).replan);
 }
