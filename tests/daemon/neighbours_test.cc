@@ -1,6 +1,8 @@
 // A daemon's neighbours over an in-process memq:// LCM: a neighbour's valid plan is followed when
 // it has priority and held at its state otherwise, its bodies are named in reasons, a heartbeat
-// whose model or base does not fit its scene is reported, and failure answers change nothing.
+// whose model or base does not fit its scene is reported, failure answers change nothing, and
+// a goal refused by a neighbour is tried again once per new plan of it, following it, up to the
+// bound.
 #include "daemon/neighbours.h"
 
 #include <gtest/gtest.h>
@@ -198,7 +200,7 @@ TEST_F(NeighboursTest, TriesARefusedGoalAgainOncePerNewPlanOfItsBlockerFollowing
     ASSERT_TRUE(b.has_value());
     EXPECT_EQ(b->treatment, fleet::Treatment::kAlongPlan);
     EXPECT_NEAR(b->plan_end, 2.0, 1e-9);  // starts 1 s after knot 0, lasts 1 s: a wait's end
-    neighbours_->planned(d, &*b);  // refused again: only right's next plan is a retry
+    neighbours_->planned(d, &*b);         // refused again: only right's next plan is a retry
     EXPECT_FALSE(neighbours_->decide(own, false).replan);
     send("RIGHT_PLAN_CURRENT", plan(k));  // the same plan sent again is nothing new
     EXPECT_FALSE(neighbours_->decide(own, false).replan);

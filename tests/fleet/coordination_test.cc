@@ -1,7 +1,10 @@
 // The coordination rule: a strict priority order (goal time, then name); higher-priority
 // neighbours followed along their plans, the others held; a replan only for the own goal or a
 // higher-priority neighbour's change, once per change; and a fleet that settles within N − 1
-// rounds after every robot gets a new goal (random goal times and plan churn, seeded).
+// rounds after every robot gets a new goal (random goal times and plan churn, seeded); a goal
+// refused after or before a higher plan came; a blocked goal tried again once per new plan of its
+// blocker, whatever its priority, at most kMaxBlockedRetries times, and a fleet with refusals and
+// retries that still falls quiet.
 #include "kinograph/fleet/coordination.h"
 
 #include <gtest/gtest.h>
@@ -132,12 +135,10 @@ TEST(Coordinate, RetriesABlockedGoalOncePerNewPlanOfTheBlockerWhateverItsPriorit
   const Decision d = coordinate(own, n, tried, false, &blocked);
   EXPECT_TRUE(d.replan);
   EXPECT_TRUE(d.retry);
-  EXPECT_EQ(d.treatment,
-            (std::vector<Treatment>{Treatment::kAlongPlan, Treatment::kHeldAtState}));
+  EXPECT_EQ(d.treatment, (std::vector<Treatment>{Treatment::kAlongPlan, Treatment::kHeldAtState}));
   EXPECT_EQ(d.around.at("low"), 5);
   EXPECT_EQ(d.plans, (std::vector<std::optional<std::int64_t>>{5, 3}));
-  EXPECT_NE(d.reason.find("neighbour 'low', which blocked the goal, has plan 5"),
-            std::string::npos)
+  EXPECT_NE(d.reason.find("neighbour 'low', which blocked the goal, has plan 5"), std::string::npos)
       << d.reason;
 
   blocked = {"low", 5, 1};  // refused again around plan 5: only its next plan is a retry
