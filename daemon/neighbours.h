@@ -103,8 +103,9 @@ class Neighbours {
   /// link 'iiwa_link_4'").
   std::string name_bodies(std::string text) const;
   /// One entry per neighbour for the heartbeat, "; "-separated: how it is seen ("right: plan 3,
-  /// followed" when the current plan was made around its plan 3; "right: plan 3, held at its
-  /// state"; "silent for 4.1 s, held at its last state"; a model or base mismatch in brackets).
+  /// followed" when the latest plan, valid or refused, was made around its plan 3; "right: plan
+  /// 3, held at its state"; "silent for 4.1 s, held at its last state"; a model or base mismatch
+  /// in brackets).
   std::string summary() const;
   /// Number of neighbours.
   std::size_t size() const { return specs_.size(); }
