@@ -273,7 +273,7 @@ fleet::Decision Neighbours::decide(const fleet::PriorityKey& own, bool own_goal_
     goal_retries_ = 0;
   }
   if (blocked_goal_) blocked_goal_->retries = goal_retries_;
-  return fleet::coordinate(key, views, planned_, own_goal_changed,
+  return fleet::coordinate(key, views, tried_, own_goal_changed,
                            blocked_goal_ ? &*blocked_goal_ : nullptr);
 }
 
@@ -366,9 +366,11 @@ bool Neighbours::blocked_by_own(const std::string& name) const {
   return false;
 }
 
-void Neighbours::planned(const fleet::Decision& decision, const fleet::Blocker* refused_by) {
+void Neighbours::planned(const fleet::Decision& decision, bool valid,
+                         const fleet::Blocker* refused_by) {
   std::lock_guard lock(mutex_);
-  planned_ = decision.around;
+  tried_ = decision.around;
+  if (valid) planned_ = decision.around;
   if (decision.retry) ++goal_retries_;
   blocked_goal_.reset();
   if (!refused_by) return;

@@ -827,7 +827,7 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t
     }
   }
   // Failed attempts count too: a higher neighbour's change after a refusal is one to replan for.
-  if (around) neighbours_->planned(*around, valid || !refused_by ? nullptr : &*refused_by);
+  if (around) neighbours_->planned(*around, valid, valid || !refused_by ? nullptr : &*refused_by);
   // Knot 0 is the measured state, at its own time, or where the motion under way will be at
   // the take-over; without a state the plan starts when it is published (with neighbours, when
   // planning began: the time their bodies were placed on); after a wait, that much later, the
