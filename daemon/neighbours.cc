@@ -255,22 +255,26 @@ bool Neighbours::take_joined() {
 
 fleet::Decision Neighbours::decide(const fleet::PriorityKey& own, bool own_goal_changed) {
   std::vector<fleet::NeighbourView> views;
-  {
-    std::lock_guard lock(mutex_);
-    update_silence_locked();
-    for (std::size_t i = 0; i < specs_.size(); ++i) {
-      const Heard& h = heard_[i];
-      fleet::NeighbourView v;
-      v.name = specs_[i].name;
-      v.key = {h.goal_utime, specs_[i].channel_prefix};
-      if (h.plan) v.plan_id = h.generation;
-      v.silent = h.silent;
-      views.push_back(std::move(v));
-    }
+  std::lock_guard lock(mutex_);
+  update_silence_locked();
+  for (std::size_t i = 0; i < specs_.size(); ++i) {
+    const Heard& h = heard_[i];
+    fleet::NeighbourView v;
+    v.name = specs_[i].name;
+    v.key = {h.goal_utime, specs_[i].channel_prefix};
+    if (h.plan) v.plan_id = h.generation;
+    v.silent = h.silent;
+    views.push_back(std::move(v));
   }
   fleet::PriorityKey key = own;
   key.robot = own_prefix_;
-  return fleet::coordinate(key, views, planned_, own_goal_changed);
+  if (own_goal_changed) {
+    blocked_goal_.reset();
+    goal_retries_ = 0;
+  }
+  if (blocked_goal_) blocked_goal_->retries = goal_retries_;
+  return fleet::coordinate(key, views, tried_, own_goal_changed,
+                           blocked_goal_ ? &*blocked_goal_ : nullptr);
 }
 
 void Neighbours::add_obstacles(const fleet::Decision& decision, std::int64_t origin_utime,
@@ -362,9 +366,20 @@ bool Neighbours::blocked_by_own(const std::string& name) const {
   return false;
 }
 
-void Neighbours::planned(const fleet::Decision& decision) {
+void Neighbours::planned(const fleet::Decision& decision, bool valid,
+                         const fleet::Blocker* refused_by) {
   std::lock_guard lock(mutex_);
-  planned_ = decision.around;
+  tried_ = decision.around;
+  if (valid) planned_ = decision.around;
+  if (decision.retry) ++goal_retries_;
+  blocked_goal_.reset();
+  if (!refused_by) return;
+  for (std::size_t i = 0; i < specs_.size(); ++i) {
+    // The blocker's plan as the decision saw it: one that came while planning is a new one.
+    if (specs_[i].name == refused_by->name) {
+      blocked_goal_ = fleet::BlockedGoal{refused_by->name, decision.plans[i], goal_retries_};
+    }
+  }
 }
 
 std::string Neighbours::name_bodies(std::string text) const {

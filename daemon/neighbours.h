@@ -75,7 +75,8 @@ class Neighbours {
   /// True once since the last call when a neighbour's plan, priority or liveness changed (a
   /// silence found here counts). Worker thread.
   bool take_changed();
-  /// The rule's decision for this robot (priority key `own`) now.
+  /// The rule's decision for this robot (priority key `own`) now; a changed own goal forgets the
+  /// previous goal's refusal and retries.
   fleet::Decision decide(const fleet::PriorityKey& own, bool own_goal_changed);
   /// Appends every neighbour's bodies as the decision treats them, timed from `origin_utime`
   /// (the own plan's knot 0 on the common clock), to `obstacles`.
@@ -94,14 +95,18 @@ class Neighbours {
                                         std::string& why) const;
   /// True when neighbour `name`'s latest heartbeat reports a failure blocked by this robot.
   bool blocked_by_own(const std::string& name) const;
-  /// Records that a valid plan was made as `decision` says (what later changes are judged by).
-  void planned(const fleet::Decision& decision);
+  /// Records that the current goal was planned as `decision` says, `valid` or not: what later
+  /// changes are judged by, and for a valid plan what the heartbeat reports as followed.
+  /// `refused_by` is the neighbour that blocked it when its answer is that failure (tried again
+  /// once that neighbour has a new plan), null otherwise.
+  void planned(const fleet::Decision& decision, bool valid, const fleet::Blocker* refused_by);
   /// `text` with "obstacle <id>" of a neighbour body replaced by its name ("neighbour 'right'
   /// link 'iiwa_link_4'").
   std::string name_bodies(std::string text) const;
   /// One entry per neighbour for the heartbeat, "; "-separated: how it is seen ("right: plan 3,
-  /// followed" when the current plan was made around its plan 3; "right: plan 3, held at its
-  /// state"; "silent for 4.1 s, held at its last state"; a model or base mismatch in brackets).
+  /// followed" when the current valid plan was made around its plan 3; "right: plan 3, held at
+  /// its state"; "silent for 4.1 s, held at its last state"; a model or base mismatch in
+  /// brackets).
   std::string summary() const;
   /// Number of neighbours.
   std::size_t size() const { return specs_.size(); }
@@ -147,7 +152,10 @@ class Neighbours {
   std::vector<Heard> heard_;
   bool changed_ = false;
   bool joined_ = false;
-  fleet::PlannedAround planned_;
+  fleet::PlannedAround planned_;  // what the current valid plan was made around
+  fleet::PlannedAround tried_;    // what the latest plan, valid or not, was made around
+  std::optional<fleet::BlockedGoal> blocked_goal_;  // the current goal's refusal by a neighbour
+  int goal_retries_ = 0;                            // retries of the current goal for blockers
   std::int64_t rebuilds_ = 0;              // obstacle sets made (moving bodies get new ids)
   std::map<int, std::string> body_names_;  // obstacle id -> name, of the last set made
 };

@@ -731,6 +731,7 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t
   double wait_s = 0;       // the start held for a followed neighbour's plan to end
   std::string waited_for;  // that neighbour
   std::string refusal;     // the coordination rule's failure reason for a plan that ran into one
+  std::optional<fleet::Blocker> refused_by;  // the neighbour that plan ran into
   // Each wait goes to a later plan end, so there are at most as many as neighbours.
   for (std::size_t attempt = 0;; ++attempt) {
     if (neighbours_) {
@@ -784,6 +785,7 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t
       continue;
     }
     refusal = r.reason;
+    refused_by = blocker;
     if (r.kind == fleet::Remedy::Kind::kFail &&
         blocker->treatment == fleet::Treatment::kHeldAtState) {
       blocked_ = BlockedAnswer{goal.goal_id, blocker->name, blocker->prefix, why};
@@ -824,7 +826,8 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t
       valid_goal_utime_ = goal.utime;
     }
   }
-  if (around && valid) neighbours_->planned(*around);
+  // Failed attempts count too: a higher neighbour's change after a refusal is one to replan for.
+  if (around) neighbours_->planned(*around, valid, valid || !refused_by ? nullptr : &*refused_by);
   // Knot 0 is the measured state, at its own time, or where the motion under way will be at
   // the take-over; without a state the plan starts when it is published (with neighbours, when
   // planning began: the time their bodies were placed on); after a wait, that much later, the

@@ -16,7 +16,8 @@ std::string to_string(Treatment treatment) {
 }
 
 Decision coordinate(const PriorityKey& own, const std::vector<NeighbourView>& neighbours,
-                    const PlannedAround& planned, bool own_goal_changed) {
+                    const PlannedAround& planned, bool own_goal_changed,
+                    const BlockedGoal* blocked) {
   Decision d;
   d.treatment.reserve(neighbours.size());
   std::string trigger;
@@ -26,6 +27,7 @@ Decision coordinate(const PriorityKey& own, const std::vector<NeighbourView>& ne
     d.treatment.push_back(follow ? Treatment::kAlongPlan : Treatment::kHeldAtState);
     const std::int64_t entry = follow ? *n.plan_id : kHeldMark;
     d.around[n.name] = entry;
+    d.plans.push_back(n.plan_id);
     if (!higher || !trigger.empty()) continue;
     // Only a higher-priority neighbour's change moves this robot; a lower one yields to it.
     const auto was = planned.find(n.name);
@@ -46,6 +48,26 @@ Decision coordinate(const PriorityKey& own, const std::vector<NeighbourView>& ne
     d.reason = trigger;
   } else {
     d.reason = "no higher-priority neighbour changed";
+  }
+  if (own_goal_changed || !blocked || blocked->retries >= kMaxBlockedRetries) return d;
+  // The blocker moved: plan again with it moving along its new plan, once per plan of it.
+  for (std::size_t i = 0; i < neighbours.size(); ++i) {
+    const NeighbourView& n = neighbours[i];
+    if (n.name != blocked->neighbour || n.silent || !n.plan_id || n.plan_id == blocked->plan_id) {
+      continue;
+    }
+    // A replan that follows it already is no retry.
+    if (d.replan && d.treatment[i] == Treatment::kAlongPlan) break;
+    d.treatment[i] = Treatment::kAlongPlan;
+    d.around[n.name] = *n.plan_id;
+    d.retry = true;
+    const std::string retry = "neighbour '" + n.name + "', which blocked the goal, has plan " +
+                              std::to_string(*n.plan_id) + ": trying again along it (retry " +
+                              std::to_string(blocked->retries + 1) + " of " +
+                              std::to_string(kMaxBlockedRetries) + ")";
+    d.reason = d.replan ? d.reason + "; " + retry : retry;
+    d.replan = true;
+    break;
   }
   return d;
 }

@@ -44,21 +44,41 @@ using PlannedAround = std::map<std::string, std::int64_t>;
 /// The PlannedAround entry of a neighbour held at a state.
 inline constexpr std::int64_t kHeldMark = -1;
 
+/// A current goal whose latest answer is a failure because neighbour `neighbour` blocked it:
+/// what is needed to try it again once that neighbour moves (docs/multi_robot.md, "Trying again").
+struct BlockedGoal {
+  std::string neighbour;                ///< the blocker's name
+  std::optional<std::int64_t> plan_id;  ///< the blocker's plan when the goal was tried; none
+  int retries = 0;                      ///< retries of this goal so far
+};
+
+/// Retries of one goal for blocking neighbours' new plans: a small bound on top of the rule's.
+inline constexpr int kMaxBlockedRetries = 3;
+
 /// What the rule says now.
 struct Decision {
   std::vector<Treatment> treatment;  ///< one per neighbour, in the order given
   bool replan = false;               ///< plan again around the neighbours as treated
-  std::string reason;                ///< why (or why not), in the user's terms
+  /// The replan tries a blocked goal again: its blocker is followed along its new plan, whatever
+  /// its priority (counts against kMaxBlockedRetries).
+  bool retry = false;
+  std::string reason;    ///< why (or why not), in the user's terms
   PlannedAround around;  ///< what a plan made now is planned around (store it when replanning)
+  /// Each neighbour's plan id as seen now (none without one), in the order given.
+  std::vector<std::optional<std::int64_t>> plans;
 };
 
 /// The rule: higher-priority neighbours with a plan are followed along it, the others held at
 /// their state; replan when the own goal changed or a neighbour's entry in `around` would differ
 /// from what `planned` says for a higher-priority neighbour (a new plan, a neighbour gone silent
-/// or newly higher), never for a change of a lower-priority one. `planned` is empty before the
-/// first plan.
+/// or newly higher), never for a change of a lower-priority one. `planned` is what the latest
+/// attempt at the goal was planned around (valid or not), empty before the first. With
+/// `blocked` (the current goal refused because that neighbour blocked it) and the own goal
+/// unchanged: when the blocker, not silent, has a plan other than `blocked->plan_id` and fewer
+/// than kMaxBlockedRetries retries were made, replan once more with it followed along that plan.
 Decision coordinate(const PriorityKey& own, const std::vector<NeighbourView>& neighbours,
-                    const PlannedAround& planned, bool own_goal_changed);
+                    const PlannedAround& planned, bool own_goal_changed,
+                    const BlockedGoal* blocked = nullptr);
 
 /// When a yielding robot has no way around a neighbour: wait with its start held until the
 /// neighbour's plan ends, then move.

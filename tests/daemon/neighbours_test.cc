@@ -1,6 +1,8 @@
 // A daemon's neighbours over an in-process memq:// LCM: a neighbour's valid plan is followed when
 // it has priority and held at its state otherwise, its bodies are named in reasons, a heartbeat
-// whose model or base does not fit its scene is reported, and failure answers change nothing.
+// whose model or base does not fit its scene is reported, failure answers change nothing, and
+// a goal refused by a neighbour is tried again once per new plan of it, following it, up to the
+// bound.
 #include "daemon/neighbours.h"
 
 #include <gtest/gtest.h>
@@ -92,7 +94,7 @@ TEST_F(NeighboursTest, FollowsAHigherNeighboursPlanAndNamesItsBodies) {
   EXPECT_EQ(neighbours_->name_bodies("link 'a' and obstacle " + std::to_string(id) + " overlap"),
             "link 'a' and neighbour 'right' link '" + spec_.model->collision.back().link_name +
                 "' overlap");
-  neighbours_->planned(d);
+  neighbours_->planned(d, true, nullptr);
   EXPECT_NE(neighbours_->summary().find("right: plan 7, followed"), std::string::npos)
       << neighbours_->summary();
   EXPECT_FALSE(neighbours_->decide({2'000'000, ""}, false).replan);
@@ -116,7 +118,7 @@ TEST_F(NeighboursTest, HoldsALowerNeighbourAtItsState) {
   neighbours_->add_obstacles(d, 4'000'000, obstacles);
   ASSERT_EQ(obstacles.size(), spec_.model->collision.size());
   for (const auto& o : obstacles) EXPECT_FALSE(o.is_moving());
-  neighbours_->planned(d);
+  neighbours_->planned(d, true, nullptr);
   send("RIGHT_PLAN", plan(8));  // it yields: no replan here
   EXPECT_FALSE(neighbours_->decide({2'000'000, ""}, false).replan);
 }
@@ -172,6 +174,52 @@ TEST_F(NeighboursTest, FindsTheNeighbourAPlanRunsIntoAndWhetherItIsBlockedByThis
   blocked.message = fleet::blocked_reason("x", "OTHER", fleet::Treatment::kHeldAtState, 0, "x");
   send("RIGHT_PLANNER_STATUS", blocked);
   EXPECT_FALSE(neighbours_->blocked_by_own("right"));
+}
+
+TEST_F(NeighboursTest, TriesARefusedGoalAgainOncePerNewPlanOfItsBlockerFollowingIt) {
+  send("RIGHT_PLANNER_STATUS", heartbeat(3'000'000));  // later than left's goal: lower
+  const fleet::PriorityKey own{2'000'000, ""};
+  const planning::Plan at_right = fleet::standing_plan(spec_.start_q);
+  std::string why;
+  // Left's goal where right stands (its scene's start): refused, blocked by right held there.
+  fleet::Decision d = neighbours_->decide(own, true);
+  std::optional<fleet::Blocker> b =
+      neighbours_->blocker(d, 4'000'000, *spec_.model, at_right, 0.0, 0.0, why);
+  ASSERT_TRUE(b.has_value());
+  ASSERT_EQ(b->treatment, fleet::Treatment::kHeldAtState);
+  neighbours_->planned(d, false, &*b);
+  EXPECT_FALSE(neighbours_->decide(own, false).replan);
+
+  for (int k = 1; k <= fleet::kMaxBlockedRetries; ++k) {
+    send("RIGHT_PLAN", plan(k));  // right planned: try again, right moving along its plan
+    d = neighbours_->decide(own, false);
+    EXPECT_TRUE(d.replan) << d.reason;
+    EXPECT_TRUE(d.retry);
+    ASSERT_EQ(d.treatment[0], fleet::Treatment::kAlongPlan);
+    b = neighbours_->blocker(d, 4'000'000, *spec_.model, at_right, 0.0, 0.0, why);
+    ASSERT_TRUE(b.has_value());
+    EXPECT_EQ(b->treatment, fleet::Treatment::kAlongPlan);
+    EXPECT_NEAR(b->plan_end, 2.0, 1e-9);  // starts 1 s after knot 0, lasts 1 s: a wait's end
+    neighbours_->planned(d, false, &*b);  // refused again: only right's next plan is a retry
+    // The heartbeat reports what the valid plan, of which there is none, was made around.
+    EXPECT_EQ(neighbours_->summary(), "right: plan " + std::to_string(k) + ", held at its state");
+    EXPECT_FALSE(neighbours_->decide(own, false).replan);
+    send("RIGHT_PLAN_CURRENT", plan(k));  // the same plan sent again is nothing new
+    EXPECT_FALSE(neighbours_->decide(own, false).replan);
+  }
+  send("RIGHT_PLAN", plan(10));  // the bound per goal
+  EXPECT_FALSE(neighbours_->decide(own, false).replan);
+
+  // A new goal starts the count again; a valid plan for it forgets the refusal.
+  d = neighbours_->decide({2'500'000, ""}, true);
+  neighbours_->planned(d, false, &*b);
+  send("RIGHT_PLAN", plan(11));
+  d = neighbours_->decide({2'500'000, ""}, false);
+  EXPECT_TRUE(d.retry);
+  neighbours_->planned(d, true, nullptr);
+  EXPECT_EQ(neighbours_->summary(), "right: plan 11, followed");
+  send("RIGHT_PLAN", plan(12));
+  EXPECT_FALSE(neighbours_->decide({2'500'000, ""}, false).replan);
 }
 
 TEST(NeighbourOption, NeedsANameAndAScene) {

@@ -1,7 +1,10 @@
 // The coordination rule: a strict priority order (goal time, then name); higher-priority
 // neighbours followed along their plans, the others held; a replan only for the own goal or a
 // higher-priority neighbour's change, once per change; and a fleet that settles within N − 1
-// rounds after every robot gets a new goal (random goal times and plan churn, seeded).
+// rounds after every robot gets a new goal (random goal times and plan churn, seeded); a goal
+// refused after or before a higher plan came; a blocked goal tried again once per new plan of its
+// blocker, whatever its priority, at most kMaxBlockedRetries times, and a fleet with refusals and
+// retries that still falls quiet.
 #include "kinograph/fleet/coordination.h"
 
 #include <gtest/gtest.h>
@@ -102,6 +105,118 @@ TEST(Coordinate, FleetSettlesWithinNMinusOneRounds) {
       if (any) last_active = round;
     }
     EXPECT_LE(last_active, N - 1) << "trial " << trial << " with " << N << " robots";
+  }
+}
+
+TEST(Coordinate, ReplansAfterARefusalWhenAHigherNeighboursPlanArrives) {
+  const PriorityKey own{200, "mid"};
+  // Tried while the other had no goal (lowest, held at its state), and refused.
+  std::vector<NeighbourView> n = {{"high", {}, std::nullopt, false}};
+  const PlannedAround tried = coordinate(own, n, {}, true).around;
+  n[0] = {"high", {100, "high"}, 3, false};  // then its earlier goal's plan came
+  const Decision d = coordinate(own, n, tried, false);
+  EXPECT_TRUE(d.replan) << d.reason;
+  EXPECT_FALSE(d.retry);
+  EXPECT_EQ(d.treatment, std::vector<Treatment>{Treatment::kAlongPlan});
+}
+
+TEST(Coordinate, RetriesABlockedGoalOncePerNewPlanOfTheBlockerWhateverItsPriority) {
+  const PriorityKey own{100, "high"};
+  std::vector<NeighbourView> n = {{"low", {300, "low"}, std::nullopt, false},
+                                  {"other", {400, "other"}, 2, false}};
+  const PlannedAround tried = coordinate(own, n, {}, true).around;
+  BlockedGoal blocked{"low", std::nullopt, 0};
+  EXPECT_FALSE(coordinate(own, n, tried, false, &blocked).replan);  // the blocker did not move
+
+  n[1].plan_id = 3;  // another lower neighbour moved: not the blocker
+  EXPECT_FALSE(coordinate(own, n, tried, false, &blocked).replan);
+
+  n[0].plan_id = 5;  // the blocker planned: one retry, following it along its plan
+  const Decision d = coordinate(own, n, tried, false, &blocked);
+  EXPECT_TRUE(d.replan);
+  EXPECT_TRUE(d.retry);
+  EXPECT_EQ(d.treatment, (std::vector<Treatment>{Treatment::kAlongPlan, Treatment::kHeldAtState}));
+  EXPECT_EQ(d.around.at("low"), 5);
+  EXPECT_EQ(d.plans, (std::vector<std::optional<std::int64_t>>{5, 3}));
+  EXPECT_NE(d.reason.find("neighbour 'low', which blocked the goal, has plan 5"), std::string::npos)
+      << d.reason;
+
+  blocked = {"low", 5, 1};  // refused again around plan 5: only its next plan is a retry
+  EXPECT_FALSE(coordinate(own, n, d.around, false, &blocked).replan);
+  n[0].plan_id = 6;
+  EXPECT_TRUE(coordinate(own, n, d.around, false, &blocked).retry);
+
+  blocked.retries = kMaxBlockedRetries;  // the bound per goal
+  EXPECT_FALSE(coordinate(own, n, d.around, false, &blocked).replan);
+  blocked.retries = 1;
+  n[0].silent = true;  // a silent blocker is held at its last state: nothing new to follow
+  EXPECT_FALSE(coordinate(own, n, d.around, false, &blocked).replan);
+  n[0].silent = false;
+  const Decision goal = coordinate(own, n, d.around, true, &blocked);  // a new goal: no retry
+  EXPECT_FALSE(goal.retry);
+  EXPECT_EQ(goal.treatment[0], Treatment::kHeldAtState);
+}
+
+TEST(Coordinate, AHigherBlockersNewPlanIsTheRulesReplanNotARetry) {
+  const PriorityKey own{200, "mid"};
+  std::vector<NeighbourView> n = {{"high", {100, "high"}, 7, false}};
+  const PlannedAround tried = coordinate(own, n, {}, true).around;
+  const BlockedGoal blocked{"high", 7, 0};
+  n[0].plan_id = 8;
+  const Decision d = coordinate(own, n, tried, false, &blocked);
+  EXPECT_TRUE(d.replan);
+  EXPECT_FALSE(d.retry);
+}
+
+// The rounds above with refusals: a replan is refused, blocked by a random neighbour, with
+// probability 1/2, and retried under the rule. Each robot retries a goal at most
+// kMaxBlockedRetries times, and the fleet still falls quiet: a robot's plans are bounded by the
+// plans of those above it plus its retries.
+TEST(Coordinate, FleetWithRefusalsAndRetriesFallsQuiet) {
+  std::mt19937 rng(2027);
+  for (int trial = 0; trial < 200; ++trial) {
+    const int N = 2 + trial % 7;
+    std::uniform_int_distribution<int> goal_time(0, 3), other(0, N - 2);
+    std::bernoulli_distribution refused(0.5);
+    std::vector<PriorityKey> keys(N);
+    for (int i = 0; i < N; ++i) keys[i] = {goal_time(rng), "robot" + std::to_string(i)};
+    std::vector<std::optional<std::int64_t>> plan(N);
+    std::vector<PlannedAround> planned(N);
+    std::vector<std::optional<BlockedGoal>> blocked(N);
+    std::vector<int> retries(N, 0);
+    std::int64_t next_id = 0;
+    std::vector<bool> goal_changed(N, true);
+    const int rounds = 4 * N * (kMaxBlockedRetries + 2);
+    int last_active = -1;
+    for (int round = 0; round < rounds; ++round) {
+      std::vector<std::optional<std::int64_t>> published = plan;
+      bool any = false;
+      for (int i = 0; i < N; ++i) {
+        std::vector<NeighbourView> views;
+        for (int j = 0; j < N; ++j) {
+          if (j != i) views.push_back({keys[j].robot, keys[j], plan[j], false});
+        }
+        if (blocked[i]) blocked[i]->retries = retries[i];
+        const Decision d = coordinate(keys[i], views, planned[i], goal_changed[i],
+                                      blocked[i] ? &*blocked[i] : nullptr);
+        if (!d.replan) continue;
+        any = true;
+        planned[i] = d.around;
+        if (d.retry) ++retries[i];
+        blocked[i].reset();
+        if (refused(rng)) {
+          const int k = other(rng);
+          blocked[i] = BlockedGoal{views[k].name, d.plans[k], retries[i]};
+        } else {
+          published[i] = ++next_id;
+        }
+      }
+      std::fill(goal_changed.begin(), goal_changed.end(), false);
+      plan = published;
+      if (any) last_active = round;
+    }
+    EXPECT_LT(last_active, rounds - N) << "trial " << trial << " with " << N << " robots";
+    for (int i = 0; i < N; ++i) EXPECT_LE(retries[i], kMaxBlockedRetries);
   }
 }
 
