@@ -195,7 +195,7 @@ void write_plot(const nlohmann::json& results, const std::string& path) {
       time_panel(results, "centralized", "cpu_s", "Centralized planner: CPU time, sorted");
   const render::Image bottom =
       time_panel(results, "distributed", "time_to_mutually_clear_s",
-                 "Fleet of daemons: wall time until mutually clear, sorted");
+                 "Daemons: wall time to clear, sorted");
   render::Image both(top.width, top.height + bottom.height);
   std::copy(top.rgba.begin(), top.rgba.end(), both.rgba.begin());
   std::copy(bottom.rgba.begin(), bottom.rgba.end(), both.rgba.begin() + top.rgba.size());
