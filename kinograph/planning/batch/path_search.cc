@@ -15,7 +15,7 @@
 namespace kinograph::planning {
 namespace {
 
-constexpr double kStep = 0.6;         // rad (m): longest joint move of one tree extension
+constexpr double kStep = 1.0;         // rad (m): longest joint move of one tree extension
 constexpr double kResolution = 0.07;  // rad (m): largest joint change between checked states
 constexpr int kShortcutRounds = 40;   // random shortcut attempts on a found path
 
