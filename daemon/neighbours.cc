@@ -308,8 +308,9 @@ void Neighbours::add_obstacles(const fleet::Decision& decision, std::int64_t ori
 std::optional<Eigen::VectorXd> Neighbours::held_q_locked(std::size_t i) const {
   const Heard& h = heard_[i];
   if (h.state) return h.state;
-  // Heard a plan but no state: it comes to rest where the plan ends.
-  if (h.plan) return h.plan->q.row(h.plan->q.rows() - 1).transpose();
+  // Heard a plan but no state: it stands where its plans start (a daemon without states plans
+  // each one from there, so its next plan, around this robot's, starts there again).
+  if (h.plan) return h.plan->q.row(0).transpose();
   // Nothing heard yet: it stands at its scene's start.
   if (specs_[i].start_q.size() == specs_[i].model->nq()) return specs_[i].start_q;
   return std::nullopt;
@@ -319,7 +320,8 @@ std::optional<fleet::Blocker> Neighbours::blocker(const fleet::Decision& decisio
                                                   std::int64_t origin_utime,
                                                   const dynamics::Model& own_model,
                                                   const planning::Plan& plan, double wait_s,
-                                                  double contact, std::string& why) const {
+                                                  double contact, double from_s,
+                                                  std::string& why) const {
   if (plan.q.rows() < 2) return std::nullopt;
   // The own model as the fleet check wants it: shared, without owning it.
   const std::shared_ptr<const dynamics::Model> own(std::shared_ptr<void>(), &own_model);
@@ -349,7 +351,7 @@ std::optional<fleet::Blocker> Neighbours::blocker(const fleet::Decision& decisio
   std::optional<fleet::Blocker> found;
   double closest = contact;
   for (const auto& [other, b] : others) {
-    const fleet::JointClearance c = fleet::joint_clearance({self, other}, {.from = 0.0});
+    const fleet::JointClearance c = fleet::joint_clearance({self, other}, {.from = from_s});
     if (c.min_distance >= closest) continue;
     closest = c.min_distance;
     why = fleet::describe(c);
