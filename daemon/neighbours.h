@@ -95,8 +95,10 @@ class Neighbours {
                                         const dynamics::Model& own_model,
                                         const planning::Plan& plan, double wait_s, double contact,
                                         double from_s, std::string& why) const;
-  /// True when neighbour `name`'s latest heartbeat reports a failure blocked by this robot.
-  bool blocked_by_own(const std::string& name) const;
+  /// When neighbour `name`'s latest heartbeat reports a failure blocked by this robot, directly
+  /// or through neighbours each blocked by the next (a cycle): the channel prefixes from it on,
+  /// the last one blocked by this robot (fleet::Blocker::cycle); empty otherwise.
+  std::vector<std::string> blocking_cycle(const std::string& name) const;
   /// Records that the current goal was planned as `decision` says, `valid` or not: what later
   /// changes are judged by, and for a valid plan what the heartbeat reports as followed.
   /// `refused_by` is the neighbour that blocked it when its answer is that failure (tried again
@@ -132,6 +134,8 @@ class Neighbours {
   // Where neighbour i stands when held still: its latest state, else the first knot of its plan,
   // else its scene's start; none without any. Caller holds mutex_.
   std::optional<Eigen::VectorXd> held_q_locked(std::size_t i) const;
+  // blocking_cycle of neighbour i. Caller holds mutex_.
+  std::vector<std::string> blocking_cycle_locked(std::size_t i) const;
   // Marks neighbours silent after the timeout; true when one became silent. Caller holds mutex_.
   bool update_silence_locked();
   void notify();

@@ -959,12 +959,11 @@ void PlannerNode::replan_for_neighbours() {
 }
 
 void PlannerNode::answer_deadlock() {
-  if (!blocked_ || !current_goal_ || blocked_->goal_id != current_goal_->goal_id ||
-      !neighbours_->blocked_by_own(blocked_->name)) {
-    return;
-  }
+  if (!blocked_ || !current_goal_ || blocked_->goal_id != current_goal_->goal_id) return;
+  const std::vector<std::string> cycle = neighbours_->blocking_cycle(blocked_->name);
+  if (cycle.empty()) return;
   const std::string reason = fleet::deadlock_reason(identity_.channel_prefix, blocked_->name,
-                                                    blocked_->prefix, blocked_->why);
+                                                    blocked_->prefix, blocked_->why, cycle);
   spdlog::warn("goal {}: {}", blocked_->goal_id, reason);
   {
     std::lock_guard lock(mutex_);

@@ -175,7 +175,7 @@ TEST_F(NeighboursTest, FindsTheNeighbourAPlanRunsIntoAndWhetherItIsBlockedByThis
   blocked.message = fleet::blocked_reason("left", "LEFT", fleet::Treatment::kHeldAtState, 0, "x");
   send("RIGHT_PLANNER_STATUS", blocked);
   EXPECT_TRUE(neighbours_->take_changed());
-  EXPECT_TRUE(neighbours_->blocked_by_own("right"));
+  EXPECT_EQ(neighbours_->blocking_cycle("right"), std::vector<std::string>{"RIGHT"});
   EXPECT_TRUE(
       neighbours_
           ->blocker(d, 4'000'000, *spec_.model, fleet::standing_plan(spec_.start_q), 0.0, 0.0, 0.0, why)
@@ -183,7 +183,7 @@ TEST_F(NeighboursTest, FindsTheNeighbourAPlanRunsIntoAndWhetherItIsBlockedByThis
   // Blocked by another robot: not by this one.
   blocked.message = fleet::blocked_reason("x", "OTHER", fleet::Treatment::kHeldAtState, 0, "x");
   send("RIGHT_PLANNER_STATUS", blocked);
-  EXPECT_FALSE(neighbours_->blocked_by_own("right"));
+  EXPECT_TRUE(neighbours_->blocking_cycle("right").empty());
 }
 
 // A configuration of right that reaches into left standing at its scene's start (right's own
@@ -307,6 +307,43 @@ TEST_F(NeighboursTest, TriesARefusedGoalAgainOncePerNewPlanOfItsBlockerFollowing
   EXPECT_EQ(neighbours_->summary(), "right: plan 11, followed");
   send("RIGHT_PLAN", plan(12));
   EXPECT_FALSE(neighbours_->decide({2'500'000, ""}, false).replan);
+}
+
+// A blocked by B, B by C, C by A: each where the next must go. A finds the cycle from the
+// heartbeats' reasons, and only once it closes through A.
+TEST_F(NeighboursTest, FindsADeadlockOfACycleOfRobotsEachBlockedByTheNext) {
+  NeighbourSpec b = spec_, c = spec_;
+  b.name = "b";
+  b.channel_prefix = "B";
+  c.name = "c";
+  c.channel_prefix = "C";
+  Neighbours three({b, c}, "A", NeighboursOptions{});
+  three.subscribe(lcm_, [] {});
+  planner_status_t hb = heartbeat(3'000'000);  // both later than A's goal: held at their states
+  const auto blocked_by = [&](const std::string& channel, const std::string& name,
+                              const std::string& prefix) {
+    hb.message = fleet::blocked_reason(name, prefix, fleet::Treatment::kHeldAtState, 0, "x");
+    send(channel, hb);
+  };
+  blocked_by("B_PLANNER_STATUS", "c", "C");
+  EXPECT_TRUE(three.blocking_cycle("b").empty());  // C is not blocked
+  blocked_by("C_PLANNER_STATUS", "b", "B");
+  EXPECT_TRUE(three.blocking_cycle("b").empty());  // a cycle of B and C only
+  three.take_changed();
+  blocked_by("C_PLANNER_STATUS", "a", "A");
+  EXPECT_TRUE(three.take_changed());  // it may close a cycle: look again
+  EXPECT_EQ(three.blocking_cycle("b"), (std::vector<std::string>{"B", "C"}));
+  EXPECT_EQ(three.blocking_cycle("c"), std::vector<std::string>{"C"});
+
+  const fleet::Decision d = three.decide({2'000'000, ""}, true);
+  std::string why;
+  const std::optional<fleet::Blocker> found = three.blocker(
+      d, 4'000'000, *spec_.model, fleet::standing_plan(spec_.start_q), 0.0, 0.0, 0.0, why);
+  ASSERT_TRUE(found.has_value());
+  EXPECT_TRUE(found->blocked_by_own);
+  const fleet::Remedy r = fleet::remedy("A", *found, 0.0, 3.0, "", why);
+  EXPECT_EQ(r.kind, fleet::Remedy::Kind::kDeadlock) << r.reason;
+  three.unsubscribe(lcm_);
 }
 
 TEST(NeighbourOption, NeedsANameAndAScene) {
