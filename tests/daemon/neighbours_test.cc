@@ -206,14 +206,23 @@ Eigen::VectorXd reaching_into(const NeighbourSpec& right, const planning::Scene&
   return {};
 }
 
+// Left's scene and a configuration of right reaching into left standing at its start.
+class ReachingIntoLeftTest : public NeighboursTest {
+ protected:
+  void SetUp() override {
+    NeighboursTest::SetUp();
+    into = reaching_into(spec_, left);
+    ASSERT_EQ(into.size(), spec_.model->nq()) << "no configuration of right reaches into left";
+  }
+  const planning::Scene left = planning::load_scene(std::string(KINOGRAPH_SOURCE_DIR) +
+                                                    "/robots/scenes/iiwa_pair_left.yaml");
+  Eigen::VectorXd into;
+};
+
 // The blind spot of a fleet whose daemons have no states (the bench's): each plan starts at the
 // scene's start, so the robot has stood there until its plan starts. A higher neighbour's plan
 // that swept through it before then is not followed, though from knot 0 on the two keep clear.
-TEST_F(NeighboursTest, ChecksAPlanFromNoStateAgainstWhatAFollowedPlanDidBeforeIt) {
-  const planning::Scene left = planning::load_scene(std::string(KINOGRAPH_SOURCE_DIR) +
-                                                    "/robots/scenes/iiwa_pair_left.yaml");
-  const Eigen::VectorXd into = reaching_into(spec_, left);
-  ASSERT_EQ(into.size(), spec_.model->nq()) << "no configuration of right reaches into left";
+TEST_F(ReachingIntoLeftTest, ChecksAPlanFromNoStateAgainstWhatAFollowedPlanDidBeforeIt) {
   send("RIGHT_PLANNER_STATUS", heartbeat(1'000'000));  // earlier than left's goal: higher
   send("RIGHT_PLAN", moving_plan(3, into, spec_.start_q));  // 5–6 s: through left, then home
   const fleet::Decision d = neighbours_->decide({2'000'000, ""}, true);
@@ -237,11 +246,7 @@ TEST_F(NeighboursTest, ChecksAPlanFromNoStateAgainstWhatAFollowedPlanDidBeforeIt
 
 // A lower neighbour heard publishing plans but no states is held where its plans start, where it
 // stands until its next plan (around this robot's) starts, not where its latest plan ends.
-TEST_F(NeighboursTest, HoldsALowerNeighbourWithoutStatesWhereItsPlansStart) {
-  const planning::Scene left = planning::load_scene(std::string(KINOGRAPH_SOURCE_DIR) +
-                                                    "/robots/scenes/iiwa_pair_left.yaml");
-  const Eigen::VectorXd into = reaching_into(spec_, left);
-  ASSERT_EQ(into.size(), spec_.model->nq()) << "no configuration of right reaches into left";
+TEST_F(ReachingIntoLeftTest, HoldsALowerNeighbourWithoutStatesWhereItsPlansStart) {
   send("RIGHT_PLANNER_STATUS", heartbeat(3'000'000));  // later than left's goal: lower
   send("RIGHT_PLAN", moving_plan(3, spec_.start_q, into));  // ends reaching into left
   const fleet::Decision d = neighbours_->decide({2'000'000, ""}, true);
