@@ -213,9 +213,10 @@ void Neighbours::on_heartbeat(std::size_t i, const lcm::ReceiveBuffer* rbuf) {
     if (!h.last_heard || h.silent) joined_ = true;
     h.last_heard = std::chrono::steady_clock::now();
     const std::string blocked_by = fleet::blocker_prefix(msg.message);
-    // A neighbour newly blocked by this robot may make this robot's failure a deadlock.
+    // A neighbour newly blocked, by this robot or by one that may be in a cycle through it, may
+    // make this robot's failure a deadlock.
     changed = h.silent || h.goal_utime != goal_utime ||
-              (blocked_by != h.blocked_by && blocked_by == own_prefix_);
+              (blocked_by != h.blocked_by && !blocked_by.empty());
     h.silent = false;
     h.goal_utime = goal_utime;
     h.blocked_by = blocked_by;
@@ -308,8 +309,9 @@ void Neighbours::add_obstacles(const fleet::Decision& decision, std::int64_t ori
 std::optional<Eigen::VectorXd> Neighbours::held_q_locked(std::size_t i) const {
   const Heard& h = heard_[i];
   if (h.state) return h.state;
-  // Heard a plan but no state: it comes to rest where the plan ends.
-  if (h.plan) return h.plan->q.row(h.plan->q.rows() - 1).transpose();
+  // Heard a plan but no state: it stands where its plans start (a daemon without states plans
+  // each one from there, so its next plan, around this robot's, starts there again).
+  if (h.plan) return h.plan->q.row(0).transpose();
   // Nothing heard yet: it stands at its scene's start.
   if (specs_[i].start_q.size() == specs_[i].model->nq()) return specs_[i].start_q;
   return std::nullopt;
@@ -319,7 +321,8 @@ std::optional<fleet::Blocker> Neighbours::blocker(const fleet::Decision& decisio
                                                   std::int64_t origin_utime,
                                                   const dynamics::Model& own_model,
                                                   const planning::Plan& plan, double wait_s,
-                                                  double contact, std::string& why) const {
+                                                  double contact, double from_s,
+                                                  std::string& why) const {
   if (plan.q.rows() < 2) return std::nullopt;
   // The own model as the fleet check wants it: shared, without owning it.
   const std::shared_ptr<const dynamics::Model> own(std::shared_ptr<void>(), &own_model);
@@ -333,7 +336,8 @@ std::optional<fleet::Blocker> Neighbours::blocker(const fleet::Decision& decisio
       const Heard& h = heard_[i];
       fleet::RobotPlan other{specs_[i].name, specs_[i].model, {}, 0.0};
       fleet::Blocker b{specs_[i].name, specs_[i].channel_prefix, decision.treatment[i], 0.0,
-                       h.blocked_by == own_prefix_};
+                       false, blocking_cycle_locked(i)};
+      b.blocked_by_own = !b.cycle.empty();
       if (decision.treatment[i] == fleet::Treatment::kAlongPlan && h.plan) {
         other.plan = *h.plan;
         other.offset = fleet::clock_offset(h.plan_start_utime, origin_utime);
@@ -349,7 +353,7 @@ std::optional<fleet::Blocker> Neighbours::blocker(const fleet::Decision& decisio
   std::optional<fleet::Blocker> found;
   double closest = contact;
   for (const auto& [other, b] : others) {
-    const fleet::JointClearance c = fleet::joint_clearance({self, other}, {.from = 0.0});
+    const fleet::JointClearance c = fleet::joint_clearance({self, other}, {.from = from_s});
     if (c.min_distance >= closest) continue;
     closest = c.min_distance;
     why = fleet::describe(c);
@@ -358,12 +362,30 @@ std::optional<fleet::Blocker> Neighbours::blocker(const fleet::Decision& decisio
   return found;
 }
 
-bool Neighbours::blocked_by_own(const std::string& name) const {
+std::vector<std::string> Neighbours::blocking_cycle(const std::string& name) const {
   std::lock_guard lock(mutex_);
   for (std::size_t i = 0; i < specs_.size(); ++i) {
-    if (specs_[i].name == name) return heard_[i].blocked_by == own_prefix_;
+    if (specs_[i].name == name) return blocking_cycle_locked(i);
   }
-  return false;
+  return {};
+}
+
+std::vector<std::string> Neighbours::blocking_cycle_locked(std::size_t i) const {
+  // Each neighbour's heartbeat names its blocker; follow them until this robot, someone unknown
+  // or not blocked, or a robot seen before (a cycle without this robot: not its deadlock).
+  std::vector<std::string> chain;
+  std::vector<bool> seen(specs_.size(), false);
+  for (std::size_t at = i;;) {
+    if (seen[at]) return {};
+    seen[at] = true;
+    chain.push_back(specs_[at].channel_prefix);
+    const std::string& next = heard_[at].blocked_by;
+    if (next == own_prefix_) return chain;
+    std::size_t n = 0;
+    while (n < specs_.size() && specs_[n].channel_prefix != next) ++n;
+    if (next.empty() || n == specs_.size()) return {};
+    at = n;
+  }
 }
 
 void Neighbours::planned(const fleet::Decision& decision, bool valid,

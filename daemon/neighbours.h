@@ -87,14 +87,18 @@ class Neighbours {
   bool take_joined();
   /// The neighbour, as `decision` treats it, that `plan` (own clock: knot 0 at `origin_utime`
   /// plus `wait_s`, standing at its first knot before and its last after) comes within `contact`
-  /// metres of, from `origin_utime` on: the closest such one, with `why` saying where; none
-  /// when it keeps clear of all. Worker thread.
+  /// metres of, from own-clock time `from_s` on: the closest such one, with `why` saying where;
+  /// none when it keeps clear of all. `from_s` is 0 for a plan from a measured state (what came
+  /// before is another motion) and −∞ for one from no state, whose robot has stood at its first
+  /// knot all along, so a followed plan that passed through it before counts. Worker thread.
   std::optional<fleet::Blocker> blocker(const fleet::Decision& decision, std::int64_t origin_utime,
                                         const dynamics::Model& own_model,
                                         const planning::Plan& plan, double wait_s, double contact,
-                                        std::string& why) const;
-  /// True when neighbour `name`'s latest heartbeat reports a failure blocked by this robot.
-  bool blocked_by_own(const std::string& name) const;
+                                        double from_s, std::string& why) const;
+  /// When neighbour `name`'s latest heartbeat reports a failure blocked by this robot, directly
+  /// or through neighbours each blocked by the next (a cycle): the channel prefixes from it on,
+  /// the last one blocked by this robot (fleet::Blocker::cycle); empty otherwise.
+  std::vector<std::string> blocking_cycle(const std::string& name) const;
   /// Records that the current goal was planned as `decision` says, `valid` or not: what later
   /// changes are judged by, and for a valid plan what the heartbeat reports as followed.
   /// `refused_by` is the neighbour that blocked it when its answer is that failure (tried again
@@ -127,9 +131,11 @@ class Neighbours {
   void on_plan(std::size_t i, const lcm::ReceiveBuffer* rbuf);
   void on_state(std::size_t i, const lcm::ReceiveBuffer* rbuf);
   void on_heartbeat(std::size_t i, const lcm::ReceiveBuffer* rbuf);
-  // Where neighbour i stands when held still: its latest state, else the last knot of its plan,
+  // Where neighbour i stands when held still: its latest state, else the first knot of its plan,
   // else its scene's start; none without any. Caller holds mutex_.
   std::optional<Eigen::VectorXd> held_q_locked(std::size_t i) const;
+  // blocking_cycle of neighbour i. Caller holds mutex_.
+  std::vector<std::string> blocking_cycle_locked(std::size_t i) const;
   // Marks neighbours silent after the timeout; true when one became silent. Caller holds mutex_.
   bool update_silence_locked();
   void notify();

@@ -11,6 +11,7 @@
 #include <fstream>
 #include <functional>
 #include <lcm/lcm-cpp.hpp>
+#include <limits>
 #include <stdexcept>
 #include <string_view>
 #include <thread>
@@ -724,6 +725,10 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t
   }
   const std::size_t own_obstacles = problem.obstacles.size();
   blocked_.reset();
+  // A plan from a measured state says where the robot is from then on; one from no state says it
+  // has stood at its start all along, so neighbours' motion before knot 0 is checked too.
+  const double checked_from =
+      state_utime ? 0.0 : -std::numeric_limits<double>::infinity();
 
   planning::Plan plan;
   bool threw = false;
@@ -764,7 +769,7 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t
     const std::optional<fleet::Blocker> blocker = neighbours_->blocker(
         *around, *origin, *problem.model,
         refused ? fleet::standing_plan(problem.goal.q, problem.horizon) : plan, wait_s,
-        plan.success() ? 0.0 : problem.objectives.collision_epsilon, why);
+        plan.success() ? 0.0 : problem.objectives.collision_epsilon, checked_from, why);
     if (refused) {
       why = "its goal: " + why;
     } else if (!plan.success() && !plan.stats.reason.empty()) {
@@ -954,12 +959,11 @@ void PlannerNode::replan_for_neighbours() {
 }
 
 void PlannerNode::answer_deadlock() {
-  if (!blocked_ || !current_goal_ || blocked_->goal_id != current_goal_->goal_id ||
-      !neighbours_->blocked_by_own(blocked_->name)) {
-    return;
-  }
+  if (!blocked_ || !current_goal_ || blocked_->goal_id != current_goal_->goal_id) return;
+  const std::vector<std::string> cycle = neighbours_->blocking_cycle(blocked_->name);
+  if (cycle.empty()) return;
   const std::string reason = fleet::deadlock_reason(identity_.channel_prefix, blocked_->name,
-                                                    blocked_->prefix, blocked_->why);
+                                                    blocked_->prefix, blocked_->why, cycle);
   spdlog::warn("goal {}: {}", blocked_->goal_id, reason);
   {
     std::lock_guard lock(mutex_);

@@ -2,9 +2,10 @@
 # The distributed half of multi_robot_bench on the first two 2-arm cells of seed 1, over udpm in
 # a private network namespace: p00 settles after arm0, refused at first (its goal is where arm1
 # stands), tries again along arm1's plan, and p01 settles; the centralized-only run of the same
-# cells merges into one row per problem; --distributed-timeout is obeyed; without a multicast
-# route the bench refuses. Usage: distributed_runs_test.sh BUILD_DIR SOURCE_DIR. Exit 77 when
-# not root.
+# cells merges into one row per problem; --distributed-timeout is obeyed; with daemons that do
+# not wait (--no-neighbour-wait, through --kinographd), p00's retry is refused too and the fleet,
+# idle, is given up after --quiet; without a multicast route the bench refuses.
+# Usage: distributed_runs_test.sh BUILD_DIR SOURCE_DIR. Exit 77 when not root.
 set -euo pipefail
 BUILD=$1
 SRC=$2
@@ -40,6 +41,15 @@ run --distributed-only --distributed-timeout 0.01 --out "$WORK/t.json" >/dev/nul
   2>"$WORK/t.err" || fail "timeout run: $(cat "$WORK/t.err")"
 [ "$(grep -c "distributed: FAILED .*not settled within 0.01 s" "$WORK/t.err")" = 2 ] \
   || fail "--distributed-timeout 0.01 was not obeyed: $(cat "$WORK/t.err")"
+
+# Arm0's goal is where arm1 moves: without waiting its retry is refused, and nobody plans again.
+printf '#!/bin/sh\nexec "%s" --no-neighbour-wait "$@"\n' "$BUILD/daemon/kinographd" >"$WORK/nowait"
+chmod +x "$WORK/nowait"
+"$BENCH" --robots 2 --problems 1 --seed 1 --cells-dir "$WORK/cells" --distributed-only \
+  --kinographd "$WORK/nowait" --quiet 0.5 --distributed-timeout 120 --out "$WORK/q.json" \
+  >/dev/null 2>"$WORK/q.err" || fail "quiet run: $(cat "$WORK/q.err")"
+grep -q "^iiwa2_p00 distributed: FAILED .*no daemon planning and no plan for 0.5 s, not settled: .*not waiting: waiting is off" \
+  "$WORK/q.err" || fail "the idle fleet was not given up after --quiet 0.5 s: $(cat "$WORK/q.err")"
 
 if unshare -n "$BENCH" --robots 2 --problems 1 --out "$WORK/n.json" >/dev/null \
   2>"$WORK/n.err"; then

@@ -96,7 +96,7 @@ Remedy remedy(const std::string& own, const Blocker& blocker, double own_start, 
   }
   if (blocker.blocked_by_own) {
     r.kind = Remedy::Kind::kDeadlock;
-    r.reason = deadlock_reason(own, blocker.name, blocker.prefix, why);
+    r.reason = deadlock_reason(own, blocker.name, blocker.prefix, why, blocker.cycle);
     return r;
   }
   r.reason = blocked_reason(blocker.name, blocker.prefix, blocker.treatment, 0.0, why);
@@ -137,9 +137,16 @@ std::string blocked_reason(const std::string& name, const std::string& prefix, T
 }
 
 std::string deadlock_reason(const std::string& own, const std::string& name,
-                            const std::string& prefix, const std::string& why) {
-  return "deadlock with " + tagged(name, prefix) + ": robots '" + own + "' and '" + prefix +
-         "' each stand where the other must go, and neither can move first: " + why;
+                            const std::string& prefix, const std::string& why,
+                            const std::vector<std::string>& cycle) {
+  if (cycle.size() <= 1) {
+    return "deadlock with " + tagged(name, prefix) + ": robots '" + own + "' and '" + prefix +
+           "' each stand where the other must go, and neither can move first: " + why;
+  }
+  std::string robots = "'" + own + "'";
+  for (const std::string& r : cycle) robots += " -> '" + r + "'";
+  return "deadlock with " + tagged(name, prefix) + ": robots " + robots + " -> '" + own +
+         "' each stand where the next must go, and none can move first: " + why;
 }
 
 std::string blocker_prefix(const std::string& reason) {

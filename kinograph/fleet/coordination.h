@@ -98,8 +98,12 @@ struct Blocker {
   std::string prefix;  ///< its channel prefix: its name in the priority order and in reasons
   Treatment treatment = Treatment::kHeldAtState;
   double plan_end = 0;  ///< kAlongPlan: own-clock time (s) at which its followed plan ends
-  /// Its own latest answer is a failure blocked by this robot (blocker_prefix of its reason).
+  /// Its own latest answer is a failure blocked by this robot (blocker_prefix of its reason),
+  /// directly or through neighbours each blocked by the next.
   bool blocked_by_own = false;
+  /// With blocked_by_own: the channel prefixes from it on, each robot blocked by the next and
+  /// the last by this robot ({"B"} when it is blocked by this robot itself).
+  std::vector<std::string> cycle;
 };
 
 /// What a robot whose plan ran into a neighbour does.
@@ -134,9 +138,12 @@ std::string blocked_reason(const std::string& name, const std::string& prefix, T
                            double waited, const std::string& why);
 
 /// The FAILED reason of a deadlock of robot `own` (its prefix) and neighbour `name` (`prefix`):
-/// each is held where the other must go, so neither can move first.
+/// each is held where the other must go, so neither can move first. With `cycle` (Blocker::cycle)
+/// of more than one robot, the cycle own → B → C → own is named instead: each where the next
+/// must go.
 std::string deadlock_reason(const std::string& own, const std::string& name,
-                            const std::string& prefix, const std::string& why);
+                            const std::string& prefix, const std::string& why,
+                            const std::vector<std::string>& cycle = {});
 
 /// The channel prefix of the neighbour that blocked a plan, as blocked_reason or deadlock_reason
 /// wrote it into `reason` (a failure answer, a heartbeat's message); empty when none.

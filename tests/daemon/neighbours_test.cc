@@ -7,10 +7,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <limits>
 #include <lcm/lcm-cpp.hpp>
 
 #include "kinograph/fleet/joint_clearance.h"
 #include "kinograph/fleet/model_id.h"
+#include "kinograph/fleet/neighbour_bodies.h"
 #include "kinograph/lcm/message_convert.h"
 #include "kinograph/plan_t.hpp"
 #include "kinograph/planner_status_t.hpp"
@@ -52,12 +55,19 @@ class NeighboursTest : public ::testing::Test {
     return m;
   }
   plan_t plan(int64_t id, int8_t status = plan_t::SUCCESS) const {
+    return moving_plan(id, spec_.start_q, spec_.start_q, status);
+  }
+  // Right's plan of 1 s from `from` to `to` (at `from` for its first 0.3 s, at `to` for its last),
+  // starting 5 s into the common clock.
+  plan_t moving_plan(int64_t id, const Eigen::VectorXd& from, const Eigen::VectorXd& to,
+                     int8_t status = plan_t::SUCCESS) const {
     planning::Plan p;
     const int n = spec_.model->nq(), knots = 10;
     p.q = p.qd = p.qdd = p.tau = Eigen::MatrixXd::Zero(knots + 1, n);
     for (int k = 0; k <= knots; ++k) {
       p.t.push_back(0.1 * k);
-      p.q.row(k) = spec_.start_q.transpose();
+      const double s = std::clamp((k - 3) / 4.0, 0.0, 1.0);
+      p.q.row(k) = ((1 - s) * from + s * to).transpose();
     }
     p.validation.valid = true;
     messages::PlanTime time;
@@ -143,7 +153,7 @@ TEST_F(NeighboursTest, FindsTheNeighbourAPlanRunsIntoAndWhetherItIsBlockedByThis
   // Standing where right stands (its scene's start, no state heard): right blocks it.
   std::string why;
   const std::optional<fleet::Blocker> b = neighbours_->blocker(
-      d, 4'000'000, *spec_.model, fleet::standing_plan(spec_.start_q), 0.0, 0.0, why);
+      d, 4'000'000, *spec_.model, fleet::standing_plan(spec_.start_q), 0.0, 0.0, 0.0, why);
   ASSERT_TRUE(b.has_value());
   EXPECT_EQ(b->name, "right");
   EXPECT_EQ(b->prefix, "RIGHT");
@@ -155,7 +165,7 @@ TEST_F(NeighboursTest, FindsTheNeighbourAPlanRunsIntoAndWhetherItIsBlockedByThis
                                                     "/robots/scenes/iiwa_pair_left.yaml");
   EXPECT_FALSE(neighbours_
                    ->blocker(d, 4'000'000, *left.problem.model,
-                             fleet::standing_plan(left.problem.start_q), 0.0, 0.0, why)
+                             fleet::standing_plan(left.problem.start_q), 0.0, 0.0, 0.0, why)
                    .has_value())
       << why;
 
@@ -165,15 +175,97 @@ TEST_F(NeighboursTest, FindsTheNeighbourAPlanRunsIntoAndWhetherItIsBlockedByThis
   blocked.message = fleet::blocked_reason("left", "LEFT", fleet::Treatment::kHeldAtState, 0, "x");
   send("RIGHT_PLANNER_STATUS", blocked);
   EXPECT_TRUE(neighbours_->take_changed());
-  EXPECT_TRUE(neighbours_->blocked_by_own("right"));
+  EXPECT_EQ(neighbours_->blocking_cycle("right"), std::vector<std::string>{"RIGHT"});
   EXPECT_TRUE(
       neighbours_
-          ->blocker(d, 4'000'000, *spec_.model, fleet::standing_plan(spec_.start_q), 0.0, 0.0, why)
+          ->blocker(d, 4'000'000, *spec_.model, fleet::standing_plan(spec_.start_q), 0.0, 0.0, 0.0, why)
           ->blocked_by_own);
   // Blocked by another robot: not by this one.
   blocked.message = fleet::blocked_reason("x", "OTHER", fleet::Treatment::kHeldAtState, 0, "x");
   send("RIGHT_PLANNER_STATUS", blocked);
-  EXPECT_FALSE(neighbours_->blocked_by_own("right"));
+  EXPECT_TRUE(neighbours_->blocking_cycle("right").empty());
+}
+
+// A configuration of right that reaches into left standing at its scene's start (right's own
+// start is clear of it): found on a grid of its turn, shoulder and elbow.
+Eigen::VectorXd reaching_into(const NeighbourSpec& right, const planning::Scene& left) {
+  const std::shared_ptr<const dynamics::Model> left_model(left.problem.model);
+  const fleet::RobotPlan at_left{"left", left_model, fleet::standing_plan(left.problem.start_q)};
+  for (double turn = -0.8; turn < 0.9; turn += 0.4) {
+    for (double shoulder = 0.5; shoulder < 1.6; shoulder += 0.1) {
+      for (double elbow = -1.0; elbow < 0.1; elbow += 0.2) {
+        Eigen::VectorXd q = Eigen::VectorXd::Zero(right.model->nq());
+        q[0] = turn;
+        q[1] = shoulder;
+        q[3] = elbow;
+        const fleet::RobotPlan at_q{"right", right.model, fleet::standing_plan(q)};
+        if (fleet::joint_clearance({at_left, at_q}).min_distance < -0.02) return q;
+      }
+    }
+  }
+  return {};
+}
+
+// Left's scene and a configuration of right reaching into left standing at its start.
+class ReachingIntoLeftTest : public NeighboursTest {
+ protected:
+  void SetUp() override {
+    NeighboursTest::SetUp();
+    into = reaching_into(spec_, left);
+    ASSERT_EQ(into.size(), spec_.model->nq()) << "no configuration of right reaches into left";
+  }
+  const planning::Scene left = planning::load_scene(std::string(KINOGRAPH_SOURCE_DIR) +
+                                                    "/robots/scenes/iiwa_pair_left.yaml");
+  Eigen::VectorXd into;
+};
+
+// The blind spot of a fleet whose daemons have no states (the bench's): each plan starts at the
+// scene's start, so the robot has stood there until its plan starts. A higher neighbour's plan
+// that swept through it before then is not followed, though from knot 0 on the two keep clear.
+TEST_F(ReachingIntoLeftTest, ChecksAPlanFromNoStateAgainstWhatAFollowedPlanDidBeforeIt) {
+  send("RIGHT_PLANNER_STATUS", heartbeat(1'000'000));  // earlier than left's goal: higher
+  send("RIGHT_PLAN", moving_plan(3, into, spec_.start_q));  // 5–6 s: through left, then home
+  const fleet::Decision d = neighbours_->decide({2'000'000, ""}, true);
+  ASSERT_EQ(d.treatment[0], fleet::Treatment::kAlongPlan);
+  const planning::Plan standing = fleet::standing_plan(left.problem.start_q, 3.0);
+  std::string why;
+  // Left's plan starts at 7 s: from then on right is home, clear of it.
+  EXPECT_FALSE(neighbours_
+                   ->blocker(d, 7'000'000, *left.problem.model, standing, 0.0, 0.0, 0.0, why)
+                   .has_value())
+      << why;
+  // From no state, left stood at its start while right reached into it, 2 s before knot 0.
+  const std::optional<fleet::Blocker> b =
+      neighbours_->blocker(d, 7'000'000, *left.problem.model, standing, 0.0, 0.0,
+                           -std::numeric_limits<double>::infinity(), why);
+  ASSERT_TRUE(b.has_value());
+  EXPECT_EQ(b->treatment, fleet::Treatment::kAlongPlan);
+  EXPECT_NE(why.find("overlap"), std::string::npos) << why;
+  EXPECT_NE(why.find("at t = -"), std::string::npos) << why;
+}
+
+// A lower neighbour heard publishing plans but no states is held where its plans start, where it
+// stands until its next plan (around this robot's) starts, not where its latest plan ends.
+TEST_F(ReachingIntoLeftTest, HoldsALowerNeighbourWithoutStatesWhereItsPlansStart) {
+  send("RIGHT_PLANNER_STATUS", heartbeat(3'000'000));  // later than left's goal: lower
+  send("RIGHT_PLAN", moving_plan(3, spec_.start_q, into));  // ends reaching into left
+  const fleet::Decision d = neighbours_->decide({2'000'000, ""}, true);
+  ASSERT_EQ(d.treatment[0], fleet::Treatment::kHeldAtState);
+  std::vector<collision::Obstacle> obstacles;
+  neighbours_->add_obstacles(d, 7'000'000, obstacles);
+  ASSERT_EQ(obstacles.size(), spec_.model->collision.size());
+  const std::vector<fleet::NeighbourBody> at_start =
+      fleet::bodies_at({"right", spec_.model}, spec_.start_q, Neighbours::kFirstObstacleId);
+  for (std::size_t g = 0; g < obstacles.size(); ++g) {
+    EXPECT_TRUE(obstacles[g].pose.isApprox(at_start[g].obstacle.pose, 1e-12)) << "body " << g;
+  }
+  std::string why;
+  EXPECT_FALSE(neighbours_
+                   ->blocker(d, 7'000'000, *left.problem.model,
+                             fleet::standing_plan(left.problem.start_q), 0.0, 0.0,
+                             -std::numeric_limits<double>::infinity(), why)
+                   .has_value())
+      << why;
 }
 
 TEST_F(NeighboursTest, TriesARefusedGoalAgainOncePerNewPlanOfItsBlockerFollowingIt) {
@@ -184,7 +276,7 @@ TEST_F(NeighboursTest, TriesARefusedGoalAgainOncePerNewPlanOfItsBlockerFollowing
   // Left's goal where right stands (its scene's start): refused, blocked by right held there.
   fleet::Decision d = neighbours_->decide(own, true);
   std::optional<fleet::Blocker> b =
-      neighbours_->blocker(d, 4'000'000, *spec_.model, at_right, 0.0, 0.0, why);
+      neighbours_->blocker(d, 4'000'000, *spec_.model, at_right, 0.0, 0.0, 0.0, why);
   ASSERT_TRUE(b.has_value());
   ASSERT_EQ(b->treatment, fleet::Treatment::kHeldAtState);
   neighbours_->planned(d, false, &*b);
@@ -196,7 +288,7 @@ TEST_F(NeighboursTest, TriesARefusedGoalAgainOncePerNewPlanOfItsBlockerFollowing
     EXPECT_TRUE(d.replan) << d.reason;
     EXPECT_TRUE(d.retry);
     ASSERT_EQ(d.treatment[0], fleet::Treatment::kAlongPlan);
-    b = neighbours_->blocker(d, 4'000'000, *spec_.model, at_right, 0.0, 0.0, why);
+    b = neighbours_->blocker(d, 4'000'000, *spec_.model, at_right, 0.0, 0.0, 0.0, why);
     ASSERT_TRUE(b.has_value());
     EXPECT_EQ(b->treatment, fleet::Treatment::kAlongPlan);
     EXPECT_NEAR(b->plan_end, 2.0, 1e-9);  // starts 1 s after knot 0, lasts 1 s: a wait's end
@@ -220,6 +312,43 @@ TEST_F(NeighboursTest, TriesARefusedGoalAgainOncePerNewPlanOfItsBlockerFollowing
   EXPECT_EQ(neighbours_->summary(), "right: plan 11, followed");
   send("RIGHT_PLAN", plan(12));
   EXPECT_FALSE(neighbours_->decide({2'500'000, ""}, false).replan);
+}
+
+// A blocked by B, B by C, C by A: each where the next must go. A finds the cycle from the
+// heartbeats' reasons, and only once it closes through A.
+TEST_F(NeighboursTest, FindsADeadlockOfACycleOfRobotsEachBlockedByTheNext) {
+  NeighbourSpec b = spec_, c = spec_;
+  b.name = "b";
+  b.channel_prefix = "B";
+  c.name = "c";
+  c.channel_prefix = "C";
+  Neighbours three({b, c}, "A", NeighboursOptions{});
+  three.subscribe(lcm_, [] {});
+  planner_status_t hb = heartbeat(3'000'000);  // both later than A's goal: held at their states
+  const auto blocked_by = [&](const std::string& channel, const std::string& name,
+                              const std::string& prefix) {
+    hb.message = fleet::blocked_reason(name, prefix, fleet::Treatment::kHeldAtState, 0, "x");
+    send(channel, hb);
+  };
+  blocked_by("B_PLANNER_STATUS", "c", "C");
+  EXPECT_TRUE(three.blocking_cycle("b").empty());  // C is not blocked
+  blocked_by("C_PLANNER_STATUS", "b", "B");
+  EXPECT_TRUE(three.blocking_cycle("b").empty());  // a cycle of B and C only
+  three.take_changed();
+  blocked_by("C_PLANNER_STATUS", "a", "A");
+  EXPECT_TRUE(three.take_changed());  // it may close a cycle: look again
+  EXPECT_EQ(three.blocking_cycle("b"), (std::vector<std::string>{"B", "C"}));
+  EXPECT_EQ(three.blocking_cycle("c"), std::vector<std::string>{"C"});
+
+  const fleet::Decision d = three.decide({2'000'000, ""}, true);
+  std::string why;
+  const std::optional<fleet::Blocker> found = three.blocker(
+      d, 4'000'000, *spec_.model, fleet::standing_plan(spec_.start_q), 0.0, 0.0, 0.0, why);
+  ASSERT_TRUE(found.has_value());
+  EXPECT_TRUE(found->blocked_by_own);
+  const fleet::Remedy r = fleet::remedy("A", *found, 0.0, 3.0, "", why);
+  EXPECT_EQ(r.kind, fleet::Remedy::Kind::kDeadlock) << r.reason;
+  three.unsubscribe(lcm_);
 }
 
 TEST(NeighbourOption, NeedsANameAndAScene) {

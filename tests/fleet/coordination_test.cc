@@ -230,7 +230,7 @@ TEST(WaitFor, HoldsTheStartUntilTheBlockingPlanEnds) {
 }
 
 TEST(Remedy, WaitsForAFollowedPlanThatEndsLater) {
-  const Blocker a{"a", "A", Treatment::kAlongPlan, 2.5, false};
+  const Blocker a{"a", "A", Treatment::kAlongPlan, 2.5, false, {}};
   const Remedy r = remedy("B", a, 0.0, 1.0, "", "overlap");
   EXPECT_EQ(r.kind, Remedy::Kind::kWait);
   EXPECT_DOUBLE_EQ(r.wait.wait, 2.5);
@@ -239,7 +239,7 @@ TEST(Remedy, WaitsForAFollowedPlanThatEndsLater) {
 }
 
 TEST(Remedy, FailsWhenStillBlockedAfterWaitingOrWhenWaitingIsOff) {
-  const Blocker a{"a", "A", Treatment::kAlongPlan, 2.5, false};
+  const Blocker a{"a", "A", Treatment::kAlongPlan, 2.5, false, {}};
   const Remedy after = remedy("B", a, 2.5, 1.0, "", "overlap at the goal");
   EXPECT_EQ(after.kind, Remedy::Kind::kFail);
   EXPECT_NE(after.reason.find("even after waiting 2.500 s"), std::string::npos) << after.reason;
@@ -250,7 +250,7 @@ TEST(Remedy, FailsWhenStillBlockedAfterWaitingOrWhenWaitingIsOff) {
 }
 
 TEST(Remedy, AHeldNeighbourBlockedByThisRobotIsADeadlockNamingBoth) {
-  Blocker b{"right", "RIGHT", Treatment::kHeldAtState, 0.0, false};
+  Blocker b{"right", "RIGHT", Treatment::kHeldAtState, 0.0, false, {}};
   const Remedy blocked = remedy("LEFT", b, 0.0, 3.0, "", "goal overlaps it");
   EXPECT_EQ(blocked.kind, Remedy::Kind::kFail);
   EXPECT_EQ(blocked.reason.find("deadlock"), std::string::npos) << blocked.reason;
@@ -263,6 +263,16 @@ TEST(Remedy, AHeldNeighbourBlockedByThisRobotIsADeadlockNamingBoth) {
   EXPECT_NE(dead.reason.find("'RIGHT'"), std::string::npos) << dead.reason;
   // The partner reads the deadlock answer as blocked by LEFT too: no third state, no loop.
   EXPECT_EQ(blocker_prefix(deadlock_reason("RIGHT", "left", "LEFT", "x")), "LEFT");
+}
+
+TEST(Remedy, ACycleOfBlockedRobotsIsADeadlockNamingTheCycle) {
+  Blocker b{"b", "B", Treatment::kHeldAtState, 0.0, true, {"B", "C"}};  // B by C, C by A
+  const Remedy dead = remedy("A", b, 0.0, 3.0, "", "goal overlaps it");
+  EXPECT_EQ(dead.kind, Remedy::Kind::kDeadlock);
+  EXPECT_NE(dead.reason.find("robots 'A' -> 'B' -> 'C' -> 'A' each stand where the next must go"),
+            std::string::npos)
+      << dead.reason;
+  EXPECT_EQ(blocker_prefix(dead.reason), "B");
 }
 
 TEST(BlockerPrefix, OnlyFromTheRulesReasons) {
