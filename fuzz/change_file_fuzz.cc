@@ -29,6 +29,7 @@ void try_change(const std::string& text, const kinograph::planning::Scene& scene
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace kinograph;
+  fuzz::read_each_urdf_once();
   static const planning::Scene rr =
       planning::load_scene(fuzz::source_path("robots/scenes/rr_reach.yaml"));
   static const planning::Scene iiwa =

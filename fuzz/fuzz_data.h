@@ -4,6 +4,7 @@
 #include <string>
 
 #include "kinograph/dynamics/model.h"
+#include "kinograph/dynamics/urdf_file_cache.h"
 
 namespace kinograph::fuzz {
 
@@ -22,6 +23,11 @@ inline const dynamics::Model& iiwa_model() {
       dynamics::Model::from_urdf_file(source_path("robots/iiwa14/iiwa14.urdf"));
   return model;
 }
+
+/// Makes Model::from_urdf_file read each robot once for the rest of the process: the scene,
+/// change and plan readers load the robot a file names for every input, and that load (fuzzed
+/// by urdf_model) took most of each input's time.
+inline void read_each_urdf_once() { static const dynamics::UrdfFileCache cache; }
 
 /// Stops the run (a finding for libFuzzer, a failure for the corpus replay) with `what`.
 [[noreturn]] void fail(const std::string& what);

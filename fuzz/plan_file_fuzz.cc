@@ -45,6 +45,7 @@ class ScratchFile {
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace kinograph;
+  fuzz::read_each_urdf_once();
   static ScratchFile scratch;
   static const bool data_dir = (fuzz::use_source_data_dir(), true);
   (void)data_dir;

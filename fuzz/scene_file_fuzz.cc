@@ -14,6 +14,7 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace kinograph;
+  fuzz::read_each_urdf_once();
   static const std::string source = fuzz::source_path("robots/scenes/fuzz.yaml");
   planning::Scene scene;
   try {

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "kinograph/dynamics/model.h"
+#include "kinograph/dynamics/urdf_file_cache.h"
 #include "kinograph/dynamics/urdf_outline.h"
 
 namespace kinograph::dynamics {
@@ -319,9 +320,7 @@ class Loader {
   Model model_;
 };
 
-}  // namespace
-
-Model Model::from_urdf_file(const std::string& path) {
+Model load_urdf_file(const std::string& path) {
   std::error_code ec;
   if (!fs::exists(path, ec)) throw UrdfError(path + ": URDF file does not exist");
   if (fs::is_directory(path, ec)) throw UrdfError(path + ": is a directory, not a URDF file");
@@ -338,6 +337,13 @@ Model Model::from_urdf_file(const std::string& path) {
   Model m = Loader(path, abs.parent_path()).load(text.str());
   m.urdf_path = abs.string();
   return m;
+}
+
+}  // namespace
+
+Model Model::from_urdf_file(const std::string& path) {
+  if (UrdfFileCache* cache = UrdfFileCache::active()) return cache->get(path, &load_urdf_file);
+  return load_urdf_file(path);
 }
 
 Model Model::from_urdf_string(const std::string& xml, const std::string& base_dir) {
