@@ -56,7 +56,7 @@ echo "== goal 1: carry the block from under the desk to above it (the arm starts
 wait_for "$OUT/execute.log" "plan 1 takes over"
 echo "== a ball appears in the arm's way: the daemon replans from where the motion will be"
 "$KG" send-obstacle --prefix IIWA --lcm-url "$URL" --id ball --shape sphere --size 0.05 \
-  --position 0.5,0,0.75 --utime "$(now)" --goal-id 1 --wait 120 | sed -n '2p;5p'
+  --position 0.25,0.5,0.6 --utime "$(now)" --goal-id 1 --wait 120 | sed -n '2p;5p'
 echo "== the arm arrives"
 for _ in $(seq 240); do
   "$KG" check-states "$OUT/session.lcmlog" --scene "$SCENE" --change "$BALL" >"$OUT/states.out"

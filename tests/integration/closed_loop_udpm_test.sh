@@ -5,7 +5,7 @@
 # validator's clearance world.
 #  1. goal -> plan -> execution: the arm arrives within 1e-2 rad of the goal and comes to rest,
 #     and the executed states never touch the desk, the floor or the arm itself; that executed
-#     path passes through the ball of iiwa_desk_late_ball.yaml (about 2.2 s into the motion).
+#     path passes through the ball of iiwa_desk_late_ball.yaml (about 1.8 s into the motion).
 #  2. the same goal, and the ball appears while the arm moves: the replan joins the motion
 #     (jump of the commanded q <= 1e-6 rad, q' <= 1e-4 rad/s at the take-over, as the executor
 #     measures it) and the executed path clears the ball.
@@ -47,7 +47,7 @@ start_loop "$WORK/run2.lcmlog" IIWA_STATE --slowdown 10 --start-utime 1000000
 # 0.2 s of motion on the robot's clock, then the ball.
 "$PROBE" states --url "$URL" --channel IIWA_STATE --count 40 >/dev/null
 "$KG" send-obstacle --prefix IIWA --lcm-url "$URL" --id ball --shape sphere --size 0.05 \
-  --position 0.5,0,0.75 --utime "$(robot_now)" --goal-id 1 --wait 120 \
+  --position 0.25,0.5,0.6 --utime "$(robot_now)" --goal-id 1 --wait 120 \
   | tee "$WORK/replan.out" || fail "the replan is not valid"
 arrive_and_stop "$GOAL"
 grep "takes over" "$WORK/execute.log" || true
