@@ -33,9 +33,9 @@ rc=0
 "$KG" send-goal --prefix IIWA --lcm-url "$URL" --id 1 \
   --q 0.771,0.335,-0.570,-1.046,-0.686,0.356,-0.122 --wait 120 \
   --scene "$SCENE" --out "$OUT/goal1.json" || rc=$?
-echo "== a ball appears above the desk edge: the daemon replans goal 1"
+echo "== a ball appears beside the desk on the block's way up: the daemon replans goal 1"
 "$KG" send-obstacle --prefix IIWA --lcm-url "$URL" --id ball --shape sphere --size 0.05 \
-  --position 0.35,0.25,0.62 --goal-id 1 --wait 120 --scene "$SCENE" \
+  --position 0.5,0.6,0.7 --goal-id 1 --wait 120 --scene "$SCENE" \
   --out "$OUT/goal1_replan.json" || rc=$?
 echo "== goal 2, near goal 1 (the base turned 0.15 rad): replanned incrementally around the ball"
 "$KG" send-goal --prefix IIWA --lcm-url "$URL" --id 2 \
