@@ -83,6 +83,11 @@ int run(int argc, char** argv) {
            .parse(argc, argv)) {
     return 1;
   }
+  // Every table row and the Acrobot's torques come from at least one run.
+  if (goals < 1 || acrobot_repeats < 1) {
+    std::cerr << "planning_bench: --goals and --acrobot-repeats must be at least 1\n";
+    return 1;
+  }
   spdlog::set_level(spdlog::level::warn);
   const planning::BatchPlanner planner;
   json result;
