@@ -300,6 +300,17 @@ fleet::JointClearance together(const std::vector<Arm>& arms, int64_t origin_utim
   return fleet::history_clearance(robots, {}, &memo);
 }
 
+// The id of the arm's plan in force at `utime` (the latest started by then; its first before
+// any), and whether it is the arm's current plan.
+std::string in_force_at(const Arm& arm, int64_t utime) {
+  int64_t id = arm.plans.begin()->first;
+  for (const auto& [plan_id, msg] : arm.plans) {
+    if (msg.start_utime <= utime) id = plan_id;
+  }
+  const bool current = arm.current && arm.current->plan_id == id;
+  return fmt::format("{} on its plan {}{}", arm.name, id, current ? " (its current one)" : "");
+}
+
 // How far (rad, rad/s: the larger) the arm's plan `id` starts from where the arm is when it
 // starts: along its plans before it, or at its scene's start before any.
 double start_gap(const Arm& arm, int64_t id) {
@@ -557,7 +568,17 @@ nlohmann::json run_fleet(const std::string& cell_path, const FleetRunOptions& o)
     result["objective"] = objective;
     if (!jc.clear()) {
       valid = false;
-      if (why.empty()) why = "the settled plans are not clear: " + fleet::describe(jc);
+      if (why.empty()) {
+        // Which plans the two arms were moving along then: an older one is a yielding window.
+        const int64_t at = utime0 + std::llround(jc.t * 1e6);
+        std::string on;
+        for (const Arm& a : fleet.arms) {
+          if (a.name == jc.robot_a || a.name == jc.robot_b) {
+            on += (on.empty() ? "" : ", ") + in_force_at(a, at);
+          }
+        }
+        why = "the settled plans are not clear: " + fleet::describe(jc) + " (" + on + ")";
+      }
     }
   }
   result["success"] = valid;
