@@ -17,21 +17,10 @@
 #include "kinograph/planning/trajectory_sampler.h"
 #include "kinograph/planning/validate.h"
 #include "tests/daemon/node_listener.h"
+#include "tests/daemon/rr_scene.h"
 
 namespace kinograph::daemon {
 namespace {
-
-constexpr char kOwnScene[] = R"(
-name: rr_fleet_own
-robot:
-  urdf: robots/rr/rr.urdf
-horizon: 2.0
-steps: 30
-start:
-  q: [-0.8, 0.4]
-goal:
-  q: [0.8, -0.4]
-)";
 
 // Far enough away never to be in the way: only its plans' arrival matters here.
 constexpr char kFarScene[] = R"(
@@ -57,7 +46,7 @@ class NeighbourNodeTest : public ::testing::Test {
   void SetUp() override {
     ASSERT_TRUE(lcm_.good());
     const std::string anchor = std::string(KINOGRAPH_SOURCE_DIR) + "/scene.yaml";
-    own_ = planning::parse_scene(kOwnScene, anchor);
+    own_ = testing::rr_daemon_scene();
     const planning::Scene far = planning::parse_scene(kFarScene, anchor);
     far_.name = "far";
     far_.channel_prefix = "FAR";

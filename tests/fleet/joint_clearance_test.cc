@@ -33,26 +33,20 @@ TEST(JointClearance, FindsTheClosestApproachBetweenTheKnots) {
   EXPECT_EQ(c.samples, 11);
 }
 
-TEST(JointClearance, LeavesOutWhatLiesBeforeFrom) {
+TEST(JointClearance, LeavesOutWhatLiesBeforeFromAndFromToOn) {
   // As above, checked from t = 0.75 s on: 'a' has passed x = 0 and is closest at 0.75 s, at
-  // x = 0.5: sqrt(0.5² + 0.25²) − 2r.
+  // x = 0.5: sqrt(0.5² + 0.25²) − 2r. Checked before t = 0.25 s only: closest at the last time
+  // checked, 0.2 s, x = −0.6.
   const std::vector<RobotPlan> robots = {
       {"a", slider(Eigen::Vector3d(0, 0, 0)), constant_velocity(-1.0, 2.0, 1.0, 1), 0.0},
       {"b", slider(Eigen::Vector3d(0, 0.25, 0)), constant_velocity(0.0, 0.0, 1.0, 1), 0.0}};
-  const JointClearance c = joint_clearance(robots, {.from = 0.75});
-  EXPECT_NEAR(c.min_distance, std::sqrt(0.5 * 0.5 + 0.25 * 0.25) - 2 * kSphereRadius, 1e-6);
-  EXPECT_NEAR(c.t, 0.75, 1e-12);
-}
-
-TEST(JointClearance, LeavesOutWhatLiesFromToOn) {
-  // As above, checked before t = 0.25 s only: closest at the last time checked, 0.2 s, x = −0.6.
-  const std::vector<RobotPlan> robots = {
-      {"a", slider(Eigen::Vector3d(0, 0, 0)), constant_velocity(-1.0, 2.0, 1.0, 1), 0.0},
-      {"b", slider(Eigen::Vector3d(0, 0.25, 0)), constant_velocity(0.0, 0.0, 1.0, 1), 0.0}};
-  const JointClearance c = joint_clearance(robots, {.to = 0.25});
-  EXPECT_NEAR(c.min_distance, std::sqrt(0.6 * 0.6 + 0.25 * 0.25) - 2 * kSphereRadius, 1e-6);
-  EXPECT_NEAR(c.t, 0.2, 1e-12);
-  EXPECT_EQ(c.samples, 3);
+  const JointClearance late = joint_clearance(robots, {.from = 0.75});
+  EXPECT_NEAR(late.min_distance, std::sqrt(0.5 * 0.5 + 0.25 * 0.25) - 2 * kSphereRadius, 1e-6);
+  EXPECT_NEAR(late.t, 0.75, 1e-12);
+  const JointClearance early = joint_clearance(robots, {.to = 0.25});
+  EXPECT_NEAR(early.min_distance, std::sqrt(0.6 * 0.6 + 0.25 * 0.25) - 2 * kSphereRadius, 1e-6);
+  EXPECT_NEAR(early.t, 0.2, 1e-12);
+  EXPECT_EQ(early.samples, 3);
 }
 
 // 'a' moves +0.5 m/s from x = 0; at t = 1 s a second plan takes over where the first has it
