@@ -151,10 +151,11 @@ class PlannerNode {
   PlannerNode(const PlannerNode&) = delete;
   PlannerNode& operator=(const PlannerNode&) = delete;
 
-  /// Handles LCM traffic and plans until `stop` becomes true (checked every 50 ms); the
-  /// planning thread is started and joined inside. On `stop` a solve under way is cancelled at
-  /// its next iteration, and it and every goal still pending are answered CANCELLED.
-  void run(const std::atomic<bool>& stop);
+  /// Handles LCM traffic and plans until `stop` becomes true; the planning thread is started
+  /// and joined inside. `stop` is seen at once when `wake_fd` (StopSignal::fd()) becomes
+  /// readable with it, else within 50 ms. On `stop` a solve under way is cancelled at its next
+  /// iteration, and it and every goal still pending are answered CANCELLED.
+  void run(const std::atomic<bool>& stop, int wake_fd = -1);
 
   /// Full channel name for a suffix, e.g. channel("GOAL") = "IIWA_GOAL".
   std::string channel(const std::string& suffix) const;
