@@ -1,6 +1,7 @@
 #include "daemon/planner_node.h"
 
 #include <poll.h>
+#include <unistd.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -1059,6 +1060,41 @@ void PlannerNode::publish_status() {
                 static_cast<unsigned>(bytes.size()));
 }
 
+void PlannerNode::publish_shutdown_mark() {
+  shutdown_mark_ = std::to_string(reinterpret_cast<std::uintptr_t>(this)) + "@" +
+                   std::to_string(getpid());
+  shutdown_mark_seen_ = false;
+  shutdown_mark_subscription_ =
+      lcm_->subscribe(channel("SHUTDOWN_MARK"), &PlannerNode::on_shutdown_mark, this);
+  publish_bytes("shutdown marker", channel("SHUTDOWN_MARK"), shutdown_mark_.data(),
+                static_cast<unsigned>(shutdown_mark_.size()));
+}
+
+void PlannerNode::on_shutdown_mark(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+  shutdown_mark_seen_ =
+      shutdown_mark_seen_ ||
+      std::string_view(static_cast<const char*>(rbuf->data), rbuf->data_size) == shutdown_mark_;
+}
+
+void PlannerNode::drain_until_mark() {
+  // LCM's receive thread may not yet have queued what is in the socket; the marker, sent after
+  // the stop, comes after all of it.
+  const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(kShutdownMarkWait);
+  for (int handled = 0; !shutdown_mark_seen_ && handled < kGoalQueueCapacity;) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+                          end - std::chrono::steady_clock::now()).count();
+    if (left <= 0) {
+      spdlog::warn("kinographd: own shutdown marker not back within {} ms", kShutdownMarkWait);
+      break;
+    }
+    const int n = lcm_->handleTimeout(static_cast<int>(left));
+    if (n < 0) break;
+    handled += n;
+  }
+  lcm_->unsubscribe(shutdown_mark_subscription_);
+  shutdown_mark_subscription_ = nullptr;
+}
+
 void PlannerNode::run(const std::atomic<bool>& stop, int wake_fd) {
   spdlog::info("kinographd: robot {} on channels {}_*", identity_.model_name,
                identity_.channel_prefix);
@@ -1124,11 +1160,11 @@ void PlannerNode::run(const std::atomic<bool>& stop, int wake_fd) {
   cancel_ = true;
   done = true;
   wake_.notify_all();
+  publish_shutdown_mark();  // comes back while the worker ends
   worker.join();
-  // What LCM already holds is still taken and answered here (bounded: a storm cannot hold the
-  // exit up), so that no goal that arrived goes unanswered.
-  for (int i = 0; i < kGoalQueueCapacity && lcm_->handleTimeout(0) > 0; ++i) {
-  }
+  // What reached LCM before the stop is still taken and answered here (bounded: a storm cannot
+  // hold the exit up), so that no goal that arrived goes unanswered.
+  drain_until_mark();
   hand_over();
   Intake left;
   {
