@@ -18,10 +18,11 @@
 #include <iostream>
 
 #include "daemon/planner_node.h"
+#include "daemon/stop_signal.h"
 #include "kinograph/planning/io/scene.h"
 
 namespace {
-std::atomic<bool> g_stop{false};
+kinograph::daemon::StopSignal* g_stop = nullptr;  // set before the handlers are installed
 std::atomic<int> g_signal{0};
 std::atomic<int64_t> g_signal_ns{0};  // CLOCK_MONOTONIC when the signal came, for the summary
 int64_t monotonic_ns() {
@@ -32,7 +33,7 @@ int64_t monotonic_ns() {
 void on_signal(int signal) {
   g_signal_ns = monotonic_ns();
   g_signal = signal;
-  g_stop = true;
+  g_stop->request();  // wakes the node's LCM loop at once
 }
 }  // namespace
 
@@ -100,9 +101,11 @@ int main(int argc, char** argv) {
   options.replanning.use_incremental = !batch_only;
   spdlog::set_level(spdlog::level::from_str(level));
 
-  std::signal(SIGINT, on_signal);
-  std::signal(SIGTERM, on_signal);
   try {
+    // Never freed: a signal may still come while the process ends.
+    g_stop = new kinograph::daemon::StopSignal();
+    std::signal(SIGINT, on_signal);
+    std::signal(SIGTERM, on_signal);
     kinograph::planning::Scene scene = kinograph::planning::load_scene(scene_path);
     for (const std::string& text : neighbour_options) {
       options.neighbours.push_back(kinograph::daemon::neighbour_from_option(text));
@@ -114,7 +117,7 @@ int main(int argc, char** argv) {
     spdlog::info("kinographd: batch formulation {}",
                  kinograph::planning::to_string(options.replanning.incremental.batch.formulation));
     kinograph::daemon::PlannerNode node(std::move(scene), options);
-    node.run(g_stop);
+    node.run(g_stop->flag(), g_stop->fd());
     const auto c = node.counters();
     if (g_signal != 0) {
       spdlog::info("kinographd: signal {} received; every goal answered {:.1f} ms after it",

@@ -1,5 +1,7 @@
 #include "daemon/planner_node.h"
 
+#include <poll.h>
+#include <unistd.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -49,6 +51,13 @@ std::string obstacle_name(const ObstacleKey& key) {
   std::string name = "\"" + truncated(key.second) + "\"";
   if (!key.first.empty()) name += " of source \"" + truncated(key.first) + "\"";
   return name;
+}
+
+// Waits up to `timeout_ms` until `fd` (-1: none) or `wake_fd` (-1: none) is readable; true
+// when `fd` is. A signal interrupting the wait ends it too (false).
+bool wait_readable(int fd, int wake_fd, int timeout_ms) {
+  pollfd fds[2] = {{fd, POLLIN, 0}, {wake_fd, POLLIN, 0}};
+  return poll(fds, 2, timeout_ms) > 0 && (fds[0].revents & (POLLIN | POLLERR | POLLHUP)) != 0;
 }
 }  // namespace
 
@@ -766,6 +775,9 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t
                                         problem.steps);
     }
     try {
+      // Only the solve is cancelled: the collision walks outside it (neighbours, shutdown's
+      // obstacle changes) must run to their end.
+      graph::CancellationScope cancellation(cancel_);
       plan = replanner_.plan(problem, /*new_goal=*/!replan && attempt == 0,
                              continued ? &*continued : nullptr);
     } catch (const graph::Cancelled&) {
@@ -928,7 +940,6 @@ void PlannerNode::answer_at_shutdown(const Intake& taken) {
 }
 
 void PlannerNode::worker_loop(const std::atomic<bool>& stop) {
-  graph::CancellationScope cancellation(cancel_);
   while (true) {
     Intake taken;
     std::optional<RobotWithPayload> robot;
@@ -1049,7 +1060,42 @@ void PlannerNode::publish_status() {
                 static_cast<unsigned>(bytes.size()));
 }
 
-void PlannerNode::run(const std::atomic<bool>& stop) {
+void PlannerNode::publish_shutdown_mark() {
+  shutdown_mark_ = std::to_string(reinterpret_cast<std::uintptr_t>(this)) + "@" +
+                   std::to_string(getpid());
+  shutdown_mark_seen_ = false;
+  shutdown_mark_subscription_ =
+      lcm_->subscribe(channel("SHUTDOWN_MARK"), &PlannerNode::on_shutdown_mark, this);
+  publish_bytes("shutdown marker", channel("SHUTDOWN_MARK"), shutdown_mark_.data(),
+                static_cast<unsigned>(shutdown_mark_.size()));
+}
+
+void PlannerNode::on_shutdown_mark(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+  shutdown_mark_seen_ =
+      shutdown_mark_seen_ ||
+      std::string_view(static_cast<const char*>(rbuf->data), rbuf->data_size) == shutdown_mark_;
+}
+
+void PlannerNode::drain_until_mark() {
+  // LCM's receive thread may not yet have queued what is in the socket; the marker, sent after
+  // the stop, comes after all of it.
+  const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(kShutdownMarkWait);
+  for (int handled = 0; !shutdown_mark_seen_ && handled < kGoalQueueCapacity;) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+                          end - std::chrono::steady_clock::now()).count();
+    if (left <= 0) {
+      spdlog::warn("kinographd: own shutdown marker not back within {} ms", kShutdownMarkWait);
+      break;
+    }
+    const int n = lcm_->handleTimeout(static_cast<int>(left));
+    if (n < 0) break;
+    handled += n;
+  }
+  lcm_->unsubscribe(shutdown_mark_subscription_);
+  shutdown_mark_subscription_ = nullptr;
+}
+
+void PlannerNode::run(const std::atomic<bool>& stop, int wake_fd) {
   spdlog::info("kinographd: robot {} on channels {}_*", identity_.model_name,
                identity_.channel_prefix);
   if (!options_.iiwa_status_channel.empty()) {
@@ -1079,24 +1125,30 @@ void PlannerNode::run(const std::atomic<bool>& stop) {
       next_status += std::chrono::duration_cast<std::chrono::steady_clock::duration>(
           std::chrono::duration<double>(options_.status_period_s));
     }
+    // LCM traffic or a stop request, whichever comes first (a signal's EINTR is one too).
+    if (!wait_readable(lcm_->getFileno(), wake_fd, 50)) {
+      if (stop.load()) break;
+      hand_over();
+      continue;
+    }
     // LCM 1.3's udpm handle() occasionally reports a failure for a single datagram (seen when
     // a packet of our own arrives while no handler wants it); only a persistent failure means
     // the transport is gone.
-    const int handled = lcm_->handleTimeout(50);
+    const int handled = lcm_->handleTimeout(0);
     if (handled < 0) {
       if (++handle_failures > 100) {
         spdlog::error("LCM handle failed 100 times in a row; stopping");
         break;
       }
       spdlog::debug("LCM handle failed once; continuing");
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      wait_readable(-1, wake_fd, 5);  // not a busy loop on a broken transport; a stop ends it
     } else {
       handle_failures = 0;
       // A burst (messages less than 1 ms apart, as after a stall) is taken whole before the
       // worker sees any of it, so that only its newest goal is planned; at most 5 ms, so that a
       // steady storm still reaches the worker.
       const auto drain_end = std::chrono::steady_clock::now() + std::chrono::milliseconds(5);
-      while (handled > 0 && std::chrono::steady_clock::now() < drain_end &&
+      while (handled > 0 && !stop.load() && std::chrono::steady_clock::now() < drain_end &&
              lcm_->handleTimeout(1) > 0) {
       }
     }
@@ -1108,11 +1160,11 @@ void PlannerNode::run(const std::atomic<bool>& stop) {
   cancel_ = true;
   done = true;
   wake_.notify_all();
+  publish_shutdown_mark();  // comes back while the worker ends
   worker.join();
-  // What LCM already holds is still taken and answered here (bounded: a storm cannot hold the
-  // exit up), so that no goal that arrived goes unanswered.
-  for (int i = 0; i < kGoalQueueCapacity && lcm_->handleTimeout(0) > 0; ++i) {
-  }
+  // What reached LCM before the stop is still taken and answered here (bounded: a storm cannot
+  // hold the exit up), so that no goal that arrived goes unanswered.
+  drain_until_mark();
   hand_over();
   Intake left;
   {

@@ -141,6 +141,9 @@ class PlannerNode {
   static constexpr int64_t kPlanIdReservation = 1000;
   /// Least time between two writes of the state file for obstacle changes (s).
   static constexpr double kStateWritePeriod = 1.0;
+  /// Longest wait at shutdown for the node's own marker (PREFIX_SHUTDOWN_MARK) to come back
+  /// through LCM, for a transport that does not loop a node's messages back (ms).
+  static constexpr int kShutdownMarkWait = 500;
 
   /// Throws std::runtime_error naming the URL when LCM cannot start (e.g. no multicast route),
   /// StateFileError when options.state_file exists but cannot be taken (corrupt, foreign).
@@ -151,10 +154,11 @@ class PlannerNode {
   PlannerNode(const PlannerNode&) = delete;
   PlannerNode& operator=(const PlannerNode&) = delete;
 
-  /// Handles LCM traffic and plans until `stop` becomes true (checked every 50 ms); the
-  /// planning thread is started and joined inside. On `stop` a solve under way is cancelled at
-  /// its next iteration, and it and every goal still pending are answered CANCELLED.
-  void run(const std::atomic<bool>& stop);
+  /// Handles LCM traffic and plans until `stop` becomes true; the planning thread is started
+  /// and joined inside. `stop` is seen at once when `wake_fd` (StopSignal::fd()) becomes
+  /// readable with it, else within 50 ms. On `stop` a solve under way is cancelled at its next
+  /// iteration, and it and every goal still pending are answered CANCELLED.
+  void run(const std::atomic<bool>& stop, int wake_fd = -1);
 
   /// Full channel name for a suffix, e.g. channel("GOAL") = "IIWA_GOAL".
   std::string channel(const std::string& suffix) const;
@@ -177,6 +181,13 @@ class PlannerNode {
   void on_command(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   /// A heartbeat on this daemon's status channel: its own, or another daemon's (reported).
   void on_heartbeat(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  /// At shutdown: the marker this node sent itself came back (LCM thread).
+  void on_shutdown_mark(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  /// At shutdown: handles what LCM received until the marker published with
+  /// publish_shutdown_mark() comes back (everything that reached the socket before it has then
+  /// been handled), at most kGoalQueueCapacity messages or kShutdownMarkWait.
+  void drain_until_mark();
+  void publish_shutdown_mark();
   /// Hands a decoded measured state to the intake (LCM thread); one beyond the robot's limits
   /// is refused, and goals are answered INVALID_STATE until a usable state arrives.
   void take_state(const std::string& channel, MeasuredState&& state);
@@ -282,6 +293,10 @@ class PlannerNode {
   std::chrono::steady_clock::time_point state_written_at_{};
   // Set when run() ends: the worker's solver loops poll it (graph/cancellation.h).
   std::atomic<bool> cancel_{false};
+  // The shutdown marker: this node's address and pid, so that another daemon's is not taken.
+  std::string shutdown_mark_;
+  lcm::Subscription* shutdown_mark_subscription_ = nullptr;
+  bool shutdown_mark_seen_ = false;
   MotionJoin motion_join_;  // the newest valid plan and the executor following it
   // Without states, a robot with neighbours is where its valid plans have it (worker thread).
   PlannedMotion planned_motion_;

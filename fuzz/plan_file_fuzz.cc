@@ -52,14 +52,22 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static const planning::Scene scene =
       planning::load_scene(fuzz::source_path("robots/scenes/rr_reach.yaml"));
   const std::string& path = scratch.write(data, size);
+  // Parsed once and read both ways, as read_plan and read_plan_file would each read it.
+  nlohmann::json parsed;
   try {
-    const planning::Plan plan = planning::read_plan(path, *scene.problem.model);
+    parsed = planning::read_plan_json(path);
+  } catch (const planning::PlanFileError& e) {
+    fuzz::expect_names(e.what(), path);
+    return 0;
+  }
+  try {
+    const planning::Plan plan = planning::plan_from_json(parsed, *scene.problem.model, path);
     (void)planning::validate(scene.problem, plan);
   } catch (const planning::PlanFileError& e) {
     fuzz::expect_names(e.what(), path);
   }
   try {
-    (void)planning::read_plan_file(path);
+    (void)planning::plan_file_from_json(parsed, path);
   } catch (const planning::PlanFileError& e) {
     fuzz::expect_names(e.what(), path);
   }

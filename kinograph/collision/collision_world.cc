@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "kinograph/collision/pair_distance.h"
+#include "kinograph/graph/cancellation.h"
 
 namespace kinograph::collision {
 namespace {
@@ -377,6 +378,8 @@ std::span<const Proximity> CollisionWorld::query(const dynamics::Data& data, dou
 }
 
 bool CollisionWorld::any_within(const dynamics::Data& data, double t, double distance) {
+  // The path search asks this thousands of times: a cancelled plan stops here, world unchanged.
+  graph::throw_if_cancelled();
   scan(data, t, distance, true);
   return !out_.empty();
 }

@@ -8,6 +8,7 @@
 
 #include "kinograph/collision/convex_shape.h"
 #include "kinograph/dynamics/kinematics.h"
+#include "kinograph/graph/cancellation.h"
 
 namespace kinograph::collision {
 namespace {
@@ -108,6 +109,8 @@ PathCheckResult SegmentChecker::check_path(CollisionWorld& world, dynamics::Data
     } else {
       q_ = path.row(i).transpose();
     }
+    // A long walk (a fine plan's validation) must not hold up a daemon that stops its plan.
+    graph::throw_if_cancelled();
     dynamics::forward_kinematics(model_, data, q_);
     ++result.samples;
     const Proximity p = world.closest(data, time_at(i, u));

@@ -2,7 +2,9 @@
 // Cooperative cancellation of the solvers: a thread that may have to stop a solve under way (a
 // daemon asked to shut down) installs a flag with a CancellationScope, and the solver loops
 // (LevenbergMarquardt, GaussNewton, ISAM2::update) call throw_if_cancelled() once per
-// iteration. The flag is per thread so that no planner option or signature carries it.
+// iteration. So do the long walks of a plan outside them: the detour ranking's segments, the
+// path search's collision queries and the validator's collision walk. The flag is per thread
+// so that no planner option or signature carries it.
 #include <atomic>
 
 namespace kinograph::graph {

@@ -10,6 +10,7 @@
 
 #include "kinograph/collision/collision_world.h"
 #include "kinograph/dynamics/kinematics.h"
+#include "kinograph/graph/cancellation.h"
 
 namespace kinograph::planning {
 
@@ -200,6 +201,7 @@ double clearance_along(const dynamics::Model& model, collision::CollisionWorld& 
                        double t0, double t1, int samples, double stop_below) {
   double worst = std::numeric_limits<double>::infinity();
   for (int i = 0; i <= samples; ++i) {
+    graph::throw_if_cancelled();  // the detour ranking walks many segments before any solve
     const double s = static_cast<double>(i) / samples;
     dynamics::forward_kinematics(model, data, (1 - s) * a + s * b);
     worst = std::min(worst, world.closest(data, (1 - s) * t0 + s * t1).distance);

@@ -196,16 +196,6 @@ std::vector<double> read_limit(const json& limits, const char* key, const std::s
   return out;
 }
 
-json read_json_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw PlanFileError("cannot open plan file '" + path + "'");
-  try {
-    return json::parse(in);
-  } catch (const json::exception& e) {  // parse_error, and out_of_range for a number like 1e309
-    throw PlanFileError("plan '" + path + "' is not valid JSON: " + e.what());
-  }
-}
-
 // Plan matrix `key` (rows × width) with columns picked by `column`.
 Eigen::MatrixXd read_rows(const json& j, const char* key, const std::string& source,
                           std::size_t rows, const std::vector<int>& column, std::size_t width) {
@@ -527,8 +517,18 @@ Plan plan_from_json(const json& j, const dynamics::Model& model, const std::stri
   return plan;
 }
 
+json read_plan_json(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw PlanFileError("cannot open plan file '" + path + "'");
+  try {
+    return json::parse(in);
+  } catch (const json::exception& e) {  // parse_error, and out_of_range for a number like 1e309
+    throw PlanFileError("plan '" + path + "' is not valid JSON: " + e.what());
+  }
+}
+
 Plan read_plan(const std::string& path, const dynamics::Model& model) {
-  return plan_from_json(read_json_file(path), model, path);
+  return plan_from_json(read_plan_json(path), model, path);
 }
 
 PlanFileInfo plan_info_from_json(const json& j, const std::string& source) {
@@ -678,7 +678,7 @@ PlanFile plan_file_from_json(const json& j, const std::string& source) {
 }
 
 PlanFile read_plan_file(const std::string& path) {
-  return plan_file_from_json(read_json_file(path), path);
+  return plan_file_from_json(read_plan_json(path), path);
 }
 
 }  // namespace kinograph::planning

@@ -54,6 +54,9 @@ int plan_format_version(const nlohmann::json& json, const std::string& source = 
 /// "joint_names" (by position when absent) and the sizes checked. Throws PlanFileError.
 Plan plan_from_json(const nlohmann::json& json, const dynamics::Model& model,
                     const std::string& source = "");
+/// The JSON of a plan file, for a caller that reads it more than one way (plan_from_json,
+/// plan_file_from_json) without parsing it twice. Throws PlanFileError naming the file.
+nlohmann::json read_plan_json(const std::string& path);
 /// Reads a plan file for `model` (see plan_from_json). Throws PlanFileError.
 Plan read_plan(const std::string& path, const dynamics::Model& model);
 
