@@ -563,16 +563,21 @@ std::optional<Formulation> formulation_from_name(const std::string& name) {
 
 std::optional<std::string> resolve_scene_path(const std::string& path,
                                               const std::string& anchor_dir) {
+  // A path the system cannot even look up (a name too long, a component not a directory) is
+  // not found: the throwing overloads would escape the readers as a filesystem_error.
+  std::error_code ec;
   const fs::path p(path);
   if (p.is_absolute()) {
-    if (fs::exists(p)) return p.lexically_normal().string();
+    if (fs::exists(p, ec)) return p.lexically_normal().string();
     return std::nullopt;
   }
   std::vector<fs::path> bases{fs::path(anchor_dir)};
   for (const fs::path& dir : data_dirs()) bases.push_back(dir);
   for (const fs::path& base : bases) {
     const fs::path candidate = base / p;
-    if (fs::exists(candidate)) return fs::weakly_canonical(candidate).string();
+    if (!fs::exists(candidate, ec)) continue;
+    const fs::path canonical = fs::weakly_canonical(candidate, ec);
+    if (!ec) return canonical.string();
   }
   return std::nullopt;
 }
