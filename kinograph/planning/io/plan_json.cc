@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <filesystem>
+#include <system_error>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -595,9 +596,12 @@ PlanFileInfo plan_info_from_json(const json& j, const std::string& source) {
 
 std::optional<std::string> resolve_plan_path(const std::string& path,
                                              const std::string& plan_source) {
+  // Error codes, as in resolve_scene_path: a name too long is not found, never a throw.
+  std::error_code ec;
   const fs::path p(path);
-  if (!p.is_absolute() && fs::exists(fs::current_path() / p)) {
-    return fs::weakly_canonical(fs::current_path() / p).string();
+  if (!p.is_absolute() && fs::exists(fs::current_path() / p, ec)) {
+    const fs::path canonical = fs::weakly_canonical(fs::current_path() / p, ec);
+    if (!ec) return canonical.string();
   }
   return resolve_scene_path(path, anchor_of(plan_source));
 }
