@@ -4,10 +4,10 @@
 #include <array>
 #include <cmath>
 #include <filesystem>
-#include <system_error>
 #include <fstream>
 #include <limits>
 #include <sstream>
+#include <system_error>
 
 #include "kinograph/dynamics/base_placement.h"
 #include "kinograph/dynamics/payload.h"

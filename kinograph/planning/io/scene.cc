@@ -4,10 +4,10 @@
 
 #include <cmath>
 #include <filesystem>
-#include <system_error>
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <system_error>
 
 #include "kinograph/collision/obstacle.h"
 #include "kinograph/collision/shape.h"
