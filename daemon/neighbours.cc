@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <lcm/lcm-cpp.hpp>
 #include <regex>
 #include <sstream>
@@ -16,6 +17,7 @@
 #include "kinograph/plan_t.hpp"
 #include "kinograph/planner_status_t.hpp"
 #include "kinograph/planning/io/scene.h"
+#include "kinograph/planning/trajectory_sampler.h"
 #include "kinograph/robot_state_t.hpp"
 #include "lcmtypes/safe_decode.h"
 
@@ -296,7 +298,7 @@ void Neighbours::add_obstacles(const fleet::Decision& decision, std::int64_t ori
       bodies =
           fleet::bodies_along(n, *h.plan, fleet::clock_offset(h.plan_start_utime, origin_utime),
                               fleet::SweepOptions{.first_id = first});
-    } else if (const std::optional<Eigen::VectorXd> q = held_q_locked(i)) {
+    } else if (const std::optional<Eigen::VectorXd> q = held_q_locked(i, origin_utime)) {
       bodies = fleet::bodies_at(n, *q, kFirstObstacleId + slot);
     }
     for (fleet::NeighbourBody& b : bodies) {
@@ -306,12 +308,16 @@ void Neighbours::add_obstacles(const fleet::Decision& decision, std::int64_t ori
   }
 }
 
-std::optional<Eigen::VectorXd> Neighbours::held_q_locked(std::size_t i) const {
+std::optional<Eigen::VectorXd> Neighbours::held_q_locked(std::size_t i, std::int64_t utime) const {
   const Heard& h = heard_[i];
   if (h.state) return h.state;
-  // Heard a plan but no state: it stands where its plans start (a daemon without states plans
-  // each one from there, so its next plan, around this robot's, starts there again).
-  if (h.plan) return h.plan->q.row(0).transpose();
+  // Heard a plan but no state: it is where that plan has it (a daemon without states moves along
+  // its plans, and its next plan, around this robot's, starts from there).
+  if (h.plan) {
+    planning::TrajectorySampler sampler(*specs_[i].model, *h.plan);
+    return fleet::held_configuration(*h.plan, sampler,
+                                     fleet::clock_offset(utime, h.plan_start_utime));
+  }
   // Nothing heard yet: it stands at its scene's start.
   if (specs_[i].start_q.size() == specs_[i].model->nq()) return specs_[i].start_q;
   return std::nullopt;
@@ -342,7 +348,8 @@ std::optional<fleet::Blocker> Neighbours::blocker(const fleet::Decision& decisio
         other.plan = *h.plan;
         other.offset = fleet::clock_offset(h.plan_start_utime, origin_utime);
         b.plan_end = other.offset + h.plan->t.back();
-      } else if (const std::optional<Eigen::VectorXd> q = held_q_locked(i)) {
+      } else if (const std::optional<Eigen::VectorXd> q =
+                     held_q_locked(i, origin_utime + std::llround(wait_s * 1e6))) {
         other.plan = fleet::standing_plan(*q);
       } else {
         continue;

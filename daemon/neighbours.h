@@ -79,7 +79,8 @@ class Neighbours {
   /// previous goal's refusal and retries.
   fleet::Decision decide(const fleet::PriorityKey& own, bool own_goal_changed);
   /// Appends every neighbour's bodies as the decision treats them, timed from `origin_utime`
-  /// (the own plan's knot 0 on the common clock), to `obstacles`.
+  /// (the own plan's knot 0 on the common clock; a neighbour held still is held as then), to
+  /// `obstacles`.
   void add_obstacles(const fleet::Decision& decision, std::int64_t origin_utime,
                      std::vector<collision::Obstacle>& obstacles);
   /// True once when a neighbour was heard for the first time or after being silent (a started
@@ -89,8 +90,10 @@ class Neighbours {
   /// plus `wait_s`, standing at its first knot before and its last after) comes within `contact`
   /// metres of, from own-clock time `from_s` on: the closest such one, with `why` saying where;
   /// none when it keeps clear of all. `from_s` is 0 for a plan from a measured state (what came
-  /// before is another motion) and −∞ for one from no state, whose robot has stood at its first
-  /// knot all along, so a followed plan that passed through it before counts. Worker thread.
+  /// before is another motion), `wait_s` for one from the own plans in force (they move the robot
+  /// until it starts), and −∞ for the first one from no state, whose robot has stood at its first
+  /// knot all along, so a followed plan that passed through it before counts. A neighbour held
+  /// still is held as at the plan's start, `origin_utime` plus `wait_s`. Worker thread.
   std::optional<fleet::Blocker> blocker(const fleet::Decision& decision, std::int64_t origin_utime,
                                         const dynamics::Model& own_model,
                                         const planning::Plan& plan, double wait_s, double contact,
@@ -131,9 +134,10 @@ class Neighbours {
   void on_plan(std::size_t i, const lcm::ReceiveBuffer* rbuf);
   void on_state(std::size_t i, const lcm::ReceiveBuffer* rbuf);
   void on_heartbeat(std::size_t i, const lcm::ReceiveBuffer* rbuf);
-  // Where neighbour i stands when held still: its latest state, else the first knot of its plan,
-  // else its scene's start; none without any. Caller holds mutex_.
-  std::optional<Eigen::VectorXd> held_q_locked(std::size_t i) const;
+  // Where neighbour i stands when held still at common-clock time `utime`: its latest state,
+  // else where its latest plan has it then, else its scene's start; none without any. Caller
+  // holds mutex_.
+  std::optional<Eigen::VectorXd> held_q_locked(std::size_t i, std::int64_t utime) const;
   // blocking_cycle of neighbour i. Caller holds mutex_.
   std::vector<std::string> blocking_cycle_locked(std::size_t i) const;
   // Marks neighbours silent after the timeout; true when one became silent. Caller holds mutex_.

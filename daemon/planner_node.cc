@@ -65,6 +65,7 @@ PlannerNode::PlannerNode(planning::Scene scene, PlannerNodeOptions options, lcm:
     : scene_(std::move(scene)),
       options_(std::move(options)),
       motion_join_(robot_of(scene_), options_.takeover_latency_s),
+      planned_motion_(robot_of(scene_)),
       replanner_(options_.replanning) {
   identity_.model_name = scene_.problem.model->name;
   identity_.channel_prefix =
@@ -720,11 +721,6 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t
   }
   spdlog::debug("goal {}: planning{}", goal.goal_id, replan ? " (replan)" : "");
   for (const auto& [name, obstacle] : live_obstacles_) problem.obstacles.push_back(obstacle);
-  // Joints a goal does not name stay where this plan starts.
-  problem.goal = messages::goal_for_start(goal, problem.start_q);
-  problem.task_constraints.insert(problem.task_constraints.end(), goal.task_constraints.begin(),
-                                  goal.task_constraints.end());
-  if (goal.duration_s > 0) problem.horizon = goal.duration_s;
   // Neighbours' bodies on this plan's clock: knot 0 is the state, the take-over, or now.
   std::optional<fleet::Decision> around;
   std::optional<int64_t> origin;  // without a state, the plan then starts when planning began
@@ -732,12 +728,29 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t
     around = neighbours_->decide({goal.utime, ""}, !replan);
     origin = join ? join->takeover_utime : state_utime.value_or(wall_utime());
   }
+  // Without states, a robot with neighbours moves along its plans on the common clock: a later
+  // plan starts where they have it then, not back at the scene's start.
+  const bool on_own_plans = neighbours_ && !state_utime && planned_motion_.moving();
+  const auto start_on_own_plans = [&](double wait_s) {
+    const execution::Setpoint s = *planned_motion_.at(*origin + std::llround(wait_s * 1e6));
+    problem.start_q = s.q;
+    problem.start_qd = s.qd;
+  };
+  if (on_own_plans) start_on_own_plans(0.0);
+  // Joints a goal does not name stay where this plan starts.
+  problem.goal = messages::goal_for_start(goal, problem.start_q);
+  problem.task_constraints.insert(problem.task_constraints.end(), goal.task_constraints.begin(),
+                                  goal.task_constraints.end());
+  if (goal.duration_s > 0) problem.horizon = goal.duration_s;
   const std::size_t own_obstacles = problem.obstacles.size();
   blocked_.reset();
-  // A plan from a measured state says where the robot is from then on; one from no state says it
-  // has stood at its start all along, so neighbours' motion before knot 0 is checked too.
-  const double checked_from =
-      state_utime ? 0.0 : -std::numeric_limits<double>::infinity();
+  // A plan from a measured state says where the robot is from then on, one from the own plans in
+  // force from its (possibly waited-for) start on, before which those plans move the robot; the
+  // first plan from no state says it has stood at its start all along, so neighbours' motion
+  // before knot 0 is checked too.
+  const auto checked_from = [&](double wait_s) {
+    return state_utime ? 0.0 : on_own_plans ? wait_s : -std::numeric_limits<double>::infinity();
+  };
 
   planning::Plan plan;
   bool threw = false;
@@ -749,14 +762,24 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t
   // Each wait goes to a later plan end, so there are at most as many as neighbours.
   for (std::size_t attempt = 0;; ++attempt) {
     if (neighbours_) {
+      // After a wait the robot has gone on along its plans until the later start.
+      if (on_own_plans && attempt > 0) start_on_own_plans(wait_s);
       problem.obstacles.resize(own_obstacles);
       neighbours_->add_obstacles(*around, *origin + std::llround(wait_s * 1e6), problem.obstacles);
+    }
+    // A replan from the own plans in force starts from them continued in time: re-anchoring the
+    // current plan at a start further along it would have to drag its whole trajectory there.
+    std::optional<planning::Plan> continued;
+    if (on_own_plans && replan) {
+      continued = planned_motion_.ahead(*origin + std::llround(wait_s * 1e6), problem.horizon,
+                                        problem.steps);
     }
     try {
       // Only the solve is cancelled: the collision walks outside it (neighbours, shutdown's
       // obstacle changes) must run to their end.
       graph::CancellationScope cancellation(cancel_);
-      plan = replanner_.plan(problem, /*new_goal=*/!replan && attempt == 0);
+      plan = replanner_.plan(problem, /*new_goal=*/!replan && attempt == 0,
+                             continued ? &*continued : nullptr);
     } catch (const graph::Cancelled&) {
       spdlog::info("goal {}: planning cancelled: {}", goal.goal_id, kShutdownReason);
       answer_with_failure(plan_t::CANCELLED, std::string("planning cancelled: ") + kShutdownReason,
@@ -781,7 +804,7 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t
     const std::optional<fleet::Blocker> blocker = neighbours_->blocker(
         *around, *origin, *problem.model,
         refused ? fleet::standing_plan(problem.goal.q, problem.horizon) : plan, wait_s,
-        plan.success() ? 0.0 : problem.objectives.collision_epsilon, checked_from, why);
+        plan.success() ? 0.0 : problem.objectives.collision_epsilon, checked_from(wait_s), why);
     if (refused) {
       why = "its goal: " + why;
     } else if (!plan.success() && !plan.stats.reason.empty()) {
@@ -890,6 +913,8 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t
       }
     }
     motion_join_.published(
+        {plan_id, time.start_utime, time.takeover_utime, time.state_utime, plan});
+    planned_motion_.published(
         {plan_id, time.start_utime, time.takeover_utime, time.state_utime, plan});
   }
   publish(channel("PLAN"), msg);

@@ -25,6 +25,7 @@
 #include "daemon/motion_join.h"
 #include "daemon/neighbours.h"
 #include "daemon/own_heartbeats.h"
+#include "daemon/planned_motion.h"
 #include "daemon/robot_payload.h"
 #include "kinograph/lcm/message_convert.h"
 #include "kinograph/planning/io/scene.h"
@@ -297,6 +298,8 @@ class PlannerNode {
   lcm::Subscription* shutdown_mark_subscription_ = nullptr;
   bool shutdown_mark_seen_ = false;
   MotionJoin motion_join_;  // the newest valid plan and the executor following it
+  // Without states, a robot with neighbours is where its valid plans have it (worker thread).
+  PlannedMotion planned_motion_;
   std::optional<RobotWithPayload> pending_robot_;  // after a payload_t, not yet taken
   // What the heartbeat tells neighbours: the model's id, the current valid plan and its goal.
   std::string model_id_;

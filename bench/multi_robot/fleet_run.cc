@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "kinograph/cell/cell.h"
+#include "kinograph/execution/plan_schedule.h"
 #include "kinograph/fleet/joint_clearance.h"
 #include "kinograph/goal_t.hpp"
 #include "kinograph/lcm/message_convert.h"
@@ -31,6 +32,7 @@
 #include "kinograph/planner_status_t.hpp"
 #include "kinograph/planning/formulation/planning_graph.h"
 #include "kinograph/planning/io/scene.h"
+#include "kinograph/planning/trajectory_sampler.h"
 #include "kinograph/planning/validate.h"
 #include "lcmtypes/safe_decode.h"
 
@@ -280,17 +282,62 @@ struct Fleet {
   }
 };
 
-// The plans given (one per arm) on the common clock: each at its start_utime relative to the
-// earliest, as `kinograph check-together` places plan files.
-fleet::JointClearance together(const std::vector<Arm>& arms, const std::vector<const plan_t*>& p) {
-  int64_t origin = std::numeric_limits<int64_t>::max();
-  for (const plan_t* m : p) origin = std::min(origin, m->start_utime);
-  std::vector<fleet::RobotPlan> robots;
-  for (std::size_t i = 0; i < arms.size(); ++i) {
-    robots.push_back({arms[i].name, arms[i].scene.problem.model, messages::plan_from_message(*p[i]),
-                      static_cast<double>(p[i]->start_utime - origin) * 1e-6});
+// The arms' motions on the common clock (seconds from `origin_utime`): each moves along the valid
+// plans its daemon published, each in force from its start_utime until a later one starts, as a
+// daemon without states has its robot move (docs/multi_robot.md); checked together at and
+// between the knots. `memo` keeps the windows already checked.
+fleet::JointClearance together(const std::vector<Arm>& arms, int64_t origin_utime,
+                               fleet::HistoryMemo& memo) {
+  std::vector<fleet::RobotHistory> robots;
+  for (const Arm& a : arms) {
+    fleet::RobotHistory h{a.name, a.scene.problem.model, {}};
+    for (const auto& [id, msg] : a.plans) {
+      h.plans.push_back({messages::plan_from_message(msg),
+                         static_cast<double>(msg.start_utime - origin_utime) * 1e-6});
+    }
+    robots.push_back(std::move(h));
   }
-  return fleet::joint_clearance(robots);
+  return fleet::history_clearance(robots, {}, &memo);
+}
+
+// The id of the arm's plan in force at `utime` (the latest started by then; its first before
+// any), and whether it is the arm's current plan.
+std::string in_force_at(const Arm& arm, int64_t utime) {
+  int64_t id = arm.plans.begin()->first;
+  for (const auto& [plan_id, msg] : arm.plans) {
+    if (msg.start_utime <= utime) id = plan_id;
+  }
+  const bool current = arm.current && arm.current->plan_id == id;
+  return fmt::format("{} on its plan {}{}", arm.name, id, current ? " (its current one)" : "");
+}
+
+// How far (rad, rad/s: the larger) the arm's plan `id` starts from where the arm is when it
+// starts: along its plans before it, or at its scene's start before any.
+double start_gap(const Arm& arm, int64_t id) {
+  const plan_t& msg = arm.plans.at(id);
+  const planning::Plan plan = messages::plan_from_message(msg);
+  Eigen::VectorXd q = arm.scene.problem.start_q, qd = Eigen::VectorXd::Zero(q.size());
+  // The plan in force when it starts: the latest before it started by then.
+  for (auto it = arm.plans.begin(); it != arm.plans.end() && it->first < id; ++it) {
+    if (it->second.start_utime > msg.start_utime) continue;
+    execution::TimedPlan before{it->first, it->second.start_utime, it->second.start_utime, -1,
+                                messages::plan_from_message(it->second)};
+    planning::TrajectorySampler sampler(*arm.scene.problem.model, before.plan);
+    const execution::Setpoint at = execution::sample_at(before, sampler, msg.start_utime);
+    q = at.q;
+    qd = at.qd;
+  }
+  return std::max((plan.q.row(0).transpose() - q).cwiseAbs().maxCoeff(),
+                  (plan.qd.row(0).transpose() - qd).cwiseAbs().maxCoeff());
+}
+
+// The arm's scene with its start where `plan` starts: a replan from the motion under way is a
+// plan of that problem.
+planning::Problem from_its_start(const Arm& arm, const planning::Plan& plan) {
+  planning::Problem problem = arm.scene.problem;
+  problem.start_q = plan.q.row(0).transpose();
+  problem.start_qd = plan.qd.row(0).transpose();
+  return problem;
 }
 
 goal_t goal_message(const Arm& arm) {
@@ -424,20 +471,20 @@ nlohmann::json run_fleet(const std::string& cell_path, const FleetRunOptions& o)
   fleet.last_plan = t0;
   const auto deadline = t0 + std::chrono::duration<double>(o.timeout_s);
   std::optional<double> first_clear;
+  fleet::HistoryMemo memo;
   std::string why;
   for (;;) {
     lcm.handleTimeout(20);
     if (fleet.plans_changed && !first_clear) {
       fleet.plans_changed = false;
-      std::vector<const plan_t*> current;
+      bool all = true;
       Clock::time_point last = t0;
       for (const Arm& a : fleet.arms) {
-        if (!a.current) break;
-        current.push_back(&*a.current);
-        last = std::max(last, a.current_arrival);
+        all = all && a.current;
+        if (a.current) last = std::max(last, a.current_arrival);
       }
       // The moment the last of these plans arrived: when the fleet first held them all.
-      if (current.size() == fleet.arms.size() && together(fleet.arms, current).clear()) {
+      if (all && together(fleet.arms, utime0, memo).clear()) {
         first_clear = seconds_between(t0, last);
       }
     }
@@ -471,7 +518,6 @@ nlohmann::json run_fleet(const std::string& cell_path, const FleetRunOptions& o)
   int replans = 0, neighbour_replans = 0;
   double objective = 0;
   bool valid = settled;
-  std::vector<const plan_t*> final_plans;
   for (const Arm& a : fleet.arms) {
     nlohmann::json arm;
     arm["name"] = a.name;
@@ -488,18 +534,28 @@ nlohmann::json run_fleet(const std::string& cell_path, const FleetRunOptions& o)
     }
     if (settled) {
       const plan_t& msg = a.plans.at(a.heartbeat->valid_plan_id);
-      final_plans.push_back(&msg);
       const planning::Plan plan = messages::plan_from_message(msg);
-      const planning::Validation v = planning::validate(a.scene.problem, plan);
-      const double own = plan_objective(a.scene.problem, plan);
+      const planning::Problem problem = from_its_start(a, plan);
+      const planning::Validation v = planning::validate(problem, plan);
+      const double own = plan_objective(problem, plan);
+      const double gap = start_gap(a, msg.plan_id);
       objective += own;
       arm["plan_id"] = msg.plan_id;
       arm["method"] = msg.method;
       arm["objective"] = own;
       arm["valid"] = v.valid;
+      arm["start_gap"] = gap;
       if (!v.valid) {
         valid = false;
         if (why.empty()) why = a.name + "'s plan does not validate: " + v.failures.front();
+      }
+      // A replan continues the motion under way (the validator's start tolerance).
+      if (gap > 1e-6) {
+        valid = false;
+        if (why.empty()) {
+          why = fmt::format("{}'s plan {} starts {} away from where its plans had it", a.name,
+                            msg.plan_id, gap);
+        }
       }
     }
     result["arms"].push_back(arm);
@@ -507,12 +563,22 @@ nlohmann::json run_fleet(const std::string& cell_path, const FleetRunOptions& o)
   result["replans"] = replans;
   result["neighbour_replans"] = neighbour_replans;
   if (settled) {
-    const fleet::JointClearance jc = together(fleet.arms, final_plans);
+    const fleet::JointClearance jc = together(fleet.arms, utime0, memo);
     result["min_clearance"] = jc.min_distance;
     result["objective"] = objective;
     if (!jc.clear()) {
       valid = false;
-      if (why.empty()) why = "the settled plans are not clear: " + fleet::describe(jc);
+      if (why.empty()) {
+        // Which plans the two arms were moving along then: an older one is a yielding window.
+        const int64_t at = utime0 + std::llround(jc.t * 1e6);
+        std::string on;
+        for (const Arm& a : fleet.arms) {
+          if (a.name == jc.robot_a || a.name == jc.robot_b) {
+            on += (on.empty() ? "" : ", ") + in_force_at(a, at);
+          }
+        }
+        why = "the settled plans are not clear: " + fleet::describe(jc) + " (" + on + ")";
+      }
     }
   }
   result["success"] = valid;

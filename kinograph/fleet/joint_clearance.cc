@@ -18,12 +18,12 @@ namespace {
 // included when finite), without near-duplicates (which would break PoseTrajectory's strictly
 // increasing times).
 std::vector<double> common_times(const std::vector<RobotPlan>& robots, int per_interval,
-                                 double from) {
+                                 double from, double to) {
   std::vector<double> times;
-  if (std::isfinite(from)) times.push_back(from);
+  if (std::isfinite(from) && from < to) times.push_back(from);
   for (const RobotPlan& r : robots) {
     for (const double t : sweep_times(r.plan, r.offset, per_interval)) {
-      if (t >= from) times.push_back(t);
+      if (t >= from && t < to) times.push_back(t);
     }
   }
   std::sort(times.begin(), times.end());
@@ -80,8 +80,9 @@ JointClearance joint_clearance(const std::vector<RobotPlan>& robots,
   }
   JointClearance result;
   const std::vector<double> times =
-      common_times(robots, options.samples_per_interval, options.from);
+      common_times(robots, options.samples_per_interval, options.from, options.to);
   result.samples = static_cast<int>(times.size());
+  if (times.empty()) return result;  // a window without a time of any plan in it
   // Robot i's bodies in a world whose obstacles are robot j's bodies along its plan, sampled at
   // the same common times, so both are posed exactly at every time checked.
   for (size_t i = 0; i < robots.size(); ++i) {
@@ -111,6 +112,56 @@ JointClearance joint_clearance(const std::vector<RobotPlan>& robots,
     }
   }
   return result;
+}
+
+}  // namespace kinograph::fleet
+
+namespace kinograph::fleet {
+
+JointClearance history_clearance(const std::vector<RobotHistory>& robots,
+                                 const JointClearanceOptions& options, HistoryMemo* memo) {
+  std::vector<double> cuts = {options.from};
+  for (const RobotHistory& r : robots) {
+    if (r.plans.empty()) throw std::invalid_argument("robot '" + r.name + "' has no plan");
+    for (const RobotHistory::Piece& p : r.plans) {
+      if (p.offset > options.from && p.offset < options.to) cuts.push_back(p.offset);
+    }
+  }
+  std::sort(cuts.begin(), cuts.end());
+  cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());
+  cuts.push_back(options.to);
+  JointClearance closest;
+  for (std::size_t w = 0; w + 1 < cuts.size(); ++w) {
+    JointClearanceOptions window = options;
+    window.from = cuts[w];
+    window.to = cuts[w + 1];
+    // Each robot's plan in force in the window: the latest of its list started by its beginning.
+    std::ostringstream key;  // the window exactly, and the plans in force
+    key << std::hexfloat << window.from << ' ' << window.to;
+    std::vector<RobotPlan> in_force;
+    for (const RobotHistory& r : robots) {
+      std::size_t k = 0;
+      for (std::size_t i = 0; i < r.plans.size(); ++i) {
+        if (r.plans[i].offset <= window.from) k = i;
+      }
+      key << ' ' << k;
+      in_force.push_back({r.name, r.model, r.plans[k].plan, r.plans[k].offset});
+    }
+    JointClearance c;
+    if (memo && memo->count(key.str()) != 0) {
+      c = memo->at(key.str());
+    } else {
+      c = joint_clearance(in_force, window);
+      if (memo) (*memo)[key.str()] = c;
+    }
+    closest.samples += c.samples;
+    if (c.min_distance < closest.min_distance) {
+      const int samples = closest.samples;
+      closest = c;
+      closest.samples = samples;
+    }
+  }
+  return closest;
 }
 
 }  // namespace kinograph::fleet

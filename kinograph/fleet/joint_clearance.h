@@ -2,6 +2,7 @@
 // Several robots' plans checked together on a common clock: each robot's collision bodies
 // against every other robot's at the same times, at and between the knots.
 #include <limits>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -28,6 +29,9 @@ struct JointClearanceOptions {
   /// Common-clock time (s) from which on the robots are checked: what lies before (a neighbour's
   /// motion already past) is left out. Default −∞: the whole span.
   double from = -std::numeric_limits<double>::infinity();
+  /// Common-clock time (s) before which the check ends (not included): what lies after is left
+  /// out. Default +∞.
+  double to = std::numeric_limits<double>::infinity();
 };
 
 /// The closest approach of two different robots over the common span of their plans (each one
@@ -44,6 +48,33 @@ struct JointClearance {
   /// True when the robots keep at least `required` metres apart.
   bool clear(double required = 0.0) const { return min_distance >= required; }
 };
+
+/// One robot's motion made of the plans it was given, in the order given: each plan is in force
+/// from its start (common time `offset`) until a later one of the list starts; before any has
+/// started the robot stands at the first plan's first knot. A robot without measured states that
+/// follows its daemon's plans moves so.
+struct RobotHistory {
+  std::string name;
+  std::shared_ptr<const dynamics::Model> model;
+  struct Piece {
+    planning::Plan plan;
+    double offset = 0;  ///< s: plan time τ is common time offset + τ
+  };
+  std::vector<Piece> plans;  ///< at least one
+};
+
+/// Window checks already made by history_clearance, to be reused by a later call whose histories
+/// only have plans appended.
+using HistoryMemo = std::map<std::string, JointClearance>;
+
+/// The closest approach between every pair of robots moving as their histories say: the common
+/// clock cut where any robot's plan in force changes, and each window checked as joint_clearance
+/// does with the plans in force there (options.from / to bound the whole). With `memo`, windows
+/// checked before with the same plans in force are not checked again. Throws as joint_clearance,
+/// and std::invalid_argument for a history without plans.
+JointClearance history_clearance(const std::vector<RobotHistory>& robots,
+                                 const JointClearanceOptions& options = {},
+                                 HistoryMemo* memo = nullptr);
 
 /// A plan standing still at configuration q from time 0 to `duration` s (two knots, at rest): a
 /// robot held at a state, for joint_clearance.

@@ -66,11 +66,13 @@ Replanner::Replanner(ReplannerOptions options)
       batch_(options_.incremental.batch),
       incremental_(options_.incremental) {}
 
-Plan Replanner::plan(const Problem& problem, bool new_goal) {
+Plan Replanner::plan(const Problem& problem, bool new_goal, const Plan* warm) {
   report_ = ReplanReport();
+  // A warm start must fit the problem's knots.
+  if (warm && warm->q.rows() != problem.steps + 1) warm = nullptr;
   try {
-    Plan p = options_.use_incremental ? incremental_path(problem, new_goal)
-                                      : batch_path(problem, new_goal);
+    Plan p = options_.use_incremental ? incremental_path(problem, new_goal, warm)
+                                      : batch_path(problem, new_goal, warm);
     if (p.success()) {
       last_valid_ = p;
       last_problem_ = problem;
@@ -97,10 +99,11 @@ Plan Replanner::replan(const ProblemChange& change) {
   return plan(next, change.goal.has_value());
 }
 
-Plan Replanner::batch_path(const Problem& problem, bool new_goal) {
+Plan Replanner::batch_path(const Problem& problem, bool new_goal, const Plan* given) {
   // An obstacle or start change keeps the goal: the previous plan is the natural start.
-  const bool warm = !new_goal && last_valid_ && last_valid_->q.rows() == problem.steps + 1;
-  Plan plan = batch_.plan(problem, warm ? &*last_valid_ : nullptr);
+  const bool warm =
+      given || (!new_goal && last_valid_ && last_valid_->q.rows() == problem.steps + 1);
+  Plan plan = batch_.plan(problem, given ? given : warm ? &*last_valid_ : nullptr);
   // A warm start can be trapped on the wrong side of a new obstacle.
   if (warm && !plan.success()) {
     spdlog::info("warm-started replan did not validate ({}); planning from scratch",
@@ -123,7 +126,7 @@ Plan Replanner::from_scratch(const Problem& problem) {
   return plan;
 }
 
-Plan Replanner::incremental_path(const Problem& problem, bool new_goal) {
+Plan Replanner::incremental_path(const Problem& problem, bool new_goal, const Plan* warm) {
   bool scratch = !ready_ || !incremental_.has_plan() ||
                  incremental_.problem().steps != problem.steps;
   if (!scratch && new_goal) {
@@ -137,6 +140,15 @@ Plan Replanner::incremental_path(const Problem& problem, bool new_goal) {
   if (scratch) return from_scratch(problem);
 
   const Plan previous = incremental_.current_plan();
+  if (warm) {
+    // The given trajectory, not the current plan, is where the solve starts.
+    Plan plan = incremental_.plan(problem, warm);
+    report_.method = "warm-start";
+    ready_ = plan.success();
+    // A problem refused before solving (e.g. a start in collision) leaves nothing to recover.
+    if (plan.success() || plan.stats.status == PlanStatus::kInvalidProblem) return plan;
+    return recover(problem, std::move(plan), previous);
+  }
   Plan plan = incremental_.replan(change_between(incremental_.problem(), problem, new_goal));
   report_.statistics = incremental_.last_stats();
   report_.method = "incremental";

@@ -47,8 +47,11 @@ class Replanner {
   explicit Replanner(ReplannerOptions options = {});
 
   /// Plans `problem`: `new_goal` marks a new request (else the current goal's problem changed,
-  /// e.g. obstacles or the start). The answer's path is in last_report().
-  Plan plan(const Problem& problem, bool new_goal);
+  /// e.g. obstacles or the start). The answer's path is in last_report(). `warm`, when given, is
+  /// a better initial trajectory for a replan than the current plan, e.g. that plan continued in
+  /// time when the start moved along it: the replan is then a solve warm-started from it on the
+  /// incremental graph (method "warm-start"), with the usual fallbacks.
+  Plan plan(const Problem& problem, bool new_goal, const Plan* warm = nullptr);
   /// Applies `change` to the current problem and plans it (a new request when it has a goal).
   /// Needs a first plan (else status "no_plan").
   Plan replan(const ProblemChange& change);
@@ -60,9 +63,9 @@ class Replanner {
   const ReplannerOptions& options() const { return options_; }
 
  private:
-  Plan batch_path(const Problem& problem, bool new_goal);
+  Plan batch_path(const Problem& problem, bool new_goal, const Plan* warm);
   Plan from_scratch(const Problem& problem);
-  Plan incremental_path(const Problem& problem, bool new_goal);
+  Plan incremental_path(const Problem& problem, bool new_goal, const Plan* warm);
   /// The warm-started batch solve (then the plan from scratch) after a failed replan.
   Plan recover(const Problem& problem, Plan failed, const Plan& previous);
 

@@ -219,9 +219,9 @@ class ReachingIntoLeftTest : public NeighboursTest {
   Eigen::VectorXd into;
 };
 
-// The blind spot of a fleet whose daemons have no states (the bench's): each plan starts at the
-// scene's start, so the robot has stood there until its plan starts. A higher neighbour's plan
-// that swept through it before then is not followed, though from knot 0 on the two keep clear.
+// The blind spot of a daemon's first plan without states (the bench's): it starts at the scene's
+// start, where the robot has stood until then. A higher neighbour's plan that swept through it
+// before then is not followed, though from knot 0 on the two keep clear.
 TEST_F(ReachingIntoLeftTest, ChecksAPlanFromNoStateAgainstWhatAFollowedPlanDidBeforeIt) {
   send("RIGHT_PLANNER_STATUS", heartbeat(1'000'000));  // earlier than left's goal: higher
   send("RIGHT_PLAN", moving_plan(3, into, spec_.start_q));  // 5–6 s: through left, then home
@@ -244,28 +244,40 @@ TEST_F(ReachingIntoLeftTest, ChecksAPlanFromNoStateAgainstWhatAFollowedPlanDidBe
   EXPECT_NE(why.find("at t = -"), std::string::npos) << why;
 }
 
-// A lower neighbour heard publishing plans but no states is held where its plans start, where it
-// stands until its next plan (around this robot's) starts, not where its latest plan ends.
-TEST_F(ReachingIntoLeftTest, HoldsALowerNeighbourWithoutStatesWhereItsPlansStart) {
+// A lower neighbour heard publishing plans but no states moves along them (its daemon plans its
+// next one from where they have it): held still, it stands where its latest plan has it at the
+// own plan's start, not back where that plan started.
+TEST_F(ReachingIntoLeftTest, HoldsALowerNeighbourWithoutStatesWhereItsPlanHasIt) {
   send("RIGHT_PLANNER_STATUS", heartbeat(3'000'000));  // later than left's goal: lower
-  send("RIGHT_PLAN", moving_plan(3, spec_.start_q, into));  // ends reaching into left
+  send("RIGHT_PLAN", moving_plan(3, spec_.start_q, into));  // 5–6 s: ends reaching into left
   const fleet::Decision d = neighbours_->decide({2'000'000, ""}, true);
   ASSERT_EQ(d.treatment[0], fleet::Treatment::kHeldAtState);
-  std::vector<collision::Obstacle> obstacles;
-  neighbours_->add_obstacles(d, 7'000'000, obstacles);
-  ASSERT_EQ(obstacles.size(), spec_.model->collision.size());
-  const std::vector<fleet::NeighbourBody> at_start =
-      fleet::bodies_at({"right", spec_.model}, spec_.start_q, Neighbours::kFirstObstacleId);
-  for (std::size_t g = 0; g < obstacles.size(); ++g) {
-    EXPECT_TRUE(obstacles[g].pose.isApprox(at_start[g].obstacle.pose, 1e-12)) << "body " << g;
-  }
+  const auto held_at = [&](int64_t origin_utime, const Eigen::VectorXd& q) {
+    std::vector<collision::Obstacle> obstacles;
+    neighbours_->add_obstacles(d, origin_utime, obstacles);
+    ASSERT_EQ(obstacles.size(), spec_.model->collision.size());
+    const std::vector<fleet::NeighbourBody> at_q =
+        fleet::bodies_at({"right", spec_.model}, q, Neighbours::kFirstObstacleId);
+    for (std::size_t g = 0; g < obstacles.size(); ++g) {
+      EXPECT_FALSE(obstacles[g].is_moving());
+      EXPECT_TRUE(obstacles[g].pose.isApprox(at_q[g].obstacle.pose, 1e-12)) << "body " << g;
+    }
+  };
+  held_at(4'000'000, spec_.start_q);  // before its plan starts: where it starts
+  held_at(7'000'000, into);           // after it ended: where it ends
+  const planning::Plan standing = fleet::standing_plan(left.problem.start_q);
   std::string why;
-  EXPECT_FALSE(neighbours_
-                   ->blocker(d, 7'000'000, *left.problem.model,
-                             fleet::standing_plan(left.problem.start_q), 0.0, 0.0,
-                             -std::numeric_limits<double>::infinity(), why)
-                   .has_value())
+  EXPECT_FALSE(
+      neighbours_->blocker(d, 4'000'000, *left.problem.model, standing, 0.0, 0.0, 0.0, why))
       << why;
+  // Left's plan starting at 7 s runs into it; one starting at 4 s but waiting 3 s too.
+  for (const auto& [origin, wait] : {std::pair{7'000'000, 0.0}, std::pair{4'000'000, 3.0}}) {
+    const std::optional<fleet::Blocker> b =
+        neighbours_->blocker(d, origin, *left.problem.model, standing, wait, 0.0, 0.0, why);
+    ASSERT_TRUE(b.has_value()) << origin;
+    EXPECT_EQ(b->treatment, fleet::Treatment::kHeldAtState);
+    EXPECT_NE(why.find("overlap"), std::string::npos) << why;
+  }
 }
 
 TEST_F(NeighboursTest, TriesARefusedGoalAgainOncePerNewPlanOfItsBlockerFollowingIt) {

@@ -22,25 +22,12 @@
 #include "kinograph/planner_status_t.hpp"
 #include "kinograph/planning/io/scene.h"
 #include "lcmtypes/safe_decode.h"
+#include "tests/daemon/rr_scene.h"
 
 namespace kinograph::daemon {
 namespace {
 
-constexpr char kScene[] = R"(
-name: rr_options_test
-robot:
-  urdf: robots/rr/rr.urdf
-horizon: 2.0
-steps: 20
-start:
-  q: [-0.8, 0.4]
-goal:
-  q: [0.8, -0.4]
-)";
-
-planning::Scene scene() {
-  return planning::parse_scene(kScene, std::string(KINOGRAPH_SOURCE_DIR) + "/scene.yaml");
-}
+planning::Scene scene() { return testing::rr_daemon_scene(); }
 
 goal_t joint_goal(int64_t id, std::vector<double> q) {
   goal_t g{};

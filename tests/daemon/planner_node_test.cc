@@ -21,6 +21,7 @@
 
 #include "daemon/state_file.h"
 #include "tests/daemon/node_listener.h"
+#include "tests/daemon/rr_scene.h"
 #include "drake/lcmt_iiwa_status.hpp"
 #include "kinograph/dynamics/data.h"
 #include "kinograph/dynamics/kinematics.h"
@@ -34,18 +35,6 @@
 
 namespace kinograph::daemon {
 namespace {
-
-constexpr char kScene[] = R"(
-name: rr_daemon_test
-robot:
-  urdf: robots/rr/rr.urdf
-horizon: 2.0
-steps: 30
-start:
-  q: [-0.8, 0.4]
-goal:
-  q: [0.8, -0.4]
-)";
 
 // A node running on its own thread over one shared memq:// instance.
 class NodeFixture : public ::testing::Test {
@@ -70,7 +59,7 @@ class NodeFixture : public ::testing::Test {
     thread_ = std::thread([this] { node_->run(stop_); });
   }
   static planning::Scene default_scene() {
-    return planning::parse_scene(kScene, std::string(KINOGRAPH_SOURCE_DIR) + "/scene.yaml");
+    return testing::rr_daemon_scene();
   }
   void TearDown() override {
     stop_ = true;

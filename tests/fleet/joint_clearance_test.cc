@@ -33,15 +33,49 @@ TEST(JointClearance, FindsTheClosestApproachBetweenTheKnots) {
   EXPECT_EQ(c.samples, 11);
 }
 
-TEST(JointClearance, LeavesOutWhatLiesBeforeFrom) {
+TEST(JointClearance, LeavesOutWhatLiesBeforeFromAndFromToOn) {
   // As above, checked from t = 0.75 s on: 'a' has passed x = 0 and is closest at 0.75 s, at
-  // x = 0.5: sqrt(0.5² + 0.25²) − 2r.
+  // x = 0.5: sqrt(0.5² + 0.25²) − 2r. Checked before t = 0.25 s only: closest at the last time
+  // checked, 0.2 s, x = −0.6.
   const std::vector<RobotPlan> robots = {
       {"a", slider(Eigen::Vector3d(0, 0, 0)), constant_velocity(-1.0, 2.0, 1.0, 1), 0.0},
       {"b", slider(Eigen::Vector3d(0, 0.25, 0)), constant_velocity(0.0, 0.0, 1.0, 1), 0.0}};
-  const JointClearance c = joint_clearance(robots, {.from = 0.75});
-  EXPECT_NEAR(c.min_distance, std::sqrt(0.5 * 0.5 + 0.25 * 0.25) - 2 * kSphereRadius, 1e-6);
-  EXPECT_NEAR(c.t, 0.75, 1e-12);
+  const JointClearance late = joint_clearance(robots, {.from = 0.75});
+  EXPECT_NEAR(late.min_distance, std::sqrt(0.5 * 0.5 + 0.25 * 0.25) - 2 * kSphereRadius, 1e-6);
+  EXPECT_NEAR(late.t, 0.75, 1e-12);
+  const JointClearance early = joint_clearance(robots, {.to = 0.25});
+  EXPECT_NEAR(early.min_distance, std::sqrt(0.6 * 0.6 + 0.25 * 0.25) - 2 * kSphereRadius, 1e-6);
+  EXPECT_NEAR(early.t, 0.2, 1e-12);
+  EXPECT_EQ(early.samples, 3);
+}
+
+// 'a' moves +0.5 m/s from x = 0; at t = 1 s a second plan takes over where the first has it
+// (x = 0.5) and turns it back. 'b', 0.15 m to the side, sweeps from x = 0.5 to 2.5 in the first
+// second. The history keeps 0.5 m apart along x, closest at t = 0 (a at 0, b at 0.5); the second
+// plan alone, a standing at its first knot before it starts, would put a under b at t = 0.
+TEST(HistoryClearance, MovesEachRobotAlongThePlanInForce) {
+  const auto a = slider(Eigen::Vector3d(0, 0, 0));
+  const auto b = slider(Eigen::Vector3d(0, 0.15, 0));
+  const planning::Plan out = constant_velocity(0.0, 0.5, 2.0, 10);
+  const planning::Plan back = constant_velocity(0.5, -0.5, 1.0, 5);
+  const planning::Plan sweep = constant_velocity(0.5, 2.0, 1.0, 5);
+  const std::vector<RobotHistory> history = {{"a", a, {{out, 0.0}, {back, 1.0}}},
+                                             {"b", b, {{sweep, 0.0}}}};
+  const double expected = std::sqrt(0.5 * 0.5 + 0.15 * 0.15) - 2 * kSphereRadius;
+  HistoryMemo memo;
+  const JointClearance c = history_clearance(history, {}, &memo);
+  EXPECT_NEAR(c.min_distance, expected, 1e-6);
+  EXPECT_NEAR(c.t, 0.0, 1e-12);
+  EXPECT_EQ(c.robot_a, "a");
+  const JointClearance latest =
+      joint_clearance({{"a", a, back, 1.0}, {"b", b, sweep, 0.0}}, {.to = 1.0});
+  EXPECT_LT(latest.min_distance, 0.0);
+  // Checked again with the same plans: every window known, the same answer.
+  const std::size_t windows = memo.size();
+  EXPECT_EQ(windows, 3u);  // before 0 s, 0–1 s, from 1 s on
+  EXPECT_NEAR(history_clearance(history, {}, &memo).min_distance, expected, 1e-12);
+  EXPECT_EQ(memo.size(), windows);
+  EXPECT_THROW(history_clearance({{"a", a, {}}}), std::invalid_argument);
 }
 
 TEST(JointClearance, PutsEveryPlanOnTheCommonClockAndHoldsItsEnds) {

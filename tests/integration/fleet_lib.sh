@@ -74,12 +74,14 @@ with_goal() {
   echo "$out"
 }
 
-# check_plans NAME=SCENE ...: each plan validates against its scene, and together they keep
+# check_plans NAME=SCENE ...: each plan validates against its scene (from its first knot: a
+# robot without states replans from where its plan in force has it), and together they keep
 # clear at and between the knots.
 check_plans() {
   local args=() item
   for item in "$@"; do
-    "$KG" validate "${item#*=}" "$WORK/${item%%=*}.json" >"$WORK/validate.out" 2>&1 \
+    "$KG" validate --start-from-plan "${item#*=}" "$WORK/${item%%=*}.json" \
+      >"$WORK/validate.out" 2>&1 \
       || fail "${item%%=*}'s plan does not validate: $(grep -A3 failures "$WORK/validate.out")"
     args+=("${item#*=}" "$WORK/${item%%=*}.json")
   done

@@ -3,7 +3,8 @@
 # real UDP multicast in a private network namespace: each plans around the other under the
 # coordination rule (docs/multi_robot.md). Checked: both plans validate and, checked together at
 # and between the knots, keep clear; then left's goal moves keeping its priority and right
-# replans incrementally around left's new plan, still clear; a later goal of left's makes left
+# replans around left's new plan from where its own plan has it (warm-started from that motion
+# continued), still clear; a later goal of left's makes left
 # yield to right; then right is killed, left reports it silent, and the restarted right is
 # picked up again.
 # Usage: fleet_pair_udpm_test.sh BUILD_DIR SOURCE_DIR. Exit 77 (skipped) when not root.
@@ -31,7 +32,8 @@ grep -q "neighbours: right: [^;]*held at its state" "$WORK/probe.out" \
 echo "PASS: crossing goals"
 
 # 2. Left's goal moves, keeping its priority (the same goal time): left replans for its own
-# goal, right replans around left's new plan, incrementally.
+# goal, right replans around left's new plan. Without states each robot is where its plan in
+# force has it: the replan starts there, warm-started from that motion continued in time.
 watch --robot "LEFT=$LEFT" --robot "RIGHT=$RIGHT" --newer "LEFT=$(current_plan LEFT)" \
   --newer "RIGHT=$(current_plan RIGHT)"
 send_goal left 2 "-0.4,0.6,0,-1.4,0,0.8,0" "$LEFT" "$LEFT_GOAL_UTIME"
@@ -39,8 +41,8 @@ await_settled
 check_plans "left=$(with_goal "$LEFT" "-0.4,0.6,0,-1.4,0,0.8,0" left2)" "right=$RIGHT"
 grep -q "^RIGHT: .* [1-9][0-9]* neighbour replans" "$WORK/probe.out" \
   || fail "right did not count a neighbour replan"
-grep -q "^RIGHT: plan [0-9]* (incremental" "$WORK/probe.out" \
-  || fail "right's replan around left's new plan was not incremental"
+grep -q "^RIGHT: plan [0-9]* (warm-start" "$WORK/probe.out" \
+  || fail "right's replan around left's new plan was not warm-started from its own motion"
 echo "PASS: a neighbour's goal moved"
 
 # 3. A later goal of left's makes it yield: it plans around right's plan, right keeps its own.
