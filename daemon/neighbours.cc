@@ -351,6 +351,12 @@ std::optional<fleet::Blocker> Neighbours::blocker(const fleet::Decision& decisio
       } else if (const std::optional<Eigen::VectorXd> q =
                      held_q_locked(i, origin_utime + std::llround(wait_s * 1e6))) {
         other.plan = fleet::standing_plan(*q);
+        // Without a measured state it goes on along its plan in force (held_q_locked): a wait
+        // for that plan's end finds it standing there.
+        if (!h.state && h.plan) {
+          b.moving = true;
+          b.plan_end = fleet::clock_offset(h.plan_start_utime, origin_utime) + h.plan->t.back();
+        }
       } else {
         continue;
       }

@@ -82,14 +82,15 @@ WaitPlan wait_for(double blocking_end, double own_start, double horizon) {
 Remedy remedy(const std::string& own, const Blocker& blocker, double own_start, double horizon,
               const std::string& no_wait, const std::string& why) {
   Remedy r;
+  const bool moves = blocker.treatment == Treatment::kAlongPlan || blocker.moving;
+  // A plan ending within a microsecond (the clock's resolution) has ended.
+  if (moves && no_wait.empty() && blocker.plan_end > own_start + 1e-6) {
+    r.kind = Remedy::Kind::kWait;
+    r.wait = wait_for(blocker.plan_end, 0.0, horizon);
+    r.reason = wait_note(blocker.name, r.wait.wait);
+    return r;
+  }
   if (blocker.treatment == Treatment::kAlongPlan) {
-    // A plan ending within a microsecond (the clock's resolution) has ended.
-    if (no_wait.empty() && blocker.plan_end > own_start + 1e-6) {
-      r.kind = Remedy::Kind::kWait;
-      r.wait = wait_for(blocker.plan_end, 0.0, horizon);
-      r.reason = wait_note(blocker.name, r.wait.wait);
-      return r;
-    }
     r.reason = blocked_reason(blocker.name, blocker.prefix, blocker.treatment, own_start, why);
     if (!no_wait.empty() && own_start <= 0) r.reason += " (not waiting: " + no_wait + ")";
     return r;
@@ -99,7 +100,8 @@ Remedy remedy(const std::string& own, const Blocker& blocker, double own_start, 
     r.reason = deadlock_reason(own, blocker.name, blocker.prefix, why, blocker.cycle);
     return r;
   }
-  r.reason = blocked_reason(blocker.name, blocker.prefix, blocker.treatment, 0.0, why);
+  r.reason = blocked_reason(blocker.name, blocker.prefix, blocker.treatment,
+                            blocker.moving ? own_start : 0.0, why);
   return r;
 }
 
@@ -131,7 +133,9 @@ std::string blocked_reason(const std::string& name, const std::string& prefix, T
     s += waited > 0 ? ", even after waiting " + seconds(waited) + " s for its plan to end"
                     : ", moving along its plan";
   } else {
-    s += ", held at its state";
+    s += waited > 0 ? ", held where its plan ends, even after waiting " + seconds(waited) +
+                          " s for it to get there"
+                    : ", held at its state";
   }
   return s + ": " + why;
 }

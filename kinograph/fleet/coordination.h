@@ -97,13 +97,18 @@ struct Blocker {
   std::string name;    ///< its name in this robot's configuration
   std::string prefix;  ///< its channel prefix: its name in the priority order and in reasons
   Treatment treatment = Treatment::kHeldAtState;
-  double plan_end = 0;  ///< kAlongPlan: own-clock time (s) at which its followed plan ends
+  /// Own-clock time (s) at which its plan ends: the followed plan (kAlongPlan), or the plan in
+  /// force of a held neighbour that moves along it (`moving`).
+  double plan_end = 0;
   /// Its own latest answer is a failure blocked by this robot (blocker_prefix of its reason),
   /// directly or through neighbours each blocked by the next.
   bool blocked_by_own = false;
   /// With blocked_by_own: the channel prefixes from it on, each robot blocked by the next and
   /// the last by this robot ({"B"} when it is blocked by this robot itself).
   std::vector<std::string> cycle;
+  /// kHeldAtState: it has no measured state and moves along its plan in force until `plan_end`,
+  /// where it is held after a wait (a lower-priority robot already under way).
+  bool moving = false;
 };
 
 /// What a robot whose plan ran into a neighbour does.
@@ -118,11 +123,11 @@ struct Remedy {
   std::string reason;
 };
 
-/// The rule for a blocked plan (docs/multi_robot.md). Blocked by a followed neighbour's plan
-/// that ends after `own_start` (own clock, s; the wait already taken, 0 for none), and `no_wait`
-/// empty: wait until it ends. Blocked by it after waiting, or with `no_wait` saying why the robot
-/// may not wait: fail. Blocked by a neighbour held at its state that is itself blocked by this
-/// robot: deadlock. Otherwise fail. `own` is this robot's channel prefix, `why` what the planner
+/// The rule for a blocked plan (docs/multi_robot.md). Blocked by a followed neighbour's plan, or
+/// by a held neighbour moving along its plan in force, that ends after `own_start` (own clock,
+/// s; the wait already taken, 0 for none), and `no_wait` empty: wait until it ends. Blocked by
+/// it after waiting, or with `no_wait` saying why the robot may not wait: fail. Blocked by a
+/// neighbour held at its state that is itself blocked by this robot: deadlock. Otherwise fail. `own` is this robot's channel prefix, `why` what the planner
 /// or the check found.
 Remedy remedy(const std::string& own, const Blocker& blocker, double own_start, double horizon,
               const std::string& no_wait, const std::string& why);

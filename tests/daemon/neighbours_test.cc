@@ -17,6 +17,7 @@
 #include "kinograph/lcm/message_convert.h"
 #include "kinograph/plan_t.hpp"
 #include "kinograph/planner_status_t.hpp"
+#include "kinograph/robot_state_t.hpp"
 #include "kinograph/planning/io/scene.h"
 
 namespace kinograph::daemon {
@@ -278,6 +279,53 @@ TEST_F(ReachingIntoLeftTest, HoldsALowerNeighbourWithoutStatesWhereItsPlanHasIt)
     EXPECT_EQ(b->treatment, fleet::Treatment::kHeldAtState);
     EXPECT_NE(why.find("overlap"), std::string::npos) << why;
   }
+}
+
+// A lower neighbour without states that is under way, reaching into left only while it moves
+// (5.3–5.7 s): a blocker that moves, waited for until its plan ends (6 s), after which it stands
+// at its plan's end, clear. A robot with measured states is where they say: not "moving".
+TEST_F(ReachingIntoLeftTest, WaitsForALowerNeighbourUnderWayUntilItsPlanEnds) {
+  send("RIGHT_PLANNER_STATUS", heartbeat(3'000'000));  // later than left's goal: lower
+  plan_t out_and_back = moving_plan(3, spec_.start_q, spec_.start_q);
+  for (std::size_t k = 4; k <= 6; ++k) {
+    for (int j = 0; j < spec_.model->nq(); ++j) out_and_back.q[k][j] = into[j];
+  }
+  send("RIGHT_PLAN", out_and_back);
+  const fleet::Decision d = neighbours_->decide({2'000'000, ""}, true);
+  ASSERT_EQ(d.treatment[0], fleet::Treatment::kHeldAtState);
+  const planning::Plan standing = fleet::standing_plan(left.problem.start_q);
+  std::string why;
+  const std::optional<fleet::Blocker> b =
+      neighbours_->blocker(d, 5'500'000, *left.problem.model, standing, 0.0, 0.0, 0.0, why);
+  ASSERT_TRUE(b.has_value());
+  EXPECT_EQ(b->treatment, fleet::Treatment::kHeldAtState);
+  EXPECT_TRUE(b->moving);
+  EXPECT_NEAR(b->plan_end, 0.5, 1e-9);  // its plan ends at 6 s, 0.5 s after left's knot 0
+  const fleet::Remedy r = fleet::remedy("LEFT", *b, 0.0, 3.0, "", why);
+  ASSERT_EQ(r.kind, fleet::Remedy::Kind::kWait) << r.reason;
+  EXPECT_NEAR(r.wait.wait, 0.5, 1e-9);
+  EXPECT_FALSE(neighbours_->blocker(d, 5'500'000, *left.problem.model, standing, r.wait.wait,
+                                    0.0, 0.0, why))
+      << why;
+  // Still blocked once its plan has ended: no second wait, a failure naming it.
+  const fleet::Remedy after = fleet::remedy("LEFT", *b, 0.5, 3.0, "", why);
+  EXPECT_EQ(after.kind, fleet::Remedy::Kind::kFail);
+  EXPECT_NE(after.reason.find("held where its plan ends, even after waiting 0.500 s"),
+            std::string::npos)
+      << after.reason;
+  // With a measured state it stands where the state says, not on its plan: nothing to wait for.
+  robot_state_t state{};
+  state.utime = 5'400'000;
+  state.robot = spec_.model->name;
+  state.num_joints = spec_.model->nq();
+  for (int j = 0; j < spec_.model->nq(); ++j) state.joint_name.push_back(spec_.model->bodies[j].joint_name);
+  state.position.assign(into.data(), into.data() + into.size());
+  state.velocity.assign(into.size(), 0.0);
+  send("RIGHT_STATE", state);
+  const std::optional<fleet::Blocker> measured =
+      neighbours_->blocker(d, 5'500'000, *left.problem.model, standing, 0.0, 0.0, 0.0, why);
+  ASSERT_TRUE(measured.has_value());
+  EXPECT_FALSE(measured->moving);
 }
 
 TEST_F(NeighboursTest, TriesARefusedGoalAgainOncePerNewPlanOfItsBlockerFollowingIt) {

@@ -249,6 +249,20 @@ TEST(Remedy, FailsWhenStillBlockedAfterWaitingOrWhenWaitingIsOff) {
   EXPECT_NE(off.reason.find("waiting is off"), std::string::npos) << off.reason;
 }
 
+TEST(Remedy, WaitsForAHeldNeighbourUnderWayThenFailsOrFindsTheDeadlock) {
+  Blocker b{"right", "RIGHT", Treatment::kHeldAtState, 1.5, false, {}, /*moving=*/true};
+  const Remedy r = remedy("LEFT", b, 0.0, 3.0, "", "overlap");
+  ASSERT_EQ(r.kind, Remedy::Kind::kWait);
+  EXPECT_DOUBLE_EQ(r.wait.wait, 1.5);
+  EXPECT_DOUBLE_EQ(r.wait.horizon, 4.5);
+  EXPECT_EQ(remedy("LEFT", b, 0.0, 3.0, "waiting is off", "overlap").kind, Remedy::Kind::kFail);
+  const Remedy after = remedy("LEFT", b, 1.5, 3.0, "", "overlap");
+  EXPECT_EQ(after.kind, Remedy::Kind::kFail);
+  EXPECT_EQ(blocker_prefix(after.reason), "RIGHT");
+  b.blocked_by_own = true;  // standing where its plan ended, it waits for this robot
+  EXPECT_EQ(remedy("LEFT", b, 1.5, 3.0, "", "overlap").kind, Remedy::Kind::kDeadlock);
+}
+
 TEST(Remedy, AHeldNeighbourBlockedByThisRobotIsADeadlockNamingBoth) {
   Blocker b{"right", "RIGHT", Treatment::kHeldAtState, 0.0, false, {}};
   const Remedy blocked = remedy("LEFT", b, 0.0, 3.0, "", "goal overlaps it");

@@ -33,7 +33,9 @@ echo "PASS: crossing goals"
 
 # 2. Left's goal moves, keeping its priority (the same goal time): left replans for its own
 # goal, right replans around left's new plan. Without states each robot is where its plan in
-# force has it: the replan starts there, warm-started from that motion continued in time.
+# force has it: the replan starts there, warm-started from that motion continued in time. Where
+# right stands then depends on when the goal comes; if it is in the way, left waits for right's
+# plan to end (a lower robot already under way), so the outcome does not.
 watch --robot "LEFT=$LEFT" --robot "RIGHT=$RIGHT" --newer "LEFT=$(current_plan LEFT)" \
   --newer "RIGHT=$(current_plan RIGHT)"
 send_goal left 2 "-0.4,0.6,0,-1.4,0,0.8,0" "$LEFT" "$LEFT_GOAL_UTIME"
