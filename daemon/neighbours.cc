@@ -173,6 +173,7 @@ void Neighbours::on_state(std::size_t i, const lcm::ReceiveBuffer* rbuf) {
     std::lock_guard lock(mutex_);
     Heard& h = heard_[i];
     h.state = state.q;
+    h.state_utime = msg.utime;
     h.last_heard = std::chrono::steady_clock::now();
     if (h.silent) {
       h.silent = false;
@@ -290,13 +291,13 @@ void Neighbours::add_obstacles(const fleet::Decision& decision, std::int64_t ori
     const fleet::Neighbour n{specs_[i].name, specs_[i].model};
     const int slot = static_cast<int>(i) * kMaxBodies;
     std::vector<fleet::NeighbourBody> bodies;
-    if (decision.treatment[i] == fleet::Treatment::kAlongPlan && h.plan) {
+    if (const planning::Plan* followed = followed_plan_locked(decision, i)) {
       // Moving bodies get new ids every time: the planner keeps a moving obstacle whose id it
       // knows, so a new plan of the neighbour must come as new obstacles.
       const int first = kFirstObstacleId + (1 << 20) +
                         static_cast<int>(rebuilds_ % 1000) * kMaxNeighbours * kMaxBodies + slot;
       bodies =
-          fleet::bodies_along(n, *h.plan, fleet::clock_offset(h.plan_start_utime, origin_utime),
+          fleet::bodies_along(n, *followed, fleet::clock_offset(h.plan_start_utime, origin_utime),
                               fleet::SweepOptions{.first_id = first});
     } else if (const std::optional<Eigen::VectorXd> q = held_q_locked(i, origin_utime)) {
       bodies = fleet::bodies_at(n, *q, kFirstObstacleId + slot);
@@ -306,6 +307,15 @@ void Neighbours::add_obstacles(const fleet::Decision& decision, std::int64_t ori
       obstacles.push_back(std::move(b.obstacle));
     }
   }
+}
+
+const planning::Plan* Neighbours::followed_plan_locked(const fleet::Decision& decision,
+                                                       std::size_t i) const {
+  const Heard& h = heard_[i];
+  if (decision.treatment[i] != fleet::Treatment::kAlongPlan || !h.plan) return nullptr;
+  const std::int64_t end = h.plan_start_utime + std::llround(h.plan->t.back() * 1e6);
+  if (h.state && h.state_utime > end) return nullptr;
+  return &*h.plan;
 }
 
 std::optional<Eigen::VectorXd> Neighbours::held_q_locked(std::size_t i, std::int64_t utime) const {
@@ -344,13 +354,14 @@ std::optional<fleet::Blocker> Neighbours::blocker(const fleet::Decision& decisio
       fleet::Blocker b{specs_[i].name, specs_[i].channel_prefix, decision.treatment[i], 0.0,
                        false, blocking_cycle_locked(i)};
       b.blocked_by_own = !b.cycle.empty();
-      if (decision.treatment[i] == fleet::Treatment::kAlongPlan && h.plan) {
-        other.plan = *h.plan;
+      if (const planning::Plan* followed = followed_plan_locked(decision, i)) {
+        other.plan = *followed;
         other.offset = fleet::clock_offset(h.plan_start_utime, origin_utime);
         b.plan_end = other.offset + h.plan->t.back();
       } else if (const std::optional<Eigen::VectorXd> q =
                      held_q_locked(i, origin_utime + std::llround(wait_s * 1e6))) {
         other.plan = fleet::standing_plan(*q);
+        b.treatment = fleet::Treatment::kHeldAtState;
         // Without a measured state it goes on along its plan in force (held_q_locked): a wait
         // for that plan's end finds it standing there.
         if (!h.state && h.plan) {

@@ -125,6 +125,7 @@ class Neighbours {
     std::int64_t generation = 0;  // local count of the valid plans received (ids may restart)
     std::int64_t plan_id = -1;    // as the neighbour numbers it
     std::optional<Eigen::VectorXd> state;
+    std::int64_t state_utime = 0;  // its measurement time on the common clock
     std::int64_t goal_utime = std::numeric_limits<std::int64_t>::max();
     std::string mismatch;    // why its heartbeat does not fit the scene, or empty
     std::string blocked_by;  // prefix its latest failure names as blocker (fleet::blocker_prefix)
@@ -138,6 +139,9 @@ class Neighbours {
   // else where its latest plan has it then, else its scene's start; none without any. Caller
   // holds mutex_.
   std::optional<Eigen::VectorXd> held_q_locked(std::size_t i, std::int64_t utime) const;
+  // Its plan to move along, when the decision follows it: none once a measured state newer than
+  // the plan's end says where the robot is now. Caller holds mutex_.
+  const planning::Plan* followed_plan_locked(const fleet::Decision& decision, std::size_t i) const;
   // blocking_cycle of neighbour i. Caller holds mutex_.
   std::vector<std::string> blocking_cycle_locked(std::size_t i) const;
   // Marks neighbours silent after the timeout; true when one became silent. Caller holds mutex_.

@@ -23,7 +23,9 @@ Decision coordinate(const PriorityKey& own, const std::vector<NeighbourView>& ne
   std::string trigger;
   for (const NeighbourView& n : neighbours) {
     const bool higher = outranks(n.key, own);
-    const bool follow = higher && !n.silent && n.plan_id.has_value();
+    // Every plan in force is planned around, whatever its robot's priority: a plan made now must
+    // keep clear of the motions under way until their robots react to it.
+    const bool follow = !n.silent && n.plan_id.has_value();
     d.treatment.push_back(follow ? Treatment::kAlongPlan : Treatment::kHeldAtState);
     const std::int64_t entry = follow ? *n.plan_id : kHeldMark;
     d.around[n.name] = entry;

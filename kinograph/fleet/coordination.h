@@ -23,8 +23,8 @@ bool outranks(const PriorityKey& a, const PriorityKey& b);
 
 /// How a robot plans around one neighbour.
 enum class Treatment {
-  kAlongPlan,   ///< a higher-priority neighbour with a plan: its bodies move along that plan
-  kHeldAtState  ///< a lower-priority, silent or planless neighbour: held still at its state
+  kAlongPlan,   ///< a neighbour with a plan in force: its bodies move along that plan
+  kHeldAtState  ///< a silent or planless neighbour: held still at its state
 };
 
 /// "along plan" or "held at state".
@@ -68,8 +68,8 @@ struct Decision {
   std::vector<std::optional<std::int64_t>> plans;
 };
 
-/// The rule: higher-priority neighbours with a plan are followed along it, the others held at
-/// their state; replan when the own goal changed or a neighbour's entry in `around` would differ
+/// The rule: neighbours with a plan in force are followed along it, the others held at their
+/// state; replan when the own goal changed or a neighbour's entry in `around` would differ
 /// from what `planned` says for a higher-priority neighbour (a new plan, a neighbour gone silent
 /// or newly higher), never for a change of a lower-priority one. `planned` is what the latest
 /// attempt at the goal was planned around (valid or not), empty before the first. With

@@ -120,18 +120,62 @@ TEST_F(NeighboursTest, FollowsAHigherNeighboursPlanAndNamesItsBodies) {
   EXPECT_TRUE(neighbours_->decide({2'000'000, ""}, false).replan);
 }
 
-TEST_F(NeighboursTest, HoldsALowerNeighbourAtItsState) {
+TEST_F(NeighboursTest, HoldsALowerNeighbourWithoutAPlanAndFollowsItsPlanWithoutReplanningForIt) {
   send("RIGHT_PLANNER_STATUS", heartbeat(3'000'000));
-  send("RIGHT_PLAN", plan(7));
-  const fleet::Decision d = neighbours_->decide({2'000'000, ""}, true);
+  fleet::Decision d = neighbours_->decide({2'000'000, ""}, true);
   EXPECT_EQ(d.treatment[0], fleet::Treatment::kHeldAtState);
   std::vector<collision::Obstacle> obstacles;
   neighbours_->add_obstacles(d, 4'000'000, obstacles);
   ASSERT_EQ(obstacles.size(), spec_.model->collision.size());
   for (const auto& o : obstacles) EXPECT_FALSE(o.is_moving());
+  // Its plan in force is planned around, as every neighbour's is.
+  send("RIGHT_PLAN", plan(7));
+  d = neighbours_->decide({2'000'000, ""}, true);
+  EXPECT_EQ(d.treatment[0], fleet::Treatment::kAlongPlan);
   neighbours_->planned(d, true, nullptr);
+  obstacles.clear();
+  neighbours_->add_obstacles(d, 4'000'000, obstacles);
+  EXPECT_TRUE(std::any_of(obstacles.begin(), obstacles.end(),
+                          [](const collision::Obstacle& o) { return o.is_moving(); }));
   send("RIGHT_PLAN", plan(8));  // it yields: no replan here
   EXPECT_FALSE(neighbours_->decide({2'000'000, ""}, false).replan);
+}
+
+// A measured state newer than the end of a neighbour's plan says where it is now (a robot moved
+// by hand, a restarted one): it is held there, not at the plan's last knot.
+TEST_F(NeighboursTest, AStateNewerThanTheEndOfItsPlanWins) {
+  send("RIGHT_PLANNER_STATUS", heartbeat(3'000'000));
+  send("RIGHT_PLAN", plan(7));  // 5–6 s on the common clock
+  const fleet::Decision d = neighbours_->decide({2'000'000, ""}, true);
+  ASSERT_EQ(d.treatment[0], fleet::Treatment::kAlongPlan);
+  Eigen::VectorXd elsewhere = spec_.start_q;
+  elsewhere[0] += 0.5;
+  robot_state_t state{};
+  state.robot = spec_.model->name;
+  state.num_joints = spec_.model->nq();
+  for (int j = 0; j < spec_.model->nq(); ++j) state.joint_name.push_back(spec_.model->bodies[j].joint_name);
+  state.position.assign(elsewhere.data(), elsewhere.data() + elsewhere.size());
+  state.velocity.assign(elsewhere.size(), 0.0);
+  const auto moving_bodies = [&] {
+    std::vector<collision::Obstacle> obstacles;
+    neighbours_->add_obstacles(d, 7'000'000, obstacles);
+    return std::count_if(obstacles.begin(), obstacles.end(),
+                         [](const collision::Obstacle& o) { return o.is_moving(); });
+  };
+  state.utime = 5'500'000;  // during the plan: the plan is followed
+  send("RIGHT_STATE", state);
+  EXPECT_GT(moving_bodies(), 0);
+  state.utime = 6'500'000;  // after it ended
+  send("RIGHT_STATE", state);
+  EXPECT_EQ(moving_bodies(), 0);
+  const std::vector<fleet::NeighbourBody> at_state =
+      fleet::bodies_at({"right", spec_.model}, elsewhere, Neighbours::kFirstObstacleId);
+  std::vector<collision::Obstacle> obstacles;
+  neighbours_->add_obstacles(d, 7'000'000, obstacles);
+  ASSERT_EQ(obstacles.size(), at_state.size());
+  for (std::size_t g = 0; g < obstacles.size(); ++g) {
+    EXPECT_TRUE(obstacles[g].pose.isApprox(at_state[g].obstacle.pose, 1e-12)) << "body " << g;
+  }
 }
 
 TEST_F(NeighboursTest, ReportsAHeartbeatThatDoesNotFitTheScene) {
@@ -245,14 +289,14 @@ TEST_F(ReachingIntoLeftTest, ChecksAPlanFromNoStateAgainstWhatAFollowedPlanDidBe
   EXPECT_NE(why.find("at t = -"), std::string::npos) << why;
 }
 
-// A lower neighbour heard publishing plans but no states moves along them (its daemon plans its
-// next one from where they have it): held still, it stands where its latest plan has it at the
-// own plan's start, not back where that plan started.
-TEST_F(ReachingIntoLeftTest, HoldsALowerNeighbourWithoutStatesWhereItsPlanHasIt) {
+// A neighbour heard publishing plans but no states moves along them (its daemon plans its next
+// one from where they have it): held still (as when it has gone silent), it stands where its
+// latest plan has it at the own plan's start, not back where that plan started.
+TEST_F(ReachingIntoLeftTest, HoldsANeighbourWithoutStatesWhereItsPlanHasIt) {
   send("RIGHT_PLANNER_STATUS", heartbeat(3'000'000));  // later than left's goal: lower
   send("RIGHT_PLAN", moving_plan(3, spec_.start_q, into));  // 5–6 s: ends reaching into left
-  const fleet::Decision d = neighbours_->decide({2'000'000, ""}, true);
-  ASSERT_EQ(d.treatment[0], fleet::Treatment::kHeldAtState);
+  fleet::Decision d = neighbours_->decide({2'000'000, ""}, true);
+  d.treatment[0] = fleet::Treatment::kHeldAtState;  // as a silent neighbour is
   const auto held_at = [&](int64_t origin_utime, const Eigen::VectorXd& q) {
     std::vector<collision::Obstacle> obstacles;
     neighbours_->add_obstacles(d, origin_utime, obstacles);
@@ -281,18 +325,19 @@ TEST_F(ReachingIntoLeftTest, HoldsALowerNeighbourWithoutStatesWhereItsPlanHasIt)
   }
 }
 
-// A lower neighbour without states that is under way, reaching into left only while it moves
-// (5.3–5.7 s): a blocker that moves, waited for until its plan ends (6 s), after which it stands
-// at its plan's end, clear. A robot with measured states is where they say: not "moving".
-TEST_F(ReachingIntoLeftTest, WaitsForALowerNeighbourUnderWayUntilItsPlanEnds) {
+// A neighbour without states held still (as a silent one is) while it is under way, reaching
+// into left only while it moves (5.3–5.7 s): a blocker that moves, waited for until its plan ends
+// (6 s), after which it stands at its plan's end, clear. A robot with measured states is where
+// they say: not "moving".
+TEST_F(ReachingIntoLeftTest, WaitsForAHeldNeighbourUnderWayUntilItsPlanEnds) {
   send("RIGHT_PLANNER_STATUS", heartbeat(3'000'000));  // later than left's goal: lower
   plan_t out_and_back = moving_plan(3, spec_.start_q, spec_.start_q);
   for (std::size_t k = 4; k <= 6; ++k) {
     for (int j = 0; j < spec_.model->nq(); ++j) out_and_back.q[k][j] = into[j];
   }
   send("RIGHT_PLAN", out_and_back);
-  const fleet::Decision d = neighbours_->decide({2'000'000, ""}, true);
-  ASSERT_EQ(d.treatment[0], fleet::Treatment::kHeldAtState);
+  fleet::Decision d = neighbours_->decide({2'000'000, ""}, true);
+  d.treatment[0] = fleet::Treatment::kHeldAtState;  // as a silent neighbour is
   const planning::Plan standing = fleet::standing_plan(left.problem.start_q);
   std::string why;
   const std::optional<fleet::Blocker> b =

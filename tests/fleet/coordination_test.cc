@@ -1,5 +1,5 @@
-// The coordination rule: a strict priority order (goal time, then name); higher-priority
-// neighbours followed along their plans, the others held; a replan only for the own goal or a
+// The coordination rule: a strict priority order (goal time, then name); every neighbour's plan
+// in force followed, silent and planless neighbours held; a replan only for the own goal or a
 // higher-priority neighbour's change, once per change; and a fleet that settles within N − 1
 // rounds after every robot gets a new goal (random goal times and plan churn, seeded); a goal
 // refused after or before a higher plan came; a blocked goal tried again once per new plan of its
@@ -25,7 +25,7 @@ TEST(Priority, EarlierGoalFirstThenName) {
   EXPECT_TRUE(outranks(late, PriorityKey{.robot = "abe"}));  // no goal: last
 }
 
-TEST(Coordinate, FollowsHigherNeighboursAndHoldsTheOthers) {
+TEST(Coordinate, FollowsEveryPlanInForceAndHoldsTheOthers) {
   const PriorityKey own{200, "mid"};
   const std::vector<NeighbourView> n = {{"first", {100, "first"}, 7, false},
                                         {"last", {300, "last"}, 9, false},
@@ -34,10 +34,10 @@ TEST(Coordinate, FollowsHigherNeighboursAndHoldsTheOthers) {
   const Decision d = coordinate(own, n, {}, true);
   EXPECT_TRUE(d.replan);
   EXPECT_EQ(d.treatment,
-            (std::vector<Treatment>{Treatment::kAlongPlan, Treatment::kHeldAtState,
+            (std::vector<Treatment>{Treatment::kAlongPlan, Treatment::kAlongPlan,
                                     Treatment::kHeldAtState, Treatment::kHeldAtState}));
   EXPECT_EQ(d.around.at("first"), 7);
-  EXPECT_EQ(d.around.at("last"), kHeldMark);
+  EXPECT_EQ(d.around.at("last"), 9);  // lower, but under way: followed, never a trigger
   EXPECT_EQ(d.around.at("quiet"), kHeldMark);
 }
 
@@ -135,7 +135,7 @@ TEST(Coordinate, RetriesABlockedGoalOncePerNewPlanOfTheBlockerWhateverItsPriorit
   const Decision d = coordinate(own, n, tried, false, &blocked);
   EXPECT_TRUE(d.replan);
   EXPECT_TRUE(d.retry);
-  EXPECT_EQ(d.treatment, (std::vector<Treatment>{Treatment::kAlongPlan, Treatment::kHeldAtState}));
+  EXPECT_EQ(d.treatment, (std::vector<Treatment>{Treatment::kAlongPlan, Treatment::kAlongPlan}));
   EXPECT_EQ(d.around.at("low"), 5);
   EXPECT_EQ(d.plans, (std::vector<std::optional<std::int64_t>>{5, 3}));
   EXPECT_NE(d.reason.find("neighbour 'low', which blocked the goal, has plan 5"), std::string::npos)
@@ -154,7 +154,7 @@ TEST(Coordinate, RetriesABlockedGoalOncePerNewPlanOfTheBlockerWhateverItsPriorit
   n[0].silent = false;
   const Decision goal = coordinate(own, n, d.around, true, &blocked);  // a new goal: no retry
   EXPECT_FALSE(goal.retry);
-  EXPECT_EQ(goal.treatment[0], Treatment::kHeldAtState);
+  EXPECT_TRUE(goal.replan);
 }
 
 TEST(Coordinate, AHigherBlockersNewPlanIsTheRulesReplanNotARetry) {
