@@ -457,8 +457,11 @@ std::string Neighbours::summary() const {
     } else if (h.plan) {
       os << "plan " << h.plan_id;
       const auto it = planned_.find(specs_[i].name);
-      os << (it != planned_.end() && it->second == h.generation ? ", followed"
-                                                                : ", held at its state");
+      // What the own valid plan was made around: this plan, an older one, or it standing.
+      const bool around_plan = it != planned_.end() && it->second != fleet::kHeldMark;
+      os << (around_plan && it->second == h.generation ? ", followed"
+             : around_plan                             ? ", an earlier plan followed"
+                                                       : ", held at its state");
     } else {
       os << "no plan, held at its state";
     }

@@ -1,5 +1,5 @@
-// A daemon's neighbours over an in-process memq:// LCM: a neighbour's valid plan is followed when
-// it has priority and held at its state otherwise, its bodies are named in reasons, a heartbeat
+// A daemon's neighbours over an in-process memq:// LCM: a neighbour's valid plan is followed,
+// whatever its priority, and one without a plan held at its state; its bodies are named in reasons, a heartbeat
 // whose model or base does not fit its scene is reported, failure answers change nothing, and
 // a goal refused by a neighbour is tried again once per new plan of it, following it, up to the
 // bound.
