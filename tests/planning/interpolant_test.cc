@@ -211,7 +211,7 @@ TEST(IntervalDynamicsFactor, JacobiansUnderactuated) {
   expect_raw_jacobians(testing::acrobot_model(), 3, 21);
 }
 // The batch planner's warm-up rows: two RK4 steps per interval, check points between the nodes
-// (each reached by a shorter step).
+// (read from the Hermite of the two nodes).
 TEST(IntervalDynamicsFactor, JacobiansWithTheWarmUpStep) {
   expect_raw_jacobians(testing::acrobot_model(), 4, 23, 0.05);
 }
