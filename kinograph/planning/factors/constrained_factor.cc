@@ -132,16 +132,18 @@ void ConstrainedFactor::compute_at(const graph::Values& values,
 }
 
 void ConstrainedFactor::cache_evaluations() {
-  kept_ = std::make_unique<Evaluation>();
-  kept_->x.resize(jacobian_cols());
-  kept_->z.resize(residual_dim());
-  kept_->J.resize(residual_dim(), jacobian_cols());
-  kept_->filled.assign(static_cast<size_t>(residual_dim()), 0);
+  kept_.resize(2);
+  for (Evaluation& k : kept_) {
+    k.x.resize(jacobian_cols());
+    k.z.resize(residual_dim());
+  }
+  kept_[1].J.resize(residual_dim(), jacobian_cols());
+  kept_[1].filled.assign(static_cast<size_t>(residual_dim()), 0);
 }
 
 bool ConstrainedFactor::reusable(const graph::FactorValues& x, bool with_jacobian) const {
-  const Evaluation& k = *kept_;
-  if (!k.valid || (with_jacobian && !k.with_jacobian)) return false;
+  const Evaluation& k = kept_[with_jacobian ? 1 : 0];
+  if (!k.valid) return false;
   for (size_t b = 0; b < keys().size(); ++b) {
     const int i = static_cast<int>(b);
     const size_t bytes = sizeof(double) * static_cast<size_t>(dims()[b]);
@@ -157,11 +159,11 @@ bool ConstrainedFactor::reusable(const graph::FactorValues& x, bool with_jacobia
 void ConstrainedFactor::cached_compute(const graph::FactorValues& x,
                                        Eigen::Ref<Eigen::VectorXd> z,
                                        const graph::Jacobians* J) const {
-  if (!kept_) {
+  if (kept_.empty()) {
     compute(x, z, J);
     return;
   }
-  Evaluation& k = *kept_;
+  Evaluation& k = kept_[J != nullptr ? 1 : 0];
   const auto& offsets = block_offsets();
   if (reusable(x, J != nullptr)) {
     z = k.z;
@@ -178,7 +180,6 @@ void ConstrainedFactor::cached_compute(const graph::FactorValues& x,
   }
   k.z = z;
   k.valid = true;
-  k.with_jacobian = J != nullptr;
   if (J == nullptr) return;
   for (size_t b = 0; b < keys().size(); ++b) {
     k.J.middleCols(offsets[b], dims()[b]) = J->block(static_cast<int>(b));

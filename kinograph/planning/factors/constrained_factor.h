@@ -128,20 +128,20 @@ class ConstrainedFactor : public graph::Factor {
   /// the whitened Jacobian is then constant between penalty changes (Factor::jacobian_version).
   /// Throws std::logic_error if a row is a bound.
   void declare_linear();
-  /// For a subclass whose compute() is expensive (the dynamics rows): the last evaluation is
-  /// kept and reused while the variables are bitwise the same. The outer loop evaluates every
-  /// factor at the point LM stopped at three times (the last trial, the multiplier update, the
-  /// next solve's start), and only the multipliers differ between them.
+  /// For a subclass whose compute() is expensive (the dynamics rows): the last evaluation with
+  /// and the last without Jacobians are kept and reused while the variables are bitwise the
+  /// same, so results are those of compute(). The outer loop linearizes at the point LM stopped
+  /// at twice (its last trial, the next solve's start); only the multipliers differ between.
   void cache_evaluations();
 
  private:
-  // The last raw evaluation: inputs (keys concatenated), z and, when asked, dz/dx with the
-  // rows compute() filled (an inactive bound's row may be left unfilled).
+  // A kept raw evaluation: inputs (keys concatenated), z and, in the one with Jacobians,
+  // dz/dx with the rows compute() filled (an inactive bound's row may be left unfilled).
   struct Evaluation {
     Eigen::VectorXd x, z;
     Eigen::MatrixXd J;
     std::vector<char> filled;
-    bool valid = false, with_jacobian = false;
+    bool valid = false;
   };
   // compute(), or the kept evaluation when it is at the same x and has every Jacobian row
   // needed now (called while this factor is evaluating, so inactive rows are known).
@@ -157,7 +157,8 @@ class ConstrainedFactor : public graph::Factor {
   int num_constraints_ = 0;
   std::shared_ptr<const Multipliers> m_;  // null until bound
   double penalty_read_ = 1;               // μ of the last bind or penalty_changed
-  mutable std::unique_ptr<Evaluation> kept_;  // null unless cache_evaluations()
+  // Empty unless cache_evaluations(); else the last evaluation without, then with, Jacobians.
+  mutable std::vector<Evaluation> kept_;
 };
 
 }  // namespace kinograph::planning
