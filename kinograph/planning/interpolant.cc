@@ -19,7 +19,7 @@ int limit_points(int requested, double dt) {
 }
 
 IntervalInterpolant::IntervalInterpolant(const dynamics::Model& model, double max_step)
-    : model_(model), max_step_(max_step), data_(model) {
+    : model_(model), max_step_(max_step), coarse_(max_step > kMaxIntegrationStep), data_(model) {
   if (!(max_step > 0)) throw std::invalid_argument("interpolant: the RK4 step must be > 0");
   for (int j = 0; j < model.nq(); ++j) {
     (model.bodies[j].actuated ? actuated_ : unactuated_).push_back(j);
@@ -119,10 +119,39 @@ void IntervalInterpolant::point(double s, const Eigen::VectorXd& y, const Eigen:
   }
 }
 
+void IntervalInterpolant::slope(double s, const Eigen::VectorXd& y, const Eigen::MatrixXd& S,
+                                bool derivatives, Eigen::VectorXd& k, Eigen::MatrixXd& dk) {
+  const int m = static_cast<int>(unactuated_.size());
+  point(s, y, S, derivatives, false, stage_);
+  for (int a = 0; a < m; ++a) {
+    const int u = unactuated_[a];
+    k[a] = stage_.qd[u];
+    k[m + a] = stage_.qdd[u];
+    if (derivatives) {
+      dk.row(a) = stage_.dqd.row(u);
+      dk.row(m + a) = stage_.dqdd.row(u);
+    }
+  }
+}
+
+void IntervalInterpolant::hermite(int node, double rest, bool derivatives) {
+  const int want = derivatives ? 2 : 1;
+  if (node + 1 == steps_ && end_slope_ < want) {
+    slope(steps_ * h_, y_[steps_], S_[steps_], derivatives, f_[steps_], df_[steps_]);
+    end_slope_ = want;
+  }
+  const double t = rest / h_, t2 = t * t, t3 = t2 * t;
+  const double c0 = 2 * t3 - 3 * t2 + 1, c1 = (t3 - 2 * t2 + t) * h_, c2 = 3 * t2 - 2 * t3,
+               c3 = (t3 - t2) * h_;
+  y_part_ = c0 * y_[node] + c1 * f_[node] + c2 * y_[node + 1] + c3 * f_[node + 1];
+  if (derivatives) {
+    S_part_ = c0 * S_[node] + c1 * df_[node] + c2 * S_[node + 1] + c3 * df_[node + 1];
+  }
+}
+
 void IntervalInterpolant::rk4_step(double s, double len, const Eigen::VectorXd& y,
                                    const Eigen::MatrixXd& S, bool derivatives, Eigen::VectorXd& y1,
                                    Eigen::MatrixXd& S1) {
-  const int m = static_cast<int>(unactuated_.size());
   // Forward-mode RK4: each stage's slope ẏ = [q̇_u; q̈_u] and its total derivative dẏ/dz.
   const double c[4] = {0, 0.5, 0.5, 1};
   for (int i = 0; i < 4; ++i) {
@@ -133,16 +162,7 @@ void IntervalInterpolant::rk4_step(double s, double len, const Eigen::VectorXd& 
       ys_ = y + c[i] * len * k_[i - 1];
       if (derivatives) Ss_ = S + c[i] * len * dk_[i - 1];
     }
-    point(s + c[i] * len, ys_, Ss_, derivatives, false, stage_);
-    for (int a = 0; a < m; ++a) {
-      const int u = unactuated_[a];
-      k_[i][a] = stage_.qd[u];
-      k_[i][m + a] = stage_.qdd[u];
-      if (derivatives) {
-        dk_[i].row(a) = stage_.dqd.row(u);
-        dk_[i].row(m + a) = stage_.dqdd.row(u);
-      }
-    }
+    slope(s + c[i] * len, ys_, Ss_, derivatives, k_[i], dk_[i]);
   }
   y1 = y + len / 6 * (k_[0] + 2 * k_[1] + 2 * k_[2] + k_[3]);
   if (derivatives) S1 = S + len / 6 * (dk_[0] + 2 * dk_[1] + 2 * dk_[2] + dk_[3]);
@@ -171,7 +191,12 @@ void IntervalInterpolant::start(const Eigen::Ref<const Eigen::VectorXd>& q0,
   if (static_cast<int>(y_.size()) < steps_ + 1) {
     y_.resize(steps_ + 1, Eigen::VectorXd(2 * m));
     S_.resize(steps_ + 1, Eigen::MatrixXd(2 * m, 4 * n));
+    if (coarse_) {
+      f_.resize(steps_ + 1, Eigen::VectorXd(2 * m));
+      df_.resize(steps_ + 1, Eigen::MatrixXd(2 * m, 4 * n));
+    }
   }
+  end_slope_ = 0;
   for (int i = 0; i < m; ++i) {
     y_[0][i] = q0[unactuated_[i]];
     y_[0][m + i] = qd0[unactuated_[i]];
@@ -185,6 +210,9 @@ void IntervalInterpolant::start(const Eigen::Ref<const Eigen::VectorXd>& q0,
   }
   for (int node = 0; node < steps_; ++node) {
     rk4_step(node * h_, h_, y_[node], S_[node], derivatives, y_[node + 1], S_[node + 1]);
+    if (!coarse_) continue;
+    f_[node] = k_[0];  // the first stage's slope is the node's
+    if (derivatives) df_[node] = dk_[0];
   }
 }
 
@@ -207,7 +235,11 @@ void IntervalInterpolant::at(double s, bool derivatives, InterpolantPoint& p) {
     point(node * h_, y_[node], S_[node], derivatives, true, p);
     return;
   }
-  rk4_step(node * h_, rest, y_[node], S_[node], derivatives, y_part_, S_part_);
+  if (coarse_) {
+    hermite(node, rest, derivatives);
+  } else {
+    rk4_step(node * h_, rest, y_[node], S_[node], derivatives, y_part_, S_part_);
+  }
   point(s, y_part_, S_part_, derivatives, true, p);
 }
 

@@ -44,7 +44,9 @@ class IntervalInterpolant {
  public:
   /// Borrows `model`, which must outlive this. `max_step` is the longest RK4 step: the
   /// interpolant's kMaxIntegrationStep, or a longer one for the planner's coarse warm-up rows
-  /// (an approximation of the interpolant, never what a plan is checked on).
+  /// (an approximation of the interpolant, never what a plan is checked on). Such a coarse one
+  /// reads a time between its nodes from the cubic Hermite of the nodes' states and slopes: one
+  /// dynamics evaluation there instead of the five of a shorter RK4 step.
   explicit IntervalInterpolant(const dynamics::Model& model,
                                double max_step = kMaxIntegrationStep);
 
@@ -57,7 +59,7 @@ class IntervalInterpolant {
              const Eigen::Ref<const Eigen::VectorXd>& qdd0,
              const Eigen::Ref<const Eigen::VectorXd>& qdd1, double dt, bool derivatives);
   /// The point s seconds into the started interval (s in [0, dt]: one shorter RK4 step from the
-  /// node before s). `derivatives` also fills the d* members and needs a start() with them.
+  /// node before s, or the nodes' Hermite when coarse). `derivatives` also fills the d* members and needs a start() with them.
   /// Throws std::invalid_argument for s outside [0, dt] or derivatives without them.
   void at(double s, bool derivatives, InterpolantPoint& p);
 
@@ -83,12 +85,20 @@ class IntervalInterpolant {
   // (q, q̇, q̈ and with derivatives their d*); with_tau adds τ (and dτ).
   void point(double s, const Eigen::VectorXd& y, const Eigen::MatrixXd& S, bool derivatives,
              bool with_tau, InterpolantPoint& p);
+  // The slope ẏ = [q̇_u; q̈_u] at (s, y, S) into k and, with derivatives, its total derivative
+  // dẏ/dz into dk.
+  void slope(double s, const Eigen::VectorXd& y, const Eigen::MatrixXd& S, bool derivatives,
+             Eigen::VectorXd& k, Eigen::MatrixXd& dk);
+  // The unactuated state (and sensitivity) `rest` seconds after node `node` of a coarse
+  // interpolant, from the cubic Hermite of its two nodes, into y_part_ and S_part_.
+  void hermite(int node, double rest, bool derivatives);
   // One RK4 step of length len from (s, y, S) into (y1, S1).
   void rk4_step(double s, double len, const Eigen::VectorXd& y, const Eigen::MatrixXd& S,
                 bool derivatives, Eigen::VectorXd& y1, Eigen::MatrixXd& S1);
 
   const dynamics::Model& model_;
   double max_step_;
+  bool coarse_;  // max_step_ longer than the interpolant's: Hermite between the nodes
   dynamics::Data data_;
   std::vector<int> unactuated_, actuated_;
   // The current interval: inputs, RK4 step and the state (and sensitivity) at every node.
@@ -98,6 +108,11 @@ class IntervalInterpolant {
   bool derivatives_ = false;
   std::vector<Eigen::VectorXd> y_;
   std::vector<Eigen::MatrixXd> S_;
+  // Coarse only: the slope at every node and its derivative, the last node's made when first
+  // needed (end_slope_: 0 not yet, 1 without derivatives, 2 with).
+  std::vector<Eigen::VectorXd> f_;
+  std::vector<Eigen::MatrixXd> df_;
+  int end_slope_ = 0;
   // Scratch.
   InterpolantPoint stage_;
   Eigen::VectorXd k_[4];

@@ -211,7 +211,7 @@ TEST(IntervalDynamicsFactor, JacobiansUnderactuated) {
   expect_raw_jacobians(testing::acrobot_model(), 3, 21);
 }
 // The batch planner's warm-up rows: two RK4 steps per interval, check points between the nodes
-// (each reached by a shorter step).
+// (read from the Hermite of the two nodes).
 TEST(IntervalDynamicsFactor, JacobiansWithTheWarmUpStep) {
   expect_raw_jacobians(testing::acrobot_model(), 4, 23, 0.05);
 }
@@ -256,6 +256,38 @@ TEST(IntervalDynamicsFactor, LinearizationIsExactWithRowsOnAndOff) {
     const auto check = check_jacobians(f, x, c);
     EXPECT_TRUE(check.ok) << urdf << "\n" << check.report();
   }
+}
+
+// The factor keeps its last evaluation while the variables stay the same; a bound row whose
+// hinge was off then (its Jacobian row left unfilled) and is on now must not be read from it.
+TEST(IntervalDynamicsFactor, KeptEvaluationIsExactWhenRowsTurnOn) {
+  auto model = std::make_shared<dynamics::Model>(*testing::acrobot_model());
+  for (dynamics::Body& b : model->bodies) b.limits.effort = std::min(b.limits.effort, 0.5);
+  IntervalDynamicsOptions o;
+  o.checks = 5;
+  IntervalDynamicsFactor f(0, 0.1, model, o);
+  std::mt19937 rng(32);
+  const graph::Values x = off_defect_interval(model->nq(), 0.1, rng);
+  f.bind(std::make_shared<Multipliers>(f.residual_dim(), 4.0));
+  Eigen::VectorXd r, z;
+  Eigen::MatrixXd J;
+  f.linearize(x, r, J);  // kept, with the rows inside their bounds off
+  f.values_at(x, z);
+  auto on = std::make_shared<Multipliers>(f.residual_dim(), 4.0);
+  int turned_on = 0;
+  for (int i = 0; i < f.residual_dim(); ++i) {
+    const RowSpec& row = f.rows()[i];
+    if (row.kind != RowKind::kBounds || z[i] > row.upper || z[i] < row.lower) continue;
+    // On through its multiplier: √μ (z − upper)/s + λ/√μ = 1/√μ > 0.
+    on->upper[i] = on->penalty * (row.upper - z[i]) / row.scale + 1;
+    ++turned_on;
+  }
+  ASSERT_GT(turned_on, 0);
+  f.bind(on);
+  graph::testing::JacobianCheckOptions c;
+  c.tolerance = 1e-6;
+  const auto check = check_jacobians(f, x, c);
+  EXPECT_TRUE(check.ok) << check.report();
 }
 
 TEST(IntervalDynamicsFactor, RowsOfTheAcrobot) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 
 namespace kinograph::planning {
@@ -74,7 +75,7 @@ void ConstrainedFactor::evaluate(const graph::FactorValues& x, Eigen::Ref<Eigen:
                                  const graph::Jacobians* J) const {
   {
     const Evaluating guard(this);
-    compute(x, e, J);
+    cached_compute(x, e, J);
   }
   // An unbound factor reads μ = 1 and λ = 0 (per-thread zeros that only grow).
   thread_local Eigen::VectorXd zeros;
@@ -127,7 +128,65 @@ void ConstrainedFactor::compute_at(const graph::Values& values,
   if (ptrs.size() < keys().size()) ptrs.resize(keys().size());
   for (size_t k = 0; k < keys().size(); ++k) ptrs[k] = values.at(keys()[k]).data();
   z.setZero();
-  compute(graph::FactorValues(ptrs.data(), dims().data()), z, nullptr);
+  cached_compute(graph::FactorValues(ptrs.data(), dims().data()), z, nullptr);
+}
+
+void ConstrainedFactor::cache_evaluations() {
+  kept_.resize(2);
+  for (Evaluation& k : kept_) {
+    k.x.resize(jacobian_cols());
+    k.z.resize(residual_dim());
+  }
+  kept_[1].J.resize(residual_dim(), jacobian_cols());
+  kept_[1].filled.assign(static_cast<size_t>(residual_dim()), 0);
+}
+
+bool ConstrainedFactor::reusable(const graph::FactorValues& x, bool with_jacobian) const {
+  const Evaluation& k = kept_[with_jacobian ? 1 : 0];
+  if (!k.valid) return false;
+  for (size_t b = 0; b < keys().size(); ++b) {
+    const int i = static_cast<int>(b);
+    const size_t bytes = sizeof(double) * static_cast<size_t>(dims()[b]);
+    if (std::memcmp(x[i].data(), k.x.data() + block_offsets()[b], bytes) != 0) return false;
+  }
+  if (!with_jacobian) return true;
+  for (int row = 0; row < residual_dim(); ++row) {
+    if (!k.filled[static_cast<size_t>(row)] && jacobian_row_needed(row, k.z[row])) return false;
+  }
+  return true;
+}
+
+void ConstrainedFactor::cached_compute(const graph::FactorValues& x,
+                                       Eigen::Ref<Eigen::VectorXd> z,
+                                       const graph::Jacobians* J) const {
+  if (kept_.empty()) {
+    compute(x, z, J);
+    return;
+  }
+  Evaluation& k = kept_[J != nullptr ? 1 : 0];
+  const auto& offsets = block_offsets();
+  if (reusable(x, J != nullptr)) {
+    z = k.z;
+    if (J != nullptr) {
+      for (size_t b = 0; b < keys().size(); ++b) {
+        J->block(static_cast<int>(b)) = k.J.middleCols(offsets[b], dims()[b]);
+      }
+    }
+    return;
+  }
+  compute(x, z, J);
+  for (size_t b = 0; b < keys().size(); ++b) {
+    k.x.segment(offsets[b], dims()[b]) = x[static_cast<int>(b)];
+  }
+  k.z = z;
+  k.valid = true;
+  if (J == nullptr) return;
+  for (size_t b = 0; b < keys().size(); ++b) {
+    k.J.middleCols(offsets[b], dims()[b]) = J->block(static_cast<int>(b));
+  }
+  for (int row = 0; row < residual_dim(); ++row) {
+    k.filled[static_cast<size_t>(row)] = jacobian_row_needed(row, z[row]) ? 1 : 0;
+  }
 }
 
 namespace {

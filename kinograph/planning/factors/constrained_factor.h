@@ -128,8 +128,28 @@ class ConstrainedFactor : public graph::Factor {
   /// the whitened Jacobian is then constant between penalty changes (Factor::jacobian_version).
   /// Throws std::logic_error if a row is a bound.
   void declare_linear();
+  /// For a subclass whose compute() is expensive (the dynamics rows): the last evaluation with
+  /// and the last without Jacobians are kept and reused while the variables are bitwise the
+  /// same, so results are those of compute(). The outer loop linearizes at the point LM stopped
+  /// at twice (its last trial, the next solve's start); only the multipliers differ between.
+  void cache_evaluations();
 
  private:
+  // A kept raw evaluation: inputs (keys concatenated), z and, in the one with Jacobians,
+  // dz/dx with the rows compute() filled (an inactive bound's row may be left unfilled).
+  struct Evaluation {
+    Eigen::VectorXd x, z;
+    Eigen::MatrixXd J;
+    std::vector<char> filled;
+    bool valid = false;
+  };
+  // compute(), or the kept evaluation when it is at the same x and has every Jacobian row
+  // needed now (called while this factor is evaluating, so inactive rows are known).
+  void cached_compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
+                      const graph::Jacobians* J) const;
+  // Whether the kept evaluation is at x (and has the Jacobian rows needed now, if asked).
+  bool reusable(const graph::FactorValues& x, bool with_jacobian) const;
+
   // check() and, with non-null multipliers, their update from the same evaluation.
   Violation scan(const graph::Values& values, Multipliers* update) const;
 
@@ -137,6 +157,8 @@ class ConstrainedFactor : public graph::Factor {
   int num_constraints_ = 0;
   std::shared_ptr<const Multipliers> m_;  // null until bound
   double penalty_read_ = 1;               // μ of the last bind or penalty_changed
+  // Empty unless cache_evaluations(); else the last evaluation without, then with, Jacobians.
+  mutable std::vector<Evaluation> kept_;
 };
 
 }  // namespace kinograph::planning

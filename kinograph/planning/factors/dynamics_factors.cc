@@ -53,6 +53,7 @@ DynamicsStepFactor::DynamicsStepFactor(int k, std::shared_ptr<const dynamics::Mo
       model_(std::move(model)),
       data_(std::move(workspace)) {
   rows_for(*model_, options, &joint_of_row_);
+  cache_evaluations();
 }
 
 void DynamicsStepFactor::compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,

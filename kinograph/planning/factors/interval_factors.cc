@@ -82,6 +82,7 @@ IntervalDynamicsFactor::IntervalDynamicsFactor(int k, double dt,
     while (row < static_cast<int>(layout_.size()) && layout_[row].point == i) ++row;
   }
   point_begin_.push_back(row);
+  cache_evaluations();
 }
 
 void IntervalDynamicsFactor::jacobian_row(int row, const Eigen::MatrixXd& d, double sign,
