@@ -4,7 +4,7 @@
 //              [--ignore-goal-id-gaps] [--max-state-age 0.5] [--takeover-latency 0.3]
 //              [--iiwa-status-channel IIWA_STATUS] [--drake-plan-channel COMMITTED_ROBOT_PLAN]
 //              [--state-file FILE] [--neighbour NAME=SCENE[@PREFIX] ...]
-//              [--neighbour-timeout 3] [--no-neighbour-wait]
+//              [--neighbour-timeout 3] [--no-neighbour-wait] [--neighbour-yield 5]
 // The scene gives the robot, default horizon and steps, start, fixed obstacles, objective
 // weights and the batch formulation; goals, obstacle updates and measured states arrive over
 // LCM.
@@ -95,6 +95,11 @@ int main(int argc, char** argv) {
                "answer a goal whose plan runs into a higher-priority neighbour's plan with the "
                "failure, instead of holding the start until that plan ends and planning from "
                "there (default: wait)");
+  app.add_option("--neighbour-yield", options.neighbour_yield_s,
+                 "before planning, wait while a neighbour of higher priority is making a plan, "
+                 "at most this long (s) in all, so that the two are not made at the same moment "
+                 "(default 5; 0: do not wait)")
+      ->check(CLI::NonNegativeNumber);
   CLI11_PARSE(app, argc, argv);
   options.wait_for_neighbours = !no_wait;
   options.answer_goal_id_gaps = !ignore_gaps;
@@ -126,10 +131,10 @@ int main(int argc, char** argv) {
     spdlog::info(
         "kinographd: stopped after {} goals ({} answered, {} superseded, {} cancelled, {} "
         "dropped in transport), {} plans ({} failed, {} incremental replans, {} fallbacks, {} for "
-        "neighbours, {} waiting for one), {} rejected messages",
+        "neighbours, {} waiting for one, {} after yielding to one), {} rejected messages",
         c.goals_received, c.goals_answered, c.goals_superseded, c.goals_cancelled, c.goals_dropped,
         c.plans_published, c.failures, c.incremental, c.fallbacks, c.neighbour_replans,
-        c.neighbour_waits, c.messages_rejected);
+        c.neighbour_waits, c.neighbour_yields, c.messages_rejected);
   } catch (const std::exception& e) {
     std::cerr << "kinographd: error: " << e.what() << "\n";
     return 1;

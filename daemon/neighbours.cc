@@ -187,7 +187,7 @@ void Neighbours::on_heartbeat(std::size_t i, const lcm::ReceiveBuffer* rbuf) {
   planner_status_t msg;
   if (auto s = lcmtypes::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), msg); !s.ok) {
     std::lock_guard lock(mutex_);
-    heard_[i].mismatch = "its heartbeat is not a planner_status_t of version 3: " + s.reason;
+    heard_[i].mismatch = "its heartbeat is not a planner_status_t of version 4: " + s.reason;
     return;
   }
   std::string mismatch;
@@ -205,7 +205,7 @@ void Neighbours::on_heartbeat(std::size_t i, const lcm::ReceiveBuffer* rbuf) {
   }
   const std::int64_t goal_utime =
       msg.goal_utime < 0 ? std::numeric_limits<std::int64_t>::max() : msg.goal_utime;
-  bool changed = false;
+  bool changed = false, planning_changed = false;
   {
     std::lock_guard lock(mutex_);
     Heard& h = heard_[i];
@@ -224,8 +224,11 @@ void Neighbours::on_heartbeat(std::size_t i, const lcm::ReceiveBuffer* rbuf) {
     h.goal_utime = goal_utime;
     h.blocked_by = blocked_by;
     changed_ = changed_ || changed;
+    // Not a change of what is planned around, but a robot yielding to it waits for this.
+    planning_changed = h.planning_goal_utime != msg.planning_goal_utime;
+    h.planning_goal_utime = msg.planning_goal_utime;
   }
-  if (changed) notify();
+  if (changed || planning_changed) notify();
 }
 
 bool Neighbours::update_silence_locked() {
@@ -248,6 +251,24 @@ bool Neighbours::take_changed() {
   const bool changed = changed_ || silence;
   changed_ = false;
   return changed;
+}
+
+std::string Neighbours::planning_above(std::int64_t own_goal_utime) const {
+  std::lock_guard lock(mutex_);
+  const fleet::PriorityKey own{own_goal_utime, own_prefix_};
+  std::optional<std::size_t> highest;
+  for (std::size_t i = 0; i < specs_.size(); ++i) {
+    const Heard& h = heard_[i];
+    const bool heard_lately = h.last_heard && seconds_since(*h.last_heard) <= options_.timeout_s;
+    if (h.planning_goal_utime < 0 || !heard_lately) continue;
+    const fleet::PriorityKey key{h.planning_goal_utime, specs_[i].channel_prefix};
+    if (!fleet::outranks(key, own)) continue;
+    if (!highest || fleet::outranks(key, {heard_[*highest].planning_goal_utime,
+                                          specs_[*highest].channel_prefix})) {
+      highest = i;
+    }
+  }
+  return highest ? specs_[*highest].name : std::string();
 }
 
 bool Neighbours::take_joined() {

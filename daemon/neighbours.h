@@ -83,6 +83,10 @@ class Neighbours {
   /// `obstacles`.
   void add_obstacles(const fleet::Decision& decision, std::int64_t origin_utime,
                      std::vector<collision::Obstacle>& obstacles);
+  /// The neighbour, not silent, whose heartbeat says it is making a plan for a goal that
+  /// outranks this robot's goal of `own_goal_utime` (fleet::outranks on its
+  /// planning_goal_utime and prefix): this robot yields to it before planning; empty when none.
+  std::string planning_above(std::int64_t own_goal_utime) const;
   /// True once when a neighbour was heard for the first time or after being silent (a started
   /// or restarted daemon, which has missed this robot's current plan). Worker thread.
   bool take_joined();
@@ -129,6 +133,7 @@ class Neighbours {
     std::int64_t goal_utime = std::numeric_limits<std::int64_t>::max();
     std::string mismatch;    // why its heartbeat does not fit the scene, or empty
     std::string blocked_by;  // prefix its latest failure names as blocker (fleet::blocker_prefix)
+    std::int64_t planning_goal_utime = -1;  // goal utime of its plan in the making; -1 none
     std::optional<std::chrono::steady_clock::time_point> last_heard;
     bool silent = false;
   };

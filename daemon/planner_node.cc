@@ -693,6 +693,7 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t
     }
     if (stale.empty()) {
       state_ = planner_status_t::PLANNING;
+      planning_goal_utime_ = goal.utime;
       // A measured state, when there is one, is where the robot is: plan from it.
       if (latest_state_) {
         problem.start_q = latest_state_->q;
@@ -714,6 +715,7 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t
     answer_with_failure(plan_t::INVALID_STATE, stale, goal.goal_id, /*first_answer=*/!replan);
     {
       std::lock_guard lock(mutex_);
+      state_ = planner_status_t::IDLE;  // it may have yielded to neighbours as PLANNING
       last_message_ = stale;
     }
     publish_status();
@@ -964,8 +966,10 @@ void PlannerNode::worker_loop(const std::atomic<bool>& stop) {
     if (obstacles_changed) store_obstacles();
     if (taken.goal) {
       current_goal_ = taken.goal;
+      yield_to_neighbours(*taken.goal);
       plan_and_publish(*taken.goal, /*replan=*/false, taken.goal->utime);
     } else if (obstacles_changed && current_goal_) {
+      yield_to_neighbours(*current_goal_);
       plan_and_publish(*current_goal_, /*replan=*/true, taken.obstacles_utime);
     } else if (neighbours_ && current_goal_ && neighbours_->take_changed()) {
       replan_for_neighbours();
@@ -991,7 +995,50 @@ void PlannerNode::replan_for_neighbours() {
     if (latest_state_) trigger_utime = latest_state_->utime;  // a neighbour's change is now
   }
   spdlog::info("goal {}: replanning: {}", current_goal_->goal_id, d.reason);
+  yield_to_neighbours(*current_goal_);
   plan_and_publish(*current_goal_, /*replan=*/true, trigger_utime);
+}
+
+void PlannerNode::yield_to_neighbours(const GoalRequest& goal) {
+  if (!neighbours_ || options_.neighbour_yield_s <= 0) return;
+  {
+    std::lock_guard lock(mutex_);
+    state_ = planner_status_t::PLANNING;
+    planning_goal_utime_ = goal.utime;
+  }
+  publish_status();
+  const auto start = std::chrono::steady_clock::now();
+  const auto pause = [&](int ms) {
+    std::unique_lock lock(mutex_);
+    wake_.wait_for(lock, std::chrono::milliseconds(ms), [&] { return cancel_.load(); });
+  };
+  // A neighbour that got its goal at the same moment announces its plan a network trip later.
+  pause(kYieldListen);
+  std::string yielded_to;
+  while (!cancel_) {
+    const std::string above = neighbours_->planning_above(goal.utime);
+    if (above.empty()) break;
+    const double waited =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (yielded_to.empty()) {
+      spdlog::info("goal {}: yields to neighbour '{}', which is making a plan of higher priority",
+                   goal.goal_id, above);
+    }
+    yielded_to = above;
+    if (waited >= options_.neighbour_yield_s) {
+      spdlog::warn("goal {}: planning after yielding {:.3f} s, the most allowed: neighbour '{}' "
+                   "is still making its plan",
+                   goal.goal_id, waited, above);
+      break;
+    }
+    pause(10);
+  }
+  if (yielded_to.empty()) return;
+  spdlog::info("goal {}: planning after yielding {:.3f} s to neighbours' plans in the making",
+               goal.goal_id,
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  std::lock_guard lock(mutex_);
+  ++counters_.neighbour_yields;
 }
 
 void PlannerNode::answer_deadlock() {
@@ -1047,6 +1094,7 @@ void PlannerNode::publish_status() {
     msg.goal_utime = valid_goal_utime_;
     msg.valid_plan_id = valid_plan_id_;
     msg.num_neighbour_replans = static_cast<int32_t>(counters_.neighbour_replans);
+    msg.planning_goal_utime = state_ == planner_status_t::PLANNING ? planning_goal_utime_ : -1;
     if (neighbours_) msg.neighbours = neighbours_->summary();
     // Recorded before it is sent, under the lock that gave it its utime, so that its
     // loop-back is always recognised as ours.

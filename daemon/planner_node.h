@@ -90,6 +90,11 @@ struct PlannerNodeOptions {
   /// until that plan ends, and published that much later (docs/multi_robot.md); off: such a goal
   /// is answered with the failure. On by default.
   bool wait_for_neighbours = true;
+  /// Before each plan a robot with neighbours announces it in its heartbeat and waits while a
+  /// neighbour of higher priority is making a plan, so that the two are not made at the same
+  /// moment, each around the other's old one (docs/multi_robot.md, "Yielding"): at most this
+  /// long (s) in all, then it plans anyway; 0: no waiting.
+  double neighbour_yield_s = 5.0;
 };
 
 /// What a node has done since it started (for its status and for tests).
@@ -113,6 +118,7 @@ struct NodeCounters {
   int64_t payload_changes = 0;     ///< payload_t attaches and detaches taken
   int64_t neighbour_replans = 0;   ///< replans because a higher-priority neighbour changed
   int64_t neighbour_waits = 0;     ///< valid plans that hold their start for a neighbour's plan
+  int64_t neighbour_yields = 0;    ///< plans begun after waiting for a neighbour's in the making
 };
 
 /// The planner daemon's node: scene (robot, defaults, fixed obstacles) + LCM + worker thread.
@@ -144,6 +150,9 @@ class PlannerNode {
   /// Longest wait at shutdown for the node's own marker (PREFIX_SHUTDOWN_MARK) to come back
   /// through LCM, for a transport that does not loop a node's messages back (ms).
   static constexpr int kShutdownMarkWait = 500;
+  /// How long a robot about to plan listens for its neighbours' announcements of plans in the
+  /// making before it looks whom to yield to (ms): longer than a heartbeat takes to arrive.
+  static constexpr int kYieldListen = 50;
 
   /// Throws std::runtime_error naming the URL when LCM cannot start (e.g. no multicast route),
   /// StateFileError when options.state_file exists but cannot be taken (corrupt, foreign).
@@ -232,6 +241,9 @@ class PlannerNode {
   /// Plans `goal` and publishes the answer; `trigger_utime` is the robot-clock time of what
   /// made it plan (the goal, or for a replan the obstacle update), for the state's age.
   void plan_and_publish(const GoalRequest& goal, bool replan, int64_t trigger_utime);
+  /// Before planning `goal`: announces the plan in the making and waits while a neighbour of
+  /// higher priority is making one, at most options_.neighbour_yield_s (worker thread).
+  void yield_to_neighbours(const GoalRequest& goal);
   void publish_status();
   /// Replans the current goal when the coordination rule says a neighbour's change calls for
   /// it (worker thread).
@@ -276,6 +288,7 @@ class PlannerNode {
   std::uint64_t state_count_ = 0;  // measured states received; compared with used_state_count_
   NodeCounters counters_;
   int8_t state_ = 0;  // planner_status_t::IDLE / PLANNING / ERROR
+  int64_t planning_goal_utime_ = -1;  // while PLANNING: the utime of the goal being planned
   int64_t last_goal_id_ = -1;
   int64_t last_plan_id_ = -1;
   std::string last_message_;

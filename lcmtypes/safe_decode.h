@@ -31,6 +31,7 @@
 #include "kinograph/plan_v1_t.hpp"
 #include "kinograph/planner_status_t.hpp"
 #include "kinograph/planner_status_v2_t.hpp"
+#include "kinograph/planner_status_v3_t.hpp"
 #include "kinograph/robot_state_t.hpp"
 #include "kinograph/stop_request_t.hpp"
 #include "kinograph/task_constraint_t.hpp"
@@ -338,7 +339,7 @@ inline bool check_fields(WireReader& r, const ::drake::lcmt_robot_plan*) {
   return true;
 }
 
-// Version 2's members, which version 3 begins with (type names the fields).
+// Version 2's members, which versions 3 and 4 begin with (type names the fields).
 inline bool check_status_v2_fields(WireReader& r, const char* type) {
   const std::string t(type);
   int64_t i64 = 0;
@@ -354,13 +355,23 @@ inline bool check_fields(WireReader& r, const planner_status_v2_t*) {
   return check_status_v2_fields(r, "planner_status_v2_t");
 }
 
+// Version 3's members after version 2's, which version 4 begins with (type names the fields).
+inline bool check_status_v3_fields(WireReader& r, const char* type) {
+  const std::string t(type);
+  return check_status_v2_fields(r, type) && r.string((t + ".model_id").c_str()) &&
+         r.skip(7, 8, (t + ".base_position/base_quaternion").c_str()) &&
+         r.skip(2, 8, (t + ".goal_utime/valid_plan_id").c_str()) &&
+         r.skip(1, 4, (t + ".num_neighbour_replans").c_str()) &&
+         r.string((t + ".neighbours").c_str());
+}
+
+inline bool check_fields(WireReader& r, const planner_status_v3_t*) {
+  return check_status_v3_fields(r, "planner_status_v3_t");
+}
+
 inline bool check_fields(WireReader& r, const planner_status_t*) {
-  return check_status_v2_fields(r, "planner_status_t") &&
-         r.string("planner_status_t.model_id") &&
-         r.skip(7, 8, "planner_status_t.base_position/base_quaternion") &&
-         r.skip(2, 8, "planner_status_t.goal_utime/valid_plan_id") &&
-         r.skip(1, 4, "planner_status_t.num_neighbour_replans") &&
-         r.string("planner_status_t.neighbours");
+  return check_status_v3_fields(r, "planner_status_t") &&
+         r.skip(1, 8, "planner_status_t.planning_goal_utime");
 }
 
 }  // namespace detail

@@ -1,7 +1,8 @@
 // A daemon with a neighbour and no measured states, end to end over an in-process memq:// LCM: its
 // first plan starts at the scene's start, and every later one where its plans in force have the
-// robot at the new plan's start (q and q̇ on the common clock), never back at the scene's start.
-// Real planning on the RR arm; the neighbour is a far-away RR arm whose plans the test publishes.
+// robot at the new plan's start (q and q̇ on the common clock), never back at the scene's start;
+// it yields to the neighbour's plan in the making. Real planning on the RR arm; the neighbour is
+// a far-away RR arm whose plans and heartbeats the test publishes.
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -43,7 +44,8 @@ int64_t wall_utime() {
 
 class NeighbourNodeTest : public ::testing::Test {
  protected:
-  void SetUp() override {
+  // Starts the node; `yield_s` is its PlannerNodeOptions::neighbour_yield_s.
+  void start(double yield_s = 5.0) {
     ASSERT_TRUE(lcm_.good());
     const std::string anchor = std::string(KINOGRAPH_SOURCE_DIR) + "/scene.yaml";
     own_ = testing::rr_daemon_scene();
@@ -58,6 +60,7 @@ class NeighbourNodeTest : public ::testing::Test {
     options.status_period_s = 0.2;
     options.neighbours = {far_};
     options.neighbour_watch.timeout_s = 600;  // never silent while the test waits
+    options.neighbour_yield_s = yield_s;
     node_ = std::make_unique<PlannerNode>(own_, options, &lcm_);
     listener_ = std::make_unique<Listener>(lcm_);
     thread_ = std::thread([this] { node_->run(stop_); });
@@ -66,14 +69,16 @@ class NeighbourNodeTest : public ::testing::Test {
     stop_ = true;
     if (thread_.joinable()) thread_.join();
   }
-  // The far arm's heartbeat: its goal at 1 s outranks this robot's (at 2 s).
-  void send_far_heartbeat() {
+  // The far arm's heartbeat: its goal at 1 s outranks this robot's (at 2 s); with
+  // `planning_goal_utime` it says it is making a plan for a goal of that utime.
+  void send_far_heartbeat(int64_t planning_goal_utime = -1) {
     planner_status_t m;
     m.robot = far_.model->name;
     m.model_id = fleet::model_id(*far_.model);
     for (int i = 0; i < 3; ++i) m.base_position[i] = far_.base.translation()[i];
     m.base_quaternion[0] = 1;
     m.goal_utime = 1'000'000;
+    m.planning_goal_utime = planning_goal_utime;
     lcm_.publish("FAR_PLANNER_STATUS", &m);
   }
   // A new plan of the far arm, standing still from now on: the rule's cue to replan.
@@ -123,6 +128,7 @@ class NeighbourNodeTest : public ::testing::Test {
 };
 
 TEST_F(NeighbourNodeTest, WithoutStatesALaterPlanStartsWhereTheOwnPlanInForceHasTheRobot) {
+  start();
   send_far_heartbeat();
   send_goal();
   std::vector<plan_t> plans = listener_->wait_plans(1);
@@ -161,6 +167,48 @@ TEST_F(NeighbourNodeTest, WithoutStatesALaterPlanStartsWhereTheOwnPlanInForceHas
   v = validate_from_its_start(third);
   EXPECT_TRUE(v.valid) << (v.failures.empty() ? "" : v.failures.front());
   EXPECT_EQ(node_->counters().neighbour_replans, 2);
+}
+
+// The neighbour is making a plan for an earlier goal: the robot announces its own plan in the
+// making at once, waits, and plans only when the neighbour's heartbeat says it is done.
+TEST_F(NeighbourNodeTest, YieldsToAHigherNeighboursPlanInTheMakingUntilItIsDone) {
+  start();
+  send_far_heartbeat(/*planning_goal_utime=*/1'000'000);
+  send_goal();
+  EXPECT_TRUE(listener_->wait_status_planning(2'000'000));
+  // The yield lasts up to 5 s: no plan can come within the first half second.
+  EXPECT_TRUE(listener_->wait_plans(1, 0.5).empty());
+  send_far_plan(1);
+  send_far_heartbeat();
+  const std::vector<plan_t> plans = listener_->wait_plans(1);
+  ASSERT_EQ(plans.size(), 1u);
+  EXPECT_EQ(plans[0].status, plan_t::SUCCESS) << plans[0].status_message;
+  EXPECT_EQ(node_->counters().neighbour_yields, 1);
+  EXPECT_EQ(node_->counters().neighbour_replans, 0);  // made around the plan that just came
+}
+
+// A neighbour that never finishes its plan holds the robot up for the yield's bound only.
+TEST_F(NeighbourNodeTest, PlansAnywayOnceTheYieldsBoundHasPassed) {
+  start(/*yield_s=*/0.3);
+  send_far_heartbeat(/*planning_goal_utime=*/1'000'000);
+  const auto sent = std::chrono::steady_clock::now();
+  send_goal();
+  const std::vector<plan_t> plans = listener_->wait_plans(1);
+  ASSERT_EQ(plans.size(), 1u);
+  EXPECT_GE(std::chrono::duration<double>(std::chrono::steady_clock::now() - sent).count(), 0.3);
+  EXPECT_EQ(plans[0].status, plan_t::SUCCESS) << plans[0].status_message;
+  EXPECT_EQ(node_->counters().neighbour_yields, 1);
+}
+
+// With yielding off, a neighbour's plan in the making does not hold the robot up.
+TEST_F(NeighbourNodeTest, DoesNotYieldWithYieldingOff) {
+  start(/*yield_s=*/0);
+  send_far_heartbeat(/*planning_goal_utime=*/1'000'000);
+  send_goal();
+  const std::vector<plan_t> plans = listener_->wait_plans(1);
+  ASSERT_EQ(plans.size(), 1u);
+  EXPECT_EQ(plans[0].status, plan_t::SUCCESS) << plans[0].status_message;
+  EXPECT_EQ(node_->counters().neighbour_yields, 0);
 }
 
 }  // namespace

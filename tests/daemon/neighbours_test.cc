@@ -8,6 +8,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
+#include <thread>
 #include <limits>
 #include <lcm/lcm-cpp.hpp>
 
@@ -53,6 +55,7 @@ class NeighboursTest : public ::testing::Test {
     m.base_quaternion[3] = turn.z();
     m.goal_utime = goal_utime;
     m.valid_plan_id = 7;
+    m.planning_goal_utime = -1;
     return m;
   }
   plan_t plan(int64_t id, int8_t status = plan_t::SUCCESS) const {
@@ -118,6 +121,47 @@ TEST_F(NeighboursTest, FollowsAHigherNeighboursPlanAndNamesItsBodies) {
   // A new plan of it: one replan.
   send("RIGHT_PLAN", plan(9));
   EXPECT_TRUE(neighbours_->decide({2'000'000, ""}, false).replan);
+}
+
+// Whom to yield to: a neighbour heard lately making a plan for a goal that outranks the own one
+// (ties by prefix, "LEFT" before "RIGHT"); its plan in the making is no change to replan for.
+TEST_F(NeighboursTest, YieldsOnlyToANeighbourMakingAPlanOfHigherPriority) {
+  EXPECT_EQ(neighbours_->planning_above(2'000'000), "");  // not heard yet
+  planner_status_t hb = heartbeat(1'000'000);
+  send("RIGHT_PLANNER_STATUS", hb);
+  EXPECT_TRUE(neighbours_->take_changed());
+  EXPECT_EQ(neighbours_->planning_above(2'000'000), "");  // heard, not planning
+  hb.planning_goal_utime = 1'500'000;
+  send("RIGHT_PLANNER_STATUS", hb);
+  EXPECT_FALSE(neighbours_->take_changed());
+  EXPECT_EQ(neighbours_->planning_above(2'000'000), "right");
+  EXPECT_EQ(neighbours_->planning_above(1'000'000), "");  // the own goal is earlier
+  hb.planning_goal_utime = 2'000'000;
+  send("RIGHT_PLANNER_STATUS", hb);
+  EXPECT_EQ(neighbours_->planning_above(2'000'000), "");  // a tie: LEFT outranks RIGHT
+  EXPECT_EQ(neighbours_->planning_above(2'000'001), "right");
+}
+
+// A neighbour gone silent while planning is not waited for.
+TEST(NeighboursYield, DoesNotYieldToASilentNeighbour) {
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  NeighbourSpec spec = neighbour_from_option("right=" + std::string(KINOGRAPH_SOURCE_DIR) +
+                                             "/robots/scenes/iiwa_pair_right.yaml");
+  Neighbours neighbours({spec}, "LEFT", NeighboursOptions{.timeout_s = 0.05});
+  neighbours.subscribe(lcm, [] {});
+  planner_status_t hb{};
+  hb.model_id = fleet::model_id(*spec.model);
+  hb.base_quaternion[0] = 1;
+  hb.goal_utime = -1;
+  hb.planning_goal_utime = 1'000'000;
+  lcm.publish("RIGHT_PLANNER_STATUS", &hb);
+  while (lcm.handleTimeout(0) > 0) {
+  }
+  EXPECT_EQ(neighbours.planning_above(2'000'000), "right");
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));  // twice the timeout, at least
+  EXPECT_EQ(neighbours.planning_above(2'000'000), "");
+  neighbours.unsubscribe(lcm);
 }
 
 TEST_F(NeighboursTest, HoldsALowerNeighbourWithoutAPlanAndFollowsItsPlanWithoutReplanningForIt) {

@@ -67,6 +67,16 @@ class Listener {
     return cv_.wait_for(lock, std::chrono::duration<double>(timeout_s),
                         [&] { return statuses_.size() >= count; });
   }
+  // Waits until a heartbeat says the node is making a plan for the goal of `goal_utime`.
+  bool wait_status_planning(int64_t goal_utime, double timeout_s = 30) {
+    std::unique_lock lock(mutex_);
+    return cv_.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] {
+      for (const auto& s : statuses_) {
+        if (s.state == planner_status_t::PLANNING && s.planning_goal_utime == goal_utime) return true;
+      }
+      return false;
+    });
+  }
   // Waits until some status message mentions `text`.
   bool wait_status_containing(const std::string& text, double timeout_s = 10) {
     std::unique_lock lock(mutex_);

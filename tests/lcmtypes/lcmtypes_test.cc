@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "kinograph/planner_status_v2_t.hpp"
+#include "kinograph/planner_status_v3_t.hpp"
 #include "lcmtypes/safe_decode.h"
 #include "tests/lcmtypes/sample_messages.h"
 
@@ -145,21 +146,32 @@ TEST(LcmTypes, PlannerStatusRoundTrip) {
   EXPECT_EQ(out.valid_plan_id, 1);
   EXPECT_EQ(out.num_neighbour_replans, 3);
   EXPECT_EQ(out.neighbours, m.neighbours);
+  EXPECT_EQ(out.planning_goal_utime, 43);
 }
 
-// Version 3 of the heartbeat has its own fingerprint; version 2 stays readable as
-// planner_status_v2_t and is refused as a version 3.
+// Each version of the heartbeat has its own fingerprint; versions 2 and 3 stay readable as
+// planner_status_v2_t and planner_status_v3_t and are refused as the current one.
+template <class Old>
+void expect_old_heartbeat_readable_not_current(Old old) {
+  old.robot = "rr";
+  old.message = "";
+  const std::vector<uint8_t> bytes = encode(old);
+  Old back;
+  EXPECT_TRUE(kinograph::lcmtypes::safe_decode(bytes.data(), static_cast<int>(bytes.size()), back).ok);
+  planner_status_t as_current;
+  EXPECT_FALSE(
+      kinograph::lcmtypes::safe_decode(bytes.data(), static_cast<int>(bytes.size()), as_current).ok);
+}
+
 TEST(LcmTypes, PlannerStatusVersions) {
   EXPECT_NE(kinograph::planner_status_t::getHash(), kinograph::planner_status_v2_t::getHash());
-  kinograph::planner_status_v2_t v2;
-  v2.robot = "rr";
-  v2.message = "";
-  const std::vector<uint8_t> bytes = encode(v2);
-  kinograph::planner_status_v2_t back;
-  EXPECT_TRUE(kinograph::lcmtypes::safe_decode(bytes.data(), static_cast<int>(bytes.size()), back).ok);
-  planner_status_t as_v3;
-  EXPECT_FALSE(
-      kinograph::lcmtypes::safe_decode(bytes.data(), static_cast<int>(bytes.size()), as_v3).ok);
+  EXPECT_NE(kinograph::planner_status_t::getHash(), kinograph::planner_status_v3_t::getHash());
+  EXPECT_NE(kinograph::planner_status_v2_t::getHash(), kinograph::planner_status_v3_t::getHash());
+  expect_old_heartbeat_readable_not_current(kinograph::planner_status_v2_t{});
+  kinograph::planner_status_v3_t v3{};
+  v3.model_id = "rr:0123456789abcdef";
+  v3.neighbours = "";
+  expect_old_heartbeat_readable_not_current(v3);
 }
 
 TEST(LcmTypes, TruncatedBuffersAreRejected) {

@@ -329,6 +329,7 @@ inline planner_status_t make_planner_status() {
   m.valid_plan_id = 1;
   m.num_neighbour_replans = 3;
   m.neighbours = "right: plan 3, followed";
+  m.planning_goal_utime = 43;
   return m;
 }
 
