@@ -24,8 +24,10 @@ run --distributed-only --out "$WORK/d.json" >"$WORK/d.out" 2>"$WORK/d.err" \
 cat "$WORK/d.err"
 grep -q "^iiwa2_p00 distributed: ok clear after [0-9.]* s, settled after [0-9.]* s, [2-9] replans" \
   "$WORK/d.err" || fail "p00 did not settle after arm0 tried its blocked goal again"
-grep -q "^iiwa2_p01 distributed: ok clear after [0-9.]* s, settled after [0-9.]* s, [1-9]" \
-  "$WORK/d.err" || fail "p01 did not settle with a replan"
+# arm1 yields to arm0's first plan (0 replans) or, when arm0's announcement comes later than
+# arm1's listen, replans around it.
+grep -q "^iiwa2_p01 distributed: ok clear after [0-9.]* s, settled after [0-9.]* s, [0-9]* replans" \
+  "$WORK/d.err" || fail "p01 did not settle"
 grep -q "centralized" "$WORK/d.err" && fail "--distributed-only planned centrally"
 
 run --centralized-only --out "$WORK/c.json" >/dev/null 2>"$WORK/c.err" \
