@@ -107,7 +107,7 @@ void run_check_together(const CheckTogetherArgs& args) {
   std::cout << "clear (required clearance " << args.clearance << " m)\n";
 }
 
-const bool kRegistered = register_command([](CLI::App& root) {
+const bool kCheckTogetherRegistered = register_command([](CLI::App& root) {
   auto args = std::make_shared<CheckTogetherArgs>();
   CLI::App* cmd = root.add_subcommand(
       "check-together",

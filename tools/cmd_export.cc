@@ -49,7 +49,7 @@ void run_export(const ExportArgs& args) {
   if (!out) throw CommandFailure("cannot write '" + args.csv + "'");
 }
 
-const bool kRegistered = register_command([](CLI::App& root) {
+const bool kExportRegistered = register_command([](CLI::App& root) {
   auto args = std::make_shared<ExportArgs>();
   CLI::App* cmd = root.add_subcommand(
       "export", "Write a plan's trajectory as CSV: t, then q, qd, qdd and tau of every joint");

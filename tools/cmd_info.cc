@@ -85,7 +85,7 @@ void run_info(const InfoArgs& args) {
   }
 }
 
-const bool kRegistered = register_command([](CLI::App& root) {
+const bool kInfoRegistered = register_command([](CLI::App& root) {
   auto args = std::make_shared<InfoArgs>();
   CLI::App* cmd = root.add_subcommand(
       "info", "Print a robot's joint table, total mass and gravity torques at a configuration");

@@ -63,7 +63,7 @@ void run_plan(const PlanArgs& args) {
   }
 }
 
-const bool kRegistered = register_command([](CLI::App& root) {
+const bool kPlanRegistered = register_command([](CLI::App& root) {
   auto args = std::make_shared<PlanArgs>();
   CLI::App* cmd = root.add_subcommand(
       "plan", "Plan a scene (YAML) with the batch DFGP planner and write the plan (JSON)");

@@ -65,7 +65,7 @@ void run_plot(const PlotArgs& args) {
   spdlog::info("plot: wrote {}", args.out);
 }
 
-const bool kRegistered = register_command([](CLI::App& root) {
+const bool kPlotRegistered = register_command([](CLI::App& root) {
   auto args = std::make_shared<PlotArgs>();
   CLI::App* cmd = root.add_subcommand(
       "plot", "Plot a plan's joint torques (and overlay a second plan) as a PNG");

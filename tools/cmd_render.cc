@@ -102,7 +102,7 @@ void run_render(const RenderArgs& args) {
                args.height, args.frames, args.compare.empty() ? args.style : "compare", seconds);
 }
 
-const bool kRegistered = register_command([](CLI::App& root) {
+const bool kRenderRegistered = register_command([](CLI::App& root) {
   auto args = std::make_shared<RenderArgs>();
   CLI::App* cmd = root.add_subcommand(
       "render",

@@ -91,7 +91,7 @@ void run_replan(const ReplanArgs& args) {
   }
 }
 
-const bool kRegistered = register_command([](CLI::App& root) {
+const bool kReplanRegistered = register_command([](CLI::App& root) {
   auto args = std::make_shared<ReplanArgs>();
   CLI::App* cmd = root.add_subcommand(
       "replan",

@@ -42,7 +42,7 @@ void run_validate(const ValidateArgs& args) {
   }
 }
 
-const bool kRegistered = register_command([](CLI::App& root) {
+const bool kValidateRegistered = register_command([](CLI::App& root) {
   auto args = std::make_shared<ValidateArgs>();
   CLI::App* cmd = root.add_subcommand(
       "validate",

@@ -13,7 +13,8 @@ using CommandSetup = std::function<void(CLI::App& root)>;
 /// All registered verbs, in registration order.
 std::vector<CommandSetup>& command_registry();
 
-/// Registers a verb; use as `static const bool kRegistered = register_command(...)`.
+/// Registers a verb; use as `const bool kVerbRegistered = register_command(...)` in an unnamed
+/// namespace, a name of its own per file: files of a target are compiled together (unity build).
 bool register_command(CommandSetup setup);
 
 /// Exit codes of every verb (the table in `kinograph --help` and the README).

@@ -11,14 +11,12 @@
 
 #include "kinograph/graph/cancellation.h"
 #include "kinograph/graph/ordering.h"
+#include "kinograph/graph/stopwatch.h"
 
 namespace kinograph::graph {
 
 namespace {
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t) {
-  return std::chrono::duration<double>(Clock::now() - t).count();
-}
 
 // Slots of the variables that are not fixed, in slot order.
 std::vector<int> free_slots(const Values& values) {

@@ -10,14 +10,12 @@
 #include "kinograph/graph/cancellation.h"
 #include "kinograph/graph/envelope_cholesky.h"
 #include "kinograph/graph/normal_equations.h"
+#include "kinograph/graph/stopwatch.h"
 
 namespace kinograph::graph {
 
 namespace {
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t) {
-  return std::chrono::duration<double>(Clock::now() - t).count();
-}
 }  // namespace
 
 struct LevenbergMarquardt::Solve {

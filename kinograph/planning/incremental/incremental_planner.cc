@@ -6,6 +6,7 @@
 #include <chrono>
 #include <sstream>
 
+#include "kinograph/graph/stopwatch.h"
 #include "kinograph/planning/incremental/first_plan.h"
 #include "kinograph/planning/incremental/incremental_tree.h"
 #include "kinograph/planning/incremental/stopping_rule.h"
@@ -17,9 +18,7 @@ namespace kinograph::planning {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
+using graph::seconds_since;
 
 // The plan keeps the measured start itself when the estimate is this close to it (rad, rad/s):
 // the start prior holds x_0 to about the validator's threshold after a large change.

@@ -89,7 +89,7 @@ Eigen::Isometry3d read_pose(const json& j, const std::string& source, const std:
   return pose;
 }
 
-std::string anchor_of(const std::string& source) {
+std::string directory_of(const std::string& source) {
   return source.empty() ? std::string() : fs::absolute(source).parent_path().string();
 }
 
@@ -603,7 +603,7 @@ std::optional<std::string> resolve_plan_path(const std::string& path,
     const fs::path canonical = fs::weakly_canonical(fs::current_path() / p, ec);
     if (!ec) return canonical.string();
   }
-  return resolve_scene_path(path, anchor_of(plan_source));
+  return resolve_scene_path(path, directory_of(plan_source));
 }
 
 dynamics::Model load_plan_model(const PlanFileInfo& info) {

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "kinograph/graph/levenberg_marquardt.h"
+#include "kinograph/graph/stopwatch.h"
 
 namespace kinograph::planning {
 
@@ -84,9 +85,7 @@ ConstraintReport AugmentedLagrangian::update_unless_within(const graph::Values& 
 
 namespace {
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
+using graph::seconds_since;
 }  // namespace
 
 OuterLoopResult solve_outer_loop(const graph::FactorGraph& graph, graph::Values& values,
