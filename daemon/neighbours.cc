@@ -13,6 +13,7 @@
 #include "kinograph/fleet/joint_clearance.h"
 #include "kinograph/fleet/model_id.h"
 #include "kinograph/fleet/neighbour_bodies.h"
+#include "kinograph/graph/stopwatch.h"
 #include "kinograph/lcm/message_convert.h"
 #include "kinograph/plan_t.hpp"
 #include "kinograph/planner_status_t.hpp"
@@ -29,9 +30,7 @@ std::string upper(std::string s) {
   return s;
 }
 
-double seconds_since(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
+using graph::seconds_since;
 
 }  // namespace
 

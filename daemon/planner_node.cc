@@ -26,6 +26,7 @@
 #include "kinograph/fleet/joint_clearance.h"
 #include "kinograph/fleet/model_id.h"
 #include "kinograph/graph/cancellation.h"
+#include "kinograph/graph/stopwatch.h"
 #include "kinograph/lcm/drake_convert.h"
 #include "kinograph/lcm/lcm_connection.h"
 #include "kinograph/payload_t.hpp"
@@ -1014,17 +1015,16 @@ void PlannerNode::yield_to_neighbours(const GoalRequest& goal) {
   };
   // A neighbour that got its goal at the same moment announces its plan a network trip later.
   pause(kYieldListen);
-  std::string yielded_to;
+  bool yielded = false;
   while (!cancel_) {
     const std::string above = neighbours_->planning_above(goal.utime);
     if (above.empty()) break;
-    const double waited =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (yielded_to.empty()) {
+    const double waited = graph::seconds_since(start);
+    if (!yielded) {
       spdlog::info("goal {}: yields to neighbour '{}', which is making a plan of higher priority",
                    goal.goal_id, above);
     }
-    yielded_to = above;
+    yielded = true;
     if (waited >= options_.neighbour_yield_s) {
       spdlog::warn("goal {}: planning after yielding {:.3f} s, the most allowed: neighbour '{}' "
                    "is still making its plan",
@@ -1033,10 +1033,9 @@ void PlannerNode::yield_to_neighbours(const GoalRequest& goal) {
     }
     pause(10);
   }
-  if (yielded_to.empty()) return;
+  if (!yielded) return;
   spdlog::info("goal {}: planning after yielding {:.3f} s to neighbours' plans in the making",
-               goal.goal_id,
-               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+               goal.goal_id, graph::seconds_since(start));
   std::lock_guard lock(mutex_);
   ++counters_.neighbour_yields;
 }

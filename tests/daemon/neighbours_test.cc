@@ -148,7 +148,8 @@ TEST(NeighboursYield, DoesNotYieldToASilentNeighbour) {
   ASSERT_TRUE(lcm.good());
   NeighbourSpec spec = neighbour_from_option("right=" + std::string(KINOGRAPH_SOURCE_DIR) +
                                              "/robots/scenes/iiwa_pair_right.yaml");
-  Neighbours neighbours({spec}, "LEFT", NeighboursOptions{.timeout_s = 0.05});
+  // Long enough that the first look always comes within it, even on a busy machine.
+  Neighbours neighbours({spec}, "LEFT", NeighboursOptions{.timeout_s = 2.0});
   neighbours.subscribe(lcm, [] {});
   planner_status_t hb{};
   hb.model_id = fleet::model_id(*spec.model);
@@ -159,7 +160,7 @@ TEST(NeighboursYield, DoesNotYieldToASilentNeighbour) {
   while (lcm.handleTimeout(0) > 0) {
   }
   EXPECT_EQ(neighbours.planning_above(2'000'000), "right");
-  std::this_thread::sleep_for(std::chrono::milliseconds(100));  // twice the timeout, at least
+  std::this_thread::sleep_for(std::chrono::milliseconds(2500));  // beyond the timeout, at least
   EXPECT_EQ(neighbours.planning_above(2'000'000), "");
   neighbours.unsubscribe(lcm);
 }
