@@ -23,6 +23,16 @@ std::optional<execution::Setpoint> PlannedMotion::at(int64_t utime) {
   return execution::sample_at(*oldest.timed, *oldest.sampler, utime);
 }
 
+std::optional<PlannedMotion::Knot> PlannedMotion::knot_from(int64_t utime) const {
+  if (plans_.empty() || plans_.back().timed->start_utime > utime) return std::nullopt;
+  const execution::TimedPlan& newest = *plans_.back().timed;
+  for (std::size_t k = 0; k < newest.plan.t.size(); ++k) {
+    const int64_t at = newest.start_utime + std::llround(newest.plan.t[k] * 1e6);
+    if (at >= utime) return Knot{static_cast<int>(k), at};
+  }
+  return std::nullopt;
+}
+
 std::optional<planning::Plan> PlannedMotion::ahead(int64_t utime, double horizon, int steps) {
   if (plans_.empty() || steps < 1) return std::nullopt;
   planning::Plan p;

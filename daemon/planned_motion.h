@@ -35,6 +35,14 @@ class PlannedMotion {
   /// the plans in force continued (held at the last one's end), the natural warm start of a plan
   /// from at(utime). Empty before any plan was published.
   std::optional<planning::Plan> ahead(int64_t utime, double horizon, int steps);
+  /// A knot of the newest plan: its index and its time on the common clock.
+  struct Knot {
+    int index = 0;
+    int64_t utime = 0;
+  };
+  /// The newest plan's first knot at or after `utime`, when that plan has started by `utime`
+  /// and has a knot left: where a replan that goes on from the plan's own knots can start.
+  std::optional<Knot> knot_from(int64_t utime) const;
   /// True once a plan was published.
   bool moving() const { return !plans_.empty(); }
 

@@ -734,6 +734,15 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t
   // Without states, a robot with neighbours moves along its plans on the common clock: a later
   // plan starts where they have it then, not back at the scene's start.
   const bool on_own_plans = neighbours_ && !state_utime && planned_motion_.moving();
+  // A replan from the own plans starts at their next knot: the Bayes tree then goes on from the
+  // same knots, renamed (Replanner::plan's warm_knots), rather than being warm-started anew.
+  int shift_knots = 0;
+  if (on_own_plans && replan) {
+    if (const auto knot = planned_motion_.knot_from(*origin); knot && knot->index > 0) {
+      origin = knot->utime;
+      shift_knots = knot->index;
+    }
+  }
   const auto start_on_own_plans = [&](double wait_s) {
     const execution::Setpoint s = *planned_motion_.at(*origin + std::llround(wait_s * 1e6));
     problem.start_q = s.q;
@@ -782,7 +791,7 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t
       // obstacle changes) must run to their end.
       graph::CancellationScope cancellation(cancel_);
       plan = replanner_.plan(problem, /*new_goal=*/!replan && attempt == 0,
-                             continued ? &*continued : nullptr);
+                             continued ? &*continued : nullptr, attempt == 0 ? shift_knots : 0);
     } catch (const graph::Cancelled&) {
       spdlog::info("goal {}: planning cancelled: {}", goal.goal_id, kShutdownReason);
       answer_with_failure(plan_t::CANCELLED, std::string("planning cancelled: ") + kShutdownReason,

@@ -36,6 +36,20 @@ Factor::Factor(std::vector<Key> keys, std::vector<int> dims, int residual_dim, N
   set_noise(std::move(noise));
 }
 
+void Factor::rename_keys(const std::function<Key(Key)>& rename) {
+  std::vector<Key> keys(keys_.size());
+  for (size_t i = 0; i < keys_.size(); ++i) {
+    keys[i] = rename(keys_[i]);
+    for (size_t j = 0; j < i; ++j) {
+      if (keys[j] == keys[i]) {
+        throw std::invalid_argument("Factor::rename_keys: " + keys_[j].to_string() + " and " +
+                                    keys_[i].to_string() + " would both be " + keys[i].to_string());
+      }
+    }
+  }
+  keys_ = std::move(keys);
+}
+
 std::string Factor::name() const {
   const char* mangled = typeid(*this).name();
   int status = 0;

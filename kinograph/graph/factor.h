@@ -2,6 +2,7 @@
 // A factor is one term ½‖r(x)‖² of the least-squares cost over a few variables. Authors
 // implement evaluate() (raw error and its Jacobian blocks); the noise model whitens both.
 #include <Eigen/Core>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -64,6 +65,11 @@ class Factor {
   virtual std::string name() const;
 
   const std::vector<Key>& keys() const { return keys_; }
+  /// Renames the factor's variables (`rename` must keep distinct keys distinct); what it
+  /// computes is unchanged, since evaluate() reads its variables by position. For renaming a
+  /// whole graph's variables at once (ISAM2::rename_variables). Throws std::invalid_argument when
+  /// two keys would merge.
+  void rename_keys(const std::function<Key(Key)>& rename);
   /// Dimension of each key's variable, in key order.
   const std::vector<int>& dims() const { return dims_; }
   /// Column of key i's block in the stacked Jacobian.

@@ -357,6 +357,18 @@ ISAM2Result ISAM2::update(const std::vector<FactorPtr>& new_factors,
   return res;
 }
 
+void ISAM2::rename_variables(const std::function<Key(Key)>& rename) {
+  Values theta = theta_, estimate = estimate_;
+  theta.rename(rename);  // throws before anything changed when two keys merge
+  estimate.rename(rename);
+  // A factor's keys are distinct and map to distinct keys, so renaming them cannot throw.
+  for (size_t i = 0; i < graph_.size(); ++i) {
+    if (graph_[i]) graph_[i]->rename_keys(rename);
+  }
+  theta_ = std::move(theta);
+  estimate_ = std::move(estimate);
+}
+
 // Throws for inconsistent input before update() changes any state.
 void ISAM2::validate_update(const std::vector<FactorPtr>& new_factors,
                             const std::vector<size_t>& removed_factor_indices,

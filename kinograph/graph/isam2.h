@@ -4,6 +4,7 @@
 // eliminates only the cliques touched by new, removed or relinearized factors and their
 // ancestors, reattaching the untouched subtrees through their cached marginal factors.
 #include <Eigen/Core>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -155,6 +156,13 @@ class ISAM2 {
   ISAM2Result update(const std::vector<FactorPtr>& new_factors = {},
                      const std::vector<size_t>& removed_factor_indices = {},
                      const Values& new_values = {}, const ISAM2UpdateOptions& options = {});
+
+  /// Renames every variable, in θ, the estimate and every factor at once (`rename` must keep
+  /// distinct keys distinct): the Bayes tree, the linearizations and the estimate stay as they
+  /// are, so a graph whose variables are renamed (e.g. a trajectory's steps counted from a later
+  /// start) is updated incrementally. Throws std::invalid_argument when two keys would merge,
+  /// before anything changes.
+  void rename_variables(const std::function<Key(Key)>& rename);
 
   /// Current estimate θ + δ.
   const Values& estimate() const { return estimate_; }

@@ -73,6 +73,21 @@ void Values::retract(Key key, const Eigen::Ref<const Eigen::VectorXd>& delta) {
   if (!fixed_[s]) data_.segment(offsets_[s], dims_[s]) += delta;
 }
 
+void Values::rename(const std::function<Key(Key)>& rename) {
+  std::vector<Key> keys(keys_.size());
+  std::unordered_map<Key, int> slot_of;
+  for (size_t s = 0; s < keys_.size(); ++s) {
+    keys[s] = rename(keys_[s]);
+    if (!slot_of.emplace(keys[s], static_cast<int>(s)).second) {
+      throw std::invalid_argument("Values::rename: " + keys_[s].to_string() + " and another " +
+                                  "variable would both be " + keys[s].to_string());
+    }
+  }
+  keys_ = std::move(keys);
+  slot_of_ = std::move(slot_of);
+  new_layout();
+}
+
 void Values::set_fixed(Key key, bool fixed) {
   const int s = slot(key);
   if ((fixed_[s] != 0) != fixed) {

@@ -4,6 +4,7 @@
 // copying.
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <unordered_map>
 #include <vector>
 
@@ -58,6 +59,10 @@ class Values {
   void retract(const Eigen::Ref<const Eigen::VectorXd>& delta);
   /// x_key ← x_key + delta for one variable (ignored if the variable is fixed).
   void retract(Key key, const Eigen::Ref<const Eigen::VectorXd>& delta);
+
+  /// Renames every variable (`rename` must keep distinct keys distinct); slots, values and
+  /// fixed flags stay. Throws std::invalid_argument when two keys would merge (nothing changed).
+  void rename(const std::function<Key(Key)>& rename);
 
   /// Marks a variable constant (or free again). Changes the layout id: solvers rebuild.
   void set_fixed(Key key, bool fixed = true);

@@ -66,12 +66,12 @@ Replanner::Replanner(ReplannerOptions options)
       batch_(options_.incremental.batch),
       incremental_(options_.incremental) {}
 
-Plan Replanner::plan(const Problem& problem, bool new_goal, const Plan* warm) {
+Plan Replanner::plan(const Problem& problem, bool new_goal, const Plan* warm, int warm_knots) {
   report_ = ReplanReport();
   // A warm start must fit the problem's knots.
   if (warm && warm->q.rows() != problem.steps + 1) warm = nullptr;
   try {
-    Plan p = options_.use_incremental ? incremental_path(problem, new_goal, warm)
+    Plan p = options_.use_incremental ? incremental_path(problem, new_goal, warm, warm_knots)
                                       : batch_path(problem, new_goal, warm);
     if (p.success()) {
       last_valid_ = p;
@@ -126,7 +126,8 @@ Plan Replanner::from_scratch(const Problem& problem) {
   return plan;
 }
 
-Plan Replanner::incremental_path(const Problem& problem, bool new_goal, const Plan* warm) {
+Plan Replanner::incremental_path(const Problem& problem, bool new_goal, const Plan* warm,
+                                 int warm_knots) {
   bool scratch = !ready_ || !incremental_.has_plan() ||
                  incremental_.problem().steps != problem.steps;
   if (!scratch && new_goal) {
@@ -140,6 +141,15 @@ Plan Replanner::incremental_path(const Problem& problem, bool new_goal, const Pl
   if (scratch) return from_scratch(problem);
 
   const Plan previous = incremental_.current_plan();
+  if (warm && warm_knots > 0 && !new_goal) {
+    const std::string refusal = incremental_.shift_refusal(problem, warm_knots);
+    // The warm start, not the plan before the shift, fits the shifted problem's knots.
+    if (refusal.empty()) {
+      return answer_incremental(problem, incremental_.shift(problem, warm_knots), *warm,
+                                warm_knots);
+    }
+    spdlog::debug("replan not shifted by {} knots: {}", warm_knots, refusal);
+  }
   if (warm) {
     // The given trajectory, not the current plan, is where the solve starts.
     Plan plan = incremental_.plan(problem, warm);
@@ -149,7 +159,13 @@ Plan Replanner::incremental_path(const Problem& problem, bool new_goal, const Pl
     if (plan.success() || plan.stats.status == PlanStatus::kInvalidProblem) return plan;
     return recover(problem, std::move(plan), previous);
   }
-  Plan plan = incremental_.replan(change_between(incremental_.problem(), problem, new_goal));
+  return answer_incremental(
+      problem, incremental_.replan(change_between(incremental_.problem(), problem, new_goal)),
+      previous, 0);
+}
+
+Plan Replanner::answer_incremental(const Problem& problem, Plan plan, const Plan& previous,
+                                   int knots) {
   report_.statistics = incremental_.last_stats();
   report_.method = "incremental";
   const bool refused = plan.stats.status == PlanStatus::kInvalidProblem;
@@ -160,9 +176,10 @@ Plan Replanner::incremental_path(const Problem& problem, bool new_goal, const Pl
   report_.incremental = true;
   const IncrementalStats& st = report_.statistics;
   spdlog::info(
-      "iDFGP: {} ISAM2 updates, {} multiplier rounds, {} cliques re-eliminated, factors {} "
+      "iDFGP: {}{} ISAM2 updates, {} multiplier rounds, {} cliques re-eliminated, factors {} "
       "replaced + {} added, {:.1f} ms incremental",
-      st.updates, st.rounds, st.cliques_reeliminated, st.factors_replaced, st.factors_added,
+      knots > 0 ? "shifted " + std::to_string(knots) + " knots, " : std::string(), st.updates,
+      st.rounds, st.cliques_reeliminated, st.factors_replaced, st.factors_added,
       st.incremental_time_s * 1e3);
   if (plan.success()) return plan;
   return recover(problem, std::move(plan), previous);

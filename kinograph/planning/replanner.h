@@ -50,8 +50,11 @@ class Replanner {
   /// e.g. obstacles or the start). The answer's path is in last_report(). `warm`, when given, is
   /// a better initial trajectory for a replan than the current plan, e.g. that plan continued in
   /// time when the start moved along it: the replan is then a solve warm-started from it on the
-  /// incremental graph (method "warm-start"), with the usual fallbacks.
-  Plan plan(const Problem& problem, bool new_goal, const Plan* warm = nullptr);
+  /// incremental graph (method "warm-start"), with the usual fallbacks. `warm_knots` > 0 says
+  /// that `warm` is the current plan gone on by that many knots: the replan then shifts the
+  /// Bayes tree instead (IncrementalPlanner::shift, method "incremental") when the shift applies.
+  Plan plan(const Problem& problem, bool new_goal, const Plan* warm = nullptr,
+            int warm_knots = 0);
   /// Applies `change` to the current problem and plans it (a new request when it has a goal).
   /// Needs a first plan (else status "no_plan").
   Plan replan(const ProblemChange& change);
@@ -65,7 +68,10 @@ class Replanner {
  private:
   Plan batch_path(const Problem& problem, bool new_goal, const Plan* warm);
   Plan from_scratch(const Problem& problem);
-  Plan incremental_path(const Problem& problem, bool new_goal, const Plan* warm);
+  Plan incremental_path(const Problem& problem, bool new_goal, const Plan* warm, int warm_knots);
+  /// The answer of an incremental replan (on the tree shifted by `knots`, if > 0): its report,
+  /// and recover() from `previous` when it does not validate.
+  Plan answer_incremental(const Problem& problem, Plan plan, const Plan& previous, int knots);
   /// The warm-started batch solve (then the plan from scratch) after a failed replan.
   Plan recover(const Problem& problem, Plan failed, const Plan& previous);
 

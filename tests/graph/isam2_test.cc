@@ -588,6 +588,42 @@ TEST(ISAM2, FixedVariablesStayConstant) {
   EXPECT_LT((isam.estimate().vector() - optimum.vector()).cwiseAbs().maxCoeff(), 1e-8);
 }
 
+// Renaming every variable changes nothing but the names: the next update (a new goal on the
+// renamed last variable) re-eliminates only its path, as without the renaming, and reaches the
+// dense optimum; a renaming that merges two variables throws before anything changes.
+TEST(ISAM2, RenamedVariablesKeepTheTree) {
+  const int n = 30;
+  Chain chain = make_chain(n, Eigen::Vector2d(3, 1));
+  ISAM2Options opt;
+  opt.wildfire_threshold = 0;
+  opt.relinearize_threshold = 1e9;
+  ISAM2 isam(opt);
+  ISAM2UpdateOptions first;
+  first.constrained_last = {X(n - 1)};
+  auto res = isam.update(chain.factors, {}, chain.values, first);
+  ASSERT_TRUE(res.ok()) << res.reason;
+  const size_t goal = res.new_factor_indices[chain.goal_index];
+  const Eigen::VectorXd before = isam.estimate().vector();
+  const auto later = [](Key k) { return Key('y', k.index(), k.step() + 100); };
+  EXPECT_THROW(isam.rename_variables([](Key) { return X(0); }), std::invalid_argument);
+  isam.rename_variables(later);
+  EXPECT_EQ(isam.estimate().vector(), before);
+  EXPECT_FALSE(isam.estimate().contains(X(0)));
+  EXPECT_TRUE(isam.estimate().contains(Key('y', 0, 100)));
+  for (const auto& f : isam.graph().factors()) {
+    for (Key k : f->keys()) EXPECT_EQ(k.kind(), 'y');
+  }
+  EXPECT_EQ(isam.check_invariants(), "");
+  auto new_goal = std::make_shared<PriorFactor>(Key('y', 0, 100 + n - 1), Eigen::Vector2d(2, 2),
+                                                isotropic(2, 0.1));
+  res = isam.update({new_goal}, {goal});
+  ASSERT_TRUE(res.ok()) << res.reason;
+  EXPECT_FALSE(res.full_reelimination);
+  EXPECT_LE(res.cliques_reeliminated, 2);
+  const Eigen::VectorXd expected = dense_solve(isam.graph(), isam.estimate());
+  EXPECT_LT((isam.estimate().vector() - expected).cwiseAbs().maxCoeff(), 1e-9);
+}
+
 TEST(ISAM2, BadInputThrowsBeforeChangingState) {
   Chain chain = make_chain(5, Eigen::Vector2d(1, 0));
   ISAM2 isam;

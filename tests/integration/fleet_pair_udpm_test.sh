@@ -3,8 +3,9 @@
 # real UDP multicast in a private network namespace: each plans around the other under the
 # coordination rule (docs/multi_robot.md). Checked: both plans validate and, checked together at
 # and between the knots, keep clear; then left's goal moves keeping its priority and right
-# replans around left's new plan from where its own plan has it (warm-started from that motion
-# continued), still clear; a later goal of left's makes left
+# replans around left's new plan from where its own plan has it, incrementally (its Bayes tree
+# shifted to that knot, only the changed factors replaced), still clear; a later goal of left's
+# makes left
 # yield to right; then right is killed, left reports it silent, and the restarted right is
 # picked up again.
 # Usage: fleet_pair_udpm_test.sh BUILD_DIR SOURCE_DIR. Exit 77 (skipped) when not root.
@@ -26,25 +27,30 @@ LEFT_GOAL_UTIME=$(date +%s%6N)
 send_goal left 1 "-0.6,0.7,0,-1.3,0,0.8,0" "$LEFT" "$LEFT_GOAL_UTIME"
 send_goal right 1 "-0.6,0.7,0,-1.3,0,0.8,0" "$RIGHT"
 await_settled
-check_plans "left=$LEFT" "right=$RIGHT"
 grep -q "neighbours: right: [^;]*held at its state" "$WORK/probe.out" \
   || fail "left (higher priority) does not hold right at its state"
-echo "PASS: crossing goals"
+cp "$WORK/left.json" "$WORK/first_left.json"
+cp "$WORK/right.json" "$WORK/first_right.json"
 
-# 2. Left's goal moves, keeping its priority (the same goal time): left replans for its own
-# goal, right replans around left's new plan. Without states each robot is where its plan in
-# force has it: the replan starts there, warm-started from that motion continued in time. Where
-# right stands then depends on when the goal comes; if it is in the way, left waits for right's
-# plan to end (a lower robot already under way), so the outcome does not.
+# 2. Left's goal moves, keeping its priority (the same goal time), while both arms move (sent
+# at once; the first plans are checked meanwhile): left replans for its own goal, right replans
+# around left's new plan. Without states each robot is where its plan in force has it: the
+# replan starts at that plan's next knot, on the same Bayes tree. Where right stands then
+# depends on when the goal comes; if it is in the way, left waits for right's plan to end (a
+# lower robot already under way), so the outcome does not.
 watch --robot "LEFT=$LEFT" --robot "RIGHT=$RIGHT" --newer "LEFT=$(current_plan LEFT)" \
   --newer "RIGHT=$(current_plan RIGHT)"
 send_goal left 2 "-0.4,0.6,0,-1.4,0,0.8,0" "$LEFT" "$LEFT_GOAL_UTIME"
+check_plans "first_left=$LEFT" "first_right=$RIGHT"
+echo "PASS: crossing goals"
 await_settled
 check_plans "left=$(with_goal "$LEFT" "-0.4,0.6,0,-1.4,0,0.8,0" left2)" "right=$RIGHT"
 grep -q "^RIGHT: .* [1-9][0-9]* neighbour replans" "$WORK/probe.out" \
   || fail "right did not count a neighbour replan"
-grep -q "^RIGHT: plan [0-9]* (warm-start" "$WORK/probe.out" \
-  || fail "right's replan around left's new plan was not warm-started from its own motion"
+grep -q "^RIGHT: plan [0-9]* (incremental" "$WORK/probe.out" \
+  || fail "right's replan around left's new plan was not incremental"
+grep -q "iDFGP: shifted [0-9]* knots" "$WORK/right.log" \
+  || fail "right's replan did not go on from its plan's knots on the same tree"
 echo "PASS: a neighbour's goal moved"
 
 # 3. A later goal of left's makes it yield: it plans around right's plan, right keeps its own.

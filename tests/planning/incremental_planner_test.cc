@@ -13,6 +13,7 @@
 #include "kinograph/planning/io/replan_change.h"
 #include "kinograph/planning/factors/state_target_factor.h"
 #include "kinograph/planning/io/scene.h"
+#include "kinograph/planning/replanner.h"
 #include "kinograph/planning/factors/trajectory_factors.h"
 
 #include "tests/planning/test_problems.h"
@@ -212,6 +213,129 @@ TEST(IncrementalPlanner, HorizonChange) {
   const Plan re = planner.set_horizon(p.horizon * 1.2);
   ASSERT_TRUE(re.success()) << failures(re);
   EXPECT_NEAR(re.t.back(), p.horizon * 1.2, 1e-12);
+}
+
+// The problem `p` with its start `m` knots into `plan` (the robot went on along it).
+Problem gone_on(const Problem& p, const Plan& plan, int m) {
+  Problem next = p;
+  next.start_q = plan.q.row(m).transpose();
+  next.start_qd = plan.qd.row(m).transpose();
+  return next;
+}
+
+// A sphere sweeping past the arm's reach along a trajectory on the plan's clock (t from 0).
+collision::Obstacle passing_ball(int id, double y) {
+  collision::Obstacle o;
+  o.id = id;
+  o.shape = collision::Shape::sphere(0.1);
+  Eigen::Isometry3d a = Eigen::Isometry3d::Identity(), b = a;
+  a.translation() = Eigen::Vector3d(-1.5, y, 2.6);
+  b.translation() = Eigen::Vector3d(1.5, y, 2.6);
+  o.pose = a;
+  o.trajectory = collision::PoseTrajectory({0.0, 3.0}, {a, b});
+  return o;
+}
+
+// `plan` from knot m on, held at its end for the last m knots: the motion gone on.
+Plan continued(const Plan& plan, int m) {
+  Plan c = plan;
+  const int N = static_cast<int>(plan.q.rows()) - 1;
+  for (int k = 0; k <= N; ++k) {
+    const int from = std::min(k + m, N);
+    c.q.row(k) = plan.q.row(from);
+    c.qd.row(k) = plan.qd.row(from);
+    c.qdd.row(k) = plan.qdd.row(from);
+    if (k + m > N) {
+      c.qd.row(k).setZero();
+      c.qdd.row(k).setZero();
+    }
+  }
+  return c;
+}
+
+// A replan that goes on from a knot of the plan renames the tree's states instead of rebuilding
+// it (keeping the factors it can), and the plan is the shifted problem's own (a converged shift and a
+// batch solve of the shifted problem warm-started from the motion gone on agree).
+TEST(IncrementalPlanner, ShiftGoesOnFromAKnotOfThePlan) {
+  Problem p = rr_problem();
+  p.obstacles.push_back(passing_ball(9, 0.6));
+  IncrementalPlannerOptions options;
+  options.stop_at_first_valid = false;
+  IncrementalPlanner planner(options);
+  const Plan first = planner.plan(p);
+  ASSERT_TRUE(first.success()) << failures(first);
+  const int m = 4;
+  Problem next = gone_on(p, first, m);
+  next.obstacles.back() = passing_ball(10, 0.5);  // a neighbour's new plan: a new id
+  ASSERT_EQ(planner.shift_refusal(next, m), "");
+  const Plan re = planner.shift(next, m);
+  ASSERT_TRUE(re.success()) << failures(re);
+  EXPECT_EQ(planner.last_stats().method, "incremental");
+  EXPECT_GT(planner.last_stats().factors_replaced, 0);
+  EXPECT_LT((re.q.row(0) - first.q.row(m)).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_EQ(planner.problem().obstacles.back().id, 10);
+  // The motion goes on smoothly from where it was.
+  EXPECT_LT((re.q.topRows(2) - first.q.middleRows(m, 2)).cwiseAbs().maxCoeff(), 0.05);
+  const Plan warm = continued(first, m);
+  const Plan batch = BatchPlanner(options.batch).plan(next, &warm);
+  ASSERT_TRUE(batch.success()) << failures(batch);
+  EXPECT_NEAR(re.stats.cost, batch.stats.cost, 0.02 * batch.stats.cost + 1e-6);
+  EXPECT_LT((re.q - batch.q).cwiseAbs().maxCoeff(), 2e-2);
+}
+
+// Shifting again and again (the states left behind pile up until the tree is rebuilt without
+// them) keeps every plan valid and on the robot's way to the goal.
+TEST(IncrementalPlanner, RepeatedShiftsStayValid) {
+  Problem p = rr_problem();
+  p.obstacles.push_back(passing_ball(100, 0.6));
+  IncrementalPlanner planner;
+  Plan plan = planner.plan(p);
+  ASSERT_TRUE(plan.success()) << failures(plan);
+  Problem next = p;
+  for (int i = 1; i <= 20; ++i) {
+    next = gone_on(next, plan, 2);
+    next.obstacles.back() = passing_ball(100 + i, 0.6 - 0.01 * i);
+    plan = planner.shift(next, 2);
+    ASSERT_TRUE(plan.success()) << "shift " << i << ": " << failures(plan);
+    EXPECT_LT(plan.validation.goal_error, 1e-3);
+  }
+}
+
+// A shift the problem does not allow is refused and leaves the planner as it was.
+TEST(IncrementalPlanner, ShiftRefusals) {
+  const Problem p = rr_problem();
+  IncrementalPlanner planner;
+  EXPECT_NE(planner.shift_refusal(p, 2), "");  // no plan yet
+  const Plan first = planner.plan(p);
+  ASSERT_TRUE(first.success());
+  EXPECT_NE(planner.shift_refusal(gone_on(p, first, 0), 0), "");
+  EXPECT_NE(planner.shift_refusal(gone_on(p, first, p.steps - 1), p.steps - 1), "");
+  EXPECT_NE(planner.shift_refusal(gone_on(p, first, 5), 4), "");  // not where knot 4 is
+  Problem other_goal = gone_on(p, first, 3);
+  other_goal.goal.q = Eigen::Vector2d(1.1, 0.7);
+  EXPECT_NE(planner.shift_refusal(other_goal, 3), "");
+  const Plan refused = planner.shift(other_goal, 3);
+  EXPECT_EQ(refused.stats.status, PlanStatus::kInvalidProblem);
+  EXPECT_EQ(planner.problem().start_q, p.start_q);
+  EXPECT_TRUE(planner.shift(gone_on(p, first, 3), 3).success());
+}
+
+// The Replanner shifts the tree when told that its warm start is the current plan gone on by
+// some knots, and warm-starts anew when that is not so.
+TEST(Replanner, MotionGoneOnAlongThePlanShiftsTheTree) {
+  const Problem p = rr_problem();
+  Replanner replanner;
+  const Plan first = replanner.plan(p, true);
+  ASSERT_TRUE(first.success()) << failures(first);
+  const Plan warm = continued(first, 3);
+  const Plan re = replanner.plan(gone_on(p, first, 3), false, &warm, 3);
+  ASSERT_TRUE(re.success()) << failures(re);
+  EXPECT_EQ(replanner.last_report().method, "incremental");
+  EXPECT_TRUE(replanner.last_report().incremental);
+  const Plan on = continued(re, 5);
+  const Plan other = replanner.plan(gone_on(p, re, 5), false, &on, 4);  // not knot 4
+  ASSERT_TRUE(other.success()) << failures(other);
+  EXPECT_EQ(replanner.last_report().method, "warm-start");
 }
 
 // Bad changes leave the planner as it was.

@@ -37,8 +37,11 @@ std::vector<StateLimitFactor::Limit> joint_limits(const dynamics::Model& model, 
   return limits;
 }
 
-// Limits and condensed dynamics of every state, state by state.
-void add_state_factors(PlanningGraph& pg, const Problem& problem, const GraphOptions& options) {
+// Limits and condensed dynamics of states first..N, state by state.
+std::vector<FactorEntry> state_entries(const Problem& problem,
+                                       const std::shared_ptr<dynamics::Data>& workspace,
+                                       const GraphOptions& options, int first) {
+  std::vector<FactorEntry> out;
   const auto& model = problem.model;
   const Objectives& obj = problem.objectives;
   const std::vector<StateLimitFactor::Limit> limits = joint_limits(*model, obj.limit_epsilon);
@@ -47,31 +50,36 @@ void add_state_factors(PlanningGraph& pg, const Problem& problem, const GraphOpt
   dyn.min_torque = obj.min_torque;
   dyn.torque_scale = options.torque_scale;
   const bool has_dynamics = !DynamicsStepFactor::rows_for(*model, dyn).empty();
-  for (int k = 0; k <= problem.steps; ++k) {
+  for (int k = first; k <= problem.steps; ++k) {
     if (!limits.empty()) {
-      pg.add(make_entry(
+      out.push_back(make_entry(
           std::make_shared<StateLimitFactor>(k, model->nq(), limits, options.limit_scale),
           {FactorRole::kLimits, k}));
     }
     if (has_dynamics) {
-      pg.add(make_entry(std::make_shared<DynamicsStepFactor>(k, model, pg.dynamics_workspace, dyn),
-                        {FactorRole::kDynamics, k}));
+      out.push_back(make_entry(std::make_shared<DynamicsStepFactor>(k, model, workspace, dyn),
+                               {FactorRole::kDynamics, k}));
     }
   }
+  return out;
 }
 
-// Task constraints on every free state, task by task.
-void add_task_factors(PlanningGraph& pg, const Problem& problem, const GraphOptions& options) {
+// Task constraints on the free states from `first` on, task by task.
+std::vector<FactorEntry> task_entries(const Problem& problem,
+                                      const std::shared_ptr<dynamics::Data>& workspace,
+                                      const GraphOptions& options, int first) {
+  std::vector<FactorEntry> out;
   for (size_t t = 0; t < problem.task_constraints.size(); ++t) {
     const TaskConstraint& task = problem.task_constraints[t];
     const PoseParts parts = task.orientation_only ? PoseParts::kOrientation : PoseParts::kFull;
-    for (int k = 1; k <= problem.steps; ++k) {
-      pg.add(make_entry(std::make_shared<PoseFactor>(k, problem.model, pg.dynamics_workspace,
-                                                     task.frame, task.target, parts,
-                                                     options.pose_scale),
-                        {FactorRole::kTask, k, 0, static_cast<int>(t)}));
+    for (int k = std::max(first, 1); k <= problem.steps; ++k) {
+      out.push_back(make_entry(std::make_shared<PoseFactor>(k, problem.model, workspace,
+                                                            task.frame, task.target, parts,
+                                                            options.pose_scale),
+                               {FactorRole::kTask, k, 0, static_cast<int>(t)}));
     }
   }
+  return out;
 }
 
 // Variables of every state from `init`; the start fixed, the goal at rest, a joint goal fixed.
@@ -186,18 +194,20 @@ std::shared_ptr<CollisionContext> collision_context(
 
 namespace {
 
-// Hinges of `context` at every free state and sub-step, keyed by `role` and `obstacle`.
+// Hinges of `context` at the free states from `first` on and the sub-steps of the intervals
+// that end there, keyed by `role` and `obstacle`.
 std::vector<FactorEntry> hinge_entries(const Problem& problem,
                                        const std::shared_ptr<CollisionContext>& context,
                                        FactorRole role, int obstacle, double epsilon,
-                                       const GraphOptions& options) {
+                                       const GraphOptions& options, int first = 0) {
   std::vector<FactorEntry> out;
   if (!context || context->num_pairs == 0) return out;
   const Objectives& obj = problem.objectives;
   const int N = problem.steps, sub = std::max(0, obj.collision_substeps);
   const double dt = problem.dt();
-  for (int k = 0; k <= N; ++k) {
-    if (k > 0) {  // the start state is fixed; its clearance is checked before planning
+  for (int k = std::max(first - 1, 0); k <= N; ++k) {
+    // The start state is fixed; its clearance is checked before planning.
+    if (k > 0 && k >= first) {
       out.push_back(make_entry(
           std::make_shared<CollisionFactor>(k, 0.0, dt, epsilon, options.collision_scale,
                                             context),
@@ -224,7 +234,7 @@ std::vector<FactorEntry> collision_entries(const Problem& problem,
 }
 
 std::vector<FactorEntry> self_collision_entries(const Problem& problem,
-                                                const GraphOptions& options) {
+                                                const GraphOptions& options, int first) {
   const SelfAndFloor& sf = problem.self_and_floor;
   if (problem.model->collision.empty() || (!sf.self_collision && !sf.floor)) return {};
   std::vector<collision::Obstacle> floor;
@@ -236,7 +246,32 @@ std::vector<FactorEntry> self_collision_entries(const Problem& problem,
       problem.model, floor, obj.self_collision_epsilon + options.collision_query_margin,
       sf.self_collision ? &self : nullptr);
   return hinge_entries(problem, ctx, FactorRole::kSelfCollision, -1, obj.self_collision_epsilon,
-                       options);
+                       options, first);
+}
+
+std::vector<FactorEntry> tail_entries(
+    const Problem& problem, int first, const std::shared_ptr<dynamics::Data>& workspace,
+    const std::map<int, std::shared_ptr<CollisionContext>>& obstacles,
+    const GraphOptions& options) {
+  if (first < 1 || first > problem.steps) {
+    throw std::invalid_argument("tail entries: first state " + std::to_string(first) +
+                                " is not in 1.." + std::to_string(problem.steps));
+  }
+  std::vector<FactorEntry> out;
+  auto append = [&out](std::vector<FactorEntry>&& more) {
+    for (FactorEntry& e : more) out.push_back(std::move(e));
+  };
+  for (FactorEntry& e : timing_entries(problem, options)) {
+    if (e.key.step >= first - 1) out.push_back(std::move(e));
+  }
+  append(state_entries(problem, workspace, options, first));
+  append(self_collision_entries(problem, options, first));
+  append(task_entries(problem, workspace, options, first));
+  for (const auto& [id, context] : obstacles) {
+    append(hinge_entries(problem, context, FactorRole::kCollision, id,
+                         problem.objectives.collision_epsilon, options, first));
+  }
+  return out;
 }
 
 FactorEntry start_entry(const Problem& problem) {
@@ -288,20 +323,28 @@ PlanningGraph build_graph(const Problem& problem, const Trajectory& init,
   if (form == GraphForm::kBatch) {
     if (pose_goal) pg.add(goal_entry(problem, pg.dynamics_workspace, options));
     for (FactorEntry& e : timing_entries(problem, options, between)) pg.add(std::move(e));
-    add_state_factors(pg, problem, options);
+    for (FactorEntry& e : state_entries(problem, pg.dynamics_workspace, options, 0)) {
+      pg.add(std::move(e));
+    }
     if (with_collision) {
       auto ctx = collision_context(problem, problem.obstacles, options);
       pg.collision[-1] = ctx;
       for (FactorEntry& e : collision_entries(problem, ctx, -1, options)) pg.add(std::move(e));
     }
     for (FactorEntry& e : self_collision_entries(problem, options)) pg.add(std::move(e));
-    add_task_factors(pg, problem, options);
+    for (FactorEntry& e : task_entries(problem, pg.dynamics_workspace, options, 1)) {
+      pg.add(std::move(e));
+    }
     return pg;
   }
   for (FactorEntry& e : timing_entries(problem, options, between)) pg.add(std::move(e));
-  add_state_factors(pg, problem, options);
+  for (FactorEntry& e : state_entries(problem, pg.dynamics_workspace, options, 0)) {
+    pg.add(std::move(e));
+  }
   for (FactorEntry& e : self_collision_entries(problem, options)) pg.add(std::move(e));
-  add_task_factors(pg, problem, options);
+  for (FactorEntry& e : task_entries(problem, pg.dynamics_workspace, options, 1)) {
+    pg.add(std::move(e));
+  }
   pg.add(start_entry(problem));
   pg.add(goal_entry(problem, pg.dynamics_workspace, options));
   std::set<int> ids;

@@ -148,10 +148,20 @@ std::vector<FactorEntry> timing_entries(const Problem& problem, const GraphOptio
 std::vector<FactorEntry> collision_entries(const Problem& problem,
                                            const std::shared_ptr<CollisionContext>& context,
                                            int obstacle, const GraphOptions& options);
-/// The self-collision and floor hinges of every free state and sub-step (role kSelfCollision,
-/// in a collision world of their own); none when the problem has neither.
+/// The self-collision and floor hinges of every free state from `first` on and the sub-steps
+/// of the intervals ending there (role kSelfCollision, in a collision world of their own); none
+/// when the problem has neither.
 std::vector<FactorEntry> self_collision_entries(const Problem& problem,
-                                                const GraphOptions& options);
+                                                const GraphOptions& options, int first = 0);
+/// The incremental form's entries on the states from `first` (≥ 1) on and on the intervals
+/// ending there: GP prior, collocation, between-knot dynamics, limits, dynamics, self-collision,
+/// task constraints and the hinges against each obstacle of `obstacles` (by id); not the start
+/// or the goal. What a trajectory needs for the states it gains at its end.
+/// Throws std::invalid_argument for `first` outside 1..steps.
+std::vector<FactorEntry> tail_entries(
+    const Problem& problem, int first, const std::shared_ptr<dynamics::Data>& workspace,
+    const std::map<int, std::shared_ptr<CollisionContext>>& obstacles,
+    const GraphOptions& options);
 /// A collision world of `obstacles` with the problem's query distance.
 std::shared_ptr<CollisionContext> collision_context(
     const Problem& problem, const std::vector<collision::Obstacle>& obstacles,

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <map>
 #include <sstream>
 
 #include "kinograph/graph/stopwatch.h"
@@ -37,6 +38,31 @@ bool same_shape(const collision::Shape& a, const collision::Shape& b) {
   return a.kind == b.kind && a.size == b.size && a.mesh_path == b.mesh_path &&
          a.mesh_scale == b.mesh_scale;
 }
+
+bool same_static_obstacle(const collision::Obstacle& a, const collision::Obstacle& b) {
+  return same_shape(a.shape, b.shape) && !a.is_moving() && !b.is_moving() &&
+         a.pose.matrix() == b.pose.matrix();
+}
+
+bool same_goal(const Goal& a, const Goal& b) {
+  return a.kind == b.kind && a.q == b.q && a.frame == b.frame &&
+         a.pose.matrix() == b.pose.matrix() && a.position_only == b.position_only &&
+         a.joint_tolerance == b.joint_tolerance && a.position_tolerance == b.position_tolerance &&
+         a.orientation_tolerance == b.orientation_tolerance;
+}
+
+bool same_tasks(const std::vector<TaskConstraint>& a, const std::vector<TaskConstraint>& b) {
+  return std::equal(a.begin(), a.end(), b.begin(), b.end(),
+                    [](const TaskConstraint& x, const TaskConstraint& y) {
+                      return x.frame == y.frame && x.orientation_only == y.orientation_only &&
+                             x.target.matrix() == y.target.matrix() && x.tolerance == y.tolerance;
+                    });
+}
+
+// Steps from here on name the variables shift() retired (a trajectory's steps stay far below).
+constexpr uint32_t kRetiredStep = 0x80000000u;
+// How close the start of a shifted replan must be to the plan's knot (rad, rad/s).
+constexpr double kShiftStartTolerance = 1e-3;
 
 // An initial trajectory through `q, qd, qdd` that starts at the problem's start and ends at
 // rest.
@@ -234,6 +260,10 @@ Plan IncrementalPlanner::replan(const ProblemChange& change) {
     return failed_plan("incremental", PlanStatus::kInvalidProblem, e.what());
   }
   problem_ = next;
+  return answer_replan(t0);
+}
+
+Plan IncrementalPlanner::answer_replan(Clock::time_point t0) {
   tree_->compact_if_sparse();
   PlanStatus status = PlanStatus::kMaxUpdates;
   std::string reason;
@@ -265,6 +295,171 @@ Plan IncrementalPlanner::replan(const ProblemChange& change) {
   plan.stats.solve_time_s = seconds_since(t0);
   plan_ = plan;
   return plan;
+}
+
+std::string IncrementalPlanner::shift_refusal(const Problem& next, int m) const {
+  if (!tree_) return "there is no plan to go on from";
+  if (options_.batch.formulation != Formulation::kCondensed) {
+    return "the DFG formulation's variables are not shifted";
+  }
+  const int N = problem_.steps;
+  if (next.steps != N || next.horizon != problem_.horizon) return "the steps or horizon differ";
+  if (m < 1 || m > N - 2) {
+    return "a start " + std::to_string(m) + " knots on is not within 1.." + std::to_string(N - 2);
+  }
+  if (next.model != problem_.model || !same_goal(next.goal, problem_.goal) ||
+      !same_tasks(next.task_constraints, problem_.task_constraints)) {
+    return "the robot, goal or task constraints differ";
+  }
+  for (const graph::Key& k : tree_->isam->estimate().keys()) {
+    if (k.kind() != 'q' && k.kind() != 'v' && k.kind() != 'a') {
+      return "the graph has a variable " + k.to_string() + " that is no state";
+    }
+  }
+  const int n = problem_.model->nq();
+  const graph::Values& x = tree_->isam->estimate();
+  const Eigen::VectorXd qd0 = next.start_qd.size() == n ? next.start_qd : Eigen::VectorXd::Zero(n);
+  if (next.start_q.size() != n ||
+      (x.at(q_key(m)) - next.start_q).cwiseAbs().maxCoeff() > kShiftStartTolerance ||
+      (x.at(v_key(m)) - qd0).cwiseAbs().maxCoeff() > kShiftStartTolerance) {
+    return "the start is not where the plan has the robot at knot " + std::to_string(m);
+  }
+  return "";
+}
+
+Plan IncrementalPlanner::shift(const Problem& next, int m) {
+  const auto t0 = Clock::now();
+  stats_ = IncrementalStats();
+  stats_.method = "incremental";
+  std::string error = shift_refusal(next, m);
+  if (error.empty()) error = check_problem(next);
+  if (!error.empty()) return failed_plan("incremental", PlanStatus::kInvalidProblem, error);
+  IncrementalTree& t = *tree_;
+  const int N = problem_.steps, n = problem_.model->nq();
+  const GraphOptions& go = options_.batch.graph;
+  // Obstacles whose factors are replaced: new, moved, removed or moving along a trajectory
+  // (whose times count from the start).
+  std::set<int> changed;
+  std::map<int, const collision::Obstacle*> before;
+  for (const collision::Obstacle& o : problem_.obstacles) before[o.id] = &o;
+  for (const collision::Obstacle& o : next.obstacles) {
+    const auto it = before.find(o.id);
+    if (it == before.end() || o.is_moving() || !same_static_obstacle(*it->second, o)) {
+      changed.insert(o.id);
+    }
+    if (it != before.end()) before.erase(it);
+  }
+  for (const auto& [id, o] : before) changed.insert(id);
+
+  // Steps from m on count from 0; the states before m and the end state's fixed rest (v_N,
+  // a_N) are retired under steps of their own.
+  const uint32_t retired = kRetiredStep + retired_steps_;
+  const auto rename = [&](graph::Key k) {
+    const uint32_t s = k.step();
+    if (s >= kRetiredStep) return k;
+    if (s < static_cast<uint32_t>(m)) return graph::Key(k.kind(), k.index(), retired + s);
+    if (s == static_cast<uint32_t>(N) && k.kind() != 'q') {
+      return graph::Key(k.kind(), k.index(), retired + m);
+    }
+    return graph::Key(k.kind(), k.index(), s - m);
+  };
+  // An entry's state span after the shift: [step, step] for a state, [step, step + 1] for an
+  // interval (its sub-step hinges included).
+  const auto spans_interval = [](const FactorKey& k) {
+    return k.role == FactorRole::kGpPrior || k.role == FactorRole::kCollocation ||
+           k.role == FactorRole::kInterval ||
+           ((k.role == FactorRole::kCollision || k.role == FactorRole::kSelfCollision) &&
+            k.sub > 0);
+  };
+  const int first_new = N - m;  // states first_new..N get new factors
+  std::vector<FactorEntry> keep, added;
+  std::vector<size_t> removed_slots;
+  for (const FactorEntry& e : t.entries) {
+    FactorKey k = e.key;
+    const bool anchor_role = k.role == FactorRole::kStart || k.role == FactorRole::kGoal;
+    k.step -= m;
+    const int last_state = k.step + (spans_interval(k) ? 1 : 0);
+    const bool gone = anchor_role || k.step < 0 || last_state >= first_new ||
+                      (k.role == FactorRole::kCollision && changed.count(k.index) > 0);
+    if (gone) {
+      removed_slots.push_back(e.slot);
+      continue;
+    }
+    keep.push_back(e);
+    keep.back().key = k;
+  }
+  // Built before anything changes: the tree stays as it was if a factor cannot be built.
+  std::map<int, std::shared_ptr<CollisionContext>> contexts;  // of every obstacle of `next`
+  std::map<int, std::shared_ptr<CollisionContext>> kept_contexts;
+  try {
+    for (const collision::Obstacle& o : next.obstacles) {
+      if (next.model->collision.empty()) break;
+      if (changed.count(o.id) == 0 && t.contexts.count(o.id) > 0 && t.contexts.at(o.id)) {
+        contexts[o.id] = kept_contexts[o.id] = t.contexts.at(o.id);
+        continue;
+      }
+      contexts[o.id] = collision_context(next, {o}, go);
+      for (FactorEntry& e : collision_entries(next, contexts[o.id], o.id, go)) {
+        added.push_back(std::move(e));
+      }
+    }
+    added.push_back(start_entry(next));
+    added.push_back(goal_entry(next, t.workspace, go));
+    for (FactorEntry& e : tail_entries(next, first_new, t.workspace, kept_contexts, go)) {
+      added.push_back(std::move(e));
+    }
+  } catch (const std::exception& e) {
+    return failed_plan("incremental", PlanStatus::kInvalidProblem, e.what());
+  }
+  // The new states: at rest where the plan ends (its last state's velocity and acceleration
+  // free now, the new end's fixed at rest).
+  const graph::Values& x = t.isam->estimate();
+  const Eigen::VectorXd q_end = x.at(q_key(N)), zero = Eigen::VectorXd::Zero(n);
+  std::vector<graph::Key> leaving;
+  for (int s = 0; s < m; ++s) {
+    for (const graph::Key& k : {q_key(s), v_key(s), a_key(s)}) leaving.push_back(rename(k));
+  }
+
+  t.rename(rename);
+  t.retire(leaving);
+  graph::Values fresh;
+  fresh.insert(v_key(first_new), zero);
+  fresh.insert(a_key(first_new), zero);
+  for (int k = first_new + 1; k <= N; ++k) {
+    fresh.insert(q_key(k), q_end);
+    fresh.insert(v_key(k), zero);
+    fresh.insert(a_key(k), zero);
+  }
+  fresh.set_fixed(v_key(N));
+  fresh.set_fixed(a_key(N));
+  t.queue_values(fresh);
+  // Multipliers move with their factors; those of the states left behind and of removed
+  // obstacles are dropped.
+  std::set<int> removed;
+  for (const auto& entry : before) removed.insert(entry.first);
+  t.constraints.rename([m, &removed](const FactorKey& k) -> std::optional<FactorKey> {
+    if (k.role == FactorRole::kStart || k.role == FactorRole::kGoal) return k;
+    if (k.role == FactorRole::kCollision && removed.count(k.index) > 0) return std::nullopt;
+    FactorKey to = k;
+    to.step -= m;
+    if (to.step < 0) return std::nullopt;
+    return to;
+  });
+  for (const FactorEntry& e : added) {
+    if (tracked(e)) t.constraints.bind(e);
+  }
+  t.contexts = std::move(contexts);
+  stats_.factors_replaced = static_cast<int>(removed_slots.size());
+  stats_.factors_added = static_cast<int>(added.size());
+  t.entries = std::move(keep);
+  for (size_t slot : removed_slots) t.queue_remove(slot);
+  for (FactorEntry& e : added) {
+    t.entries.push_back(std::move(e));
+    t.queue_add(t.entries.size() - 1);
+  }
+  retired_steps_ += static_cast<uint32_t>(m) + 1;
+  problem_ = next;
+  return answer_replan(t0);
 }
 
 void IncrementalPlanner::replace_factors(const ProblemChange& change, const Problem& next,
@@ -329,8 +524,8 @@ void IncrementalPlanner::replace_factors(const ProblemChange& change, const Prob
   t.entries = std::move(keep);
   for (size_t slot : removed_slots) t.queue_remove(slot);
   for (FactorEntry& e : added) {
-    t.queue_add(t.entries.size());
     t.entries.push_back(std::move(e));
+    t.queue_add(t.entries.size() - 1);
   }
 }
 

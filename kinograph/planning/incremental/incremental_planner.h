@@ -2,7 +2,8 @@
 // iDFGP: incremental replanning (the paper's section V). The planner keeps one problem's
 // planning graph in incremental form, the constraint multipliers beside it and an ISAM2 Bayes
 // tree over it. A change of goal, obstacles, start state or horizon replaces exactly the
-// factors of the roles it affects, and ISAM2 updates with multiplier rounds run until the
+// factors of the roles it affects (a start further along the plan, at one of its knots, renames
+// the states instead: shift()), and ISAM2 updates with multiplier rounds run until the
 // stopping rule (stopping_rule.h) holds; the result is validated. What to do when it does not
 // validate is the Replanner's policy (replanner.h).
 //
@@ -12,6 +13,8 @@
 // BatchPlanner's own, carried over without a second solve (first_plan.h).
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <chrono>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <set>
@@ -74,6 +77,18 @@ class IncrementalPlanner {
   /// collision) comes back as "invalid_problem" and leaves the state as it was.
   Plan replan(const ProblemChange& change);
 
+  /// Replans `next`, the current problem with its start `m` knots into the current plan (the
+  /// robot went on along it) and the same goal, horizon and steps, on the same Bayes tree: the
+  /// trajectory's variables are renamed m knots earlier, keeping their linearizations, the m
+  /// states left behind leave the graph, m states at rest at the goal are added at the end, and
+  /// the start, goal, changed and moving obstacles' factors are replaced (so are the factors of
+  /// the last m states). Other obstacle changes are applied as by replan(). A problem
+  /// shift_refusal() refuses comes back as "invalid_problem" with the state as it was.
+  Plan shift(const Problem& next, int m);
+  /// Why shift(next, m) cannot apply (empty when it can): no plan, the DFG formulation, other
+  /// steps, horizon or goal, m outside 1..N−2, or a start farther than 1e-3 from knot m.
+  std::string shift_refusal(const Problem& next, int m) const;
+
   /// Shorthands for a single change.
   Plan set_goal(const Goal& goal);
   Plan add_or_move_obstacle(const collision::Obstacle& obstacle);
@@ -101,6 +116,8 @@ class IncrementalPlanner {
   /// Replaces the factors `change` affects (next: the changed problem).
   void replace_factors(const ProblemChange& change, const Problem& next,
                        const std::set<int>& changed_obstacles);
+  /// Runs the updates of a replan whose factors are queued and answers it (started at `t0`).
+  Plan answer_replan(std::chrono::steady_clock::time_point t0);
   /// ISAM2 updates and multiplier rounds until the stopping rule holds.
   std::optional<Plan> run_updates(double previous_cost, PlanStatus& status, std::string& reason);
   /// A multiplier round at the tree's estimate; returns the number of factors re-added.
@@ -114,6 +131,7 @@ class IncrementalPlanner {
   std::unique_ptr<IncrementalTree> tree_;
   Plan plan_;
   IncrementalStats stats_;
+  uint32_t retired_steps_ = 0;  // steps given to retired variables so far (shift())
 };
 
 }  // namespace kinograph::planning

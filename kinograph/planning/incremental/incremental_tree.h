@@ -2,6 +2,7 @@
 // The incremental planner's solver state: the planning graph's factor table in its incremental
 // form, the ISAM2 Bayes tree over it, the constraint multipliers beside it, and the factor
 // changes waiting for the next ISAM2 update.
+#include <functional>
 #include <map>
 #include <memory>
 #include <vector>
@@ -25,13 +26,26 @@ struct IncrementalTree {
   ConstraintState constraints;
   double last_violation = -1;  ///< worst scaled violation at the last multiplier round
 
-  /// A fresh Bayes tree of every entry at `values` (one full elimination); nothing pending.
+  /// A fresh Bayes tree of every entry at `values` (one full elimination; variables no entry
+  /// uses are left out); nothing pending.
   graph::ISAM2Result build(const graph::Values& values);
-  /// Queues entry `i` to be added at the next update (and its old slot, if any, removed).
-  void queue_add(size_t i) { pending_add_.push_back(i); }
+  /// Renames every variable of the tree and of the entries waiting to be added
+  /// (ISAM2::rename_variables).
+  void rename(const std::function<graph::Key(graph::Key)>& rename);
+  /// Variables to add at the next update.
+  void queue_values(const graph::Values& values);
+  /// Variables whose factors have all been removed (a trajectory's states left behind): each is
+  /// held at its estimate by a unit prior so that the eliminated system stays regular, until the
+  /// next fresh tree leaves them out. Queued for the next update.
+  void retire(const std::vector<graph::Key>& keys);
+  /// Queues entry `i`'s factor to be added at the next update (its old slot, if any, is queued
+  /// apart). Entries may be reordered or dropped meanwhile: a factor no entry holds any more is
+  /// not added.
+  void queue_add(size_t i) { pending_add_.push_back(entries[i].factor); }
+  /// Queues an ISAM2 slot to be emptied at the next update (once, however often queued).
   void queue_remove(size_t slot) { pending_remove_.push_back(slot); }
   /// A fresh tree from the current estimate at the next update when re-added factors left
-  /// many empty slots in the ISAM2 graph.
+  /// many empty slots in the ISAM2 graph, or retired variables outnumber the live ones.
   void compact_if_sparse();
   /// One ISAM2 update with the queued changes; its counts and time add to `stats`.
   graph::ISAM2Result update(bool force_relinearize, IncrementalStats& stats);
@@ -49,7 +63,9 @@ struct IncrementalTree {
   bool restore(const Snapshot& s);
 
  private:
-  std::vector<size_t> pending_add_;     // entries to add
+  std::vector<graph::FactorPtr> pending_add_;  // entries' factors to add
+  std::vector<graph::FactorPtr> pending_priors_;  // priors of retired variables, to add
+  int retired_ = 0;                     // retired variables in the ISAM2 tree
   std::vector<size_t> pending_remove_;  // ISAM2 slots to empty
   graph::Values pending_values_;        // only when the tree is (re)built
 };

@@ -22,6 +22,18 @@ void ConstraintState::bind(const FactorEntry& entry) {
 
 void ConstraintState::erase(const FactorKey& key) { records_.erase(key); }
 
+void ConstraintState::rename(
+    const std::function<std::optional<FactorKey>(const FactorKey&)>& rename) {
+  std::map<FactorKey, Record> renamed;
+  for (const auto& [key, record] : records_) {
+    const std::optional<FactorKey> to = rename(key);
+    if (to && !renamed.emplace(*to, record).second) {
+      throw std::invalid_argument("ConstraintState::rename: two records would meet");
+    }
+  }
+  records_ = std::move(renamed);
+}
+
 Multipliers& ConstraintState::at(const FactorKey& key) { return *records_.at(key).m; }
 
 const Multipliers& ConstraintState::at(const FactorKey& key) const {

@@ -2,8 +2,10 @@
 // The augmented-Lagrangian state of a planning graph: one Multipliers record per constraint
 // factor, kept beside the graph under the factor's FactorKey (the factors only read them), and
 // the penalty μ common to all of them.
+#include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "kinograph/planning/factors/constrained_factor.h"
@@ -25,6 +27,9 @@ class ConstraintState {
   void bind(const FactorEntry& entry);
   /// Forgets the record under `key` (its factor left the graph without replacement).
   void erase(const FactorKey& key);
+  /// Files every record under `rename(key)`, or forgets it when that is empty (its factor left
+  /// the graph). Throws std::invalid_argument when two records would meet (nothing changed).
+  void rename(const std::function<std::optional<FactorKey>(const FactorKey&)>& rename);
   bool contains(const FactorKey& key) const { return records_.count(key) > 0; }
   /// The record under `key`; throws std::out_of_range if there is none. After changing its
   /// multipliers, the factors that were linearized with the old ones must be re-linearized.
