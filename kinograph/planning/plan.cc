@@ -1,5 +1,6 @@
 #include "kinograph/planning/plan.h"
 
+#include <algorithm>
 #include <ostream>
 #include <stdexcept>
 
@@ -42,6 +43,29 @@ Plan failed_plan(const std::string& method, PlanStatus status, const std::string
   p.validation.valid = false;
   p.validation.failures.push_back(to_string(status) + ": " + reason);
   return p;
+}
+
+Plan gone_on(const Plan& plan, int knots) {
+  const int rows = static_cast<int>(plan.q.rows());
+  if (knots < 0 || knots >= rows) {
+    throw std::invalid_argument("gone_on: " + std::to_string(knots) + " knots on a plan of " +
+                                std::to_string(rows));
+  }
+  Plan c = plan;
+  c.stats = SolveStats();
+  c.validation = Validation();
+  for (int k = 0; k < rows; ++k) {
+    const int from = std::min(k + knots, rows - 1);
+    c.q.row(k) = plan.q.row(from);
+    c.qd.row(k) = plan.qd.row(from);
+    c.qdd.row(k) = plan.qdd.row(from);
+    if (c.tau.rows() == rows) c.tau.row(k) = plan.tau.row(from);
+    if (k + knots >= rows) {
+      c.qd.row(k).setZero();
+      c.qdd.row(k).setZero();
+    }
+  }
+  return c;
 }
 
 std::ostream& operator<<(std::ostream& os, PlanStatus status) { return os << to_string(status); }

@@ -83,4 +83,9 @@ struct Plan {
 /// stats and its validation's one failure.
 Plan failed_plan(const std::string& method, PlanStatus status, const std::string& reason);
 
+/// The motion of a robot that went on `knots` knots along `plan`, at the same knot times: its
+/// knots from `knots` on, then its last position at rest (τ held). Stats and validation are
+/// left empty. Throws std::invalid_argument unless 0 <= knots < the number of knots.
+Plan gone_on(const Plan& plan, int knots);
+
 }  // namespace kinograph::planning

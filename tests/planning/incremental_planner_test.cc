@@ -216,7 +216,7 @@ TEST(IncrementalPlanner, HorizonChange) {
 }
 
 // The problem `p` with its start `m` knots into `plan` (the robot went on along it).
-Problem gone_on(const Problem& p, const Plan& plan, int m) {
+Problem started_at(const Problem& p, const Plan& plan, int m) {
   Problem next = p;
   next.start_q = plan.q.row(m).transpose();
   next.start_qd = plan.qd.row(m).transpose();
@@ -236,21 +236,22 @@ collision::Obstacle passing_ball(int id, double y) {
   return o;
 }
 
-// `plan` from knot m on, held at its end for the last m knots: the motion gone on.
-Plan continued(const Plan& plan, int m) {
-  Plan c = plan;
-  const int N = static_cast<int>(plan.q.rows()) - 1;
-  for (int k = 0; k <= N; ++k) {
-    const int from = std::min(k + m, N);
-    c.q.row(k) = plan.q.row(from);
-    c.qd.row(k) = plan.qd.row(from);
-    c.qdd.row(k) = plan.qdd.row(from);
-    if (k + m > N) {
-      c.qd.row(k).setZero();
-      c.qdd.row(k).setZero();
-    }
+// The motion gone on along a plan: its knots from m on, then at rest where it ends.
+TEST(GoneOn, KnotsFromMOnThenAtRestAtTheEnd) {
+  const Problem p = rr_problem();
+  const Plan first = BatchPlanner().plan(p);
+  ASSERT_TRUE(first.success()) << failures(first);
+  const int m = 3, N = p.steps;
+  const Plan on = gone_on(first, m);
+  EXPECT_EQ(on.t, first.t);
+  EXPECT_EQ(on.q.row(0), first.q.row(m));
+  EXPECT_EQ(on.qd.row(N - m), first.qd.row(N));
+  for (int k = N - m + 1; k <= N; ++k) {
+    EXPECT_EQ(on.q.row(k), first.q.row(N));
+    EXPECT_TRUE(on.qd.row(k).isZero() && on.qdd.row(k).isZero());
   }
-  return c;
+  EXPECT_THROW(gone_on(first, N + 1), std::invalid_argument);
+  EXPECT_THROW(gone_on(first, -1), std::invalid_argument);
 }
 
 // A replan that goes on from a knot of the plan renames the tree's states instead of rebuilding
@@ -265,7 +266,7 @@ TEST(IncrementalPlanner, ShiftGoesOnFromAKnotOfThePlan) {
   const Plan first = planner.plan(p);
   ASSERT_TRUE(first.success()) << failures(first);
   const int m = 4;
-  Problem next = gone_on(p, first, m);
+  Problem next = started_at(p, first, m);
   next.obstacles.back() = passing_ball(10, 0.5);  // a neighbour's new plan: a new id
   ASSERT_EQ(planner.shift_refusal(next, m), "");
   const Plan re = planner.shift(next, m);
@@ -276,7 +277,7 @@ TEST(IncrementalPlanner, ShiftGoesOnFromAKnotOfThePlan) {
   EXPECT_EQ(planner.problem().obstacles.back().id, 10);
   // The motion goes on smoothly from where it was.
   EXPECT_LT((re.q.topRows(2) - first.q.middleRows(m, 2)).cwiseAbs().maxCoeff(), 0.05);
-  const Plan warm = continued(first, m);
+  const Plan warm = gone_on(first, m);
   const Plan batch = BatchPlanner(options.batch).plan(next, &warm);
   ASSERT_TRUE(batch.success()) << failures(batch);
   EXPECT_NEAR(re.stats.cost, batch.stats.cost, 0.02 * batch.stats.cost + 1e-6);
@@ -293,7 +294,7 @@ TEST(IncrementalPlanner, RepeatedShiftsStayValid) {
   ASSERT_TRUE(plan.success()) << failures(plan);
   Problem next = p;
   for (int i = 1; i <= 20; ++i) {
-    next = gone_on(next, plan, 2);
+    next = started_at(next, plan, 2);
     next.obstacles.back() = passing_ball(100 + i, 0.6 - 0.01 * i);
     plan = planner.shift(next, 2);
     ASSERT_TRUE(plan.success()) << "shift " << i << ": " << failures(plan);
@@ -308,16 +309,16 @@ TEST(IncrementalPlanner, ShiftRefusals) {
   EXPECT_NE(planner.shift_refusal(p, 2), "");  // no plan yet
   const Plan first = planner.plan(p);
   ASSERT_TRUE(first.success());
-  EXPECT_NE(planner.shift_refusal(gone_on(p, first, 0), 0), "");
-  EXPECT_NE(planner.shift_refusal(gone_on(p, first, p.steps - 1), p.steps - 1), "");
-  EXPECT_NE(planner.shift_refusal(gone_on(p, first, 5), 4), "");  // not where knot 4 is
-  Problem other_goal = gone_on(p, first, 3);
+  EXPECT_NE(planner.shift_refusal(started_at(p, first, 0), 0), "");
+  EXPECT_NE(planner.shift_refusal(started_at(p, first, p.steps - 1), p.steps - 1), "");
+  EXPECT_NE(planner.shift_refusal(started_at(p, first, 5), 4), "");  // not where knot 4 is
+  Problem other_goal = started_at(p, first, 3);
   other_goal.goal.q = Eigen::Vector2d(1.1, 0.7);
   EXPECT_NE(planner.shift_refusal(other_goal, 3), "");
   const Plan refused = planner.shift(other_goal, 3);
   EXPECT_EQ(refused.stats.status, PlanStatus::kInvalidProblem);
   EXPECT_EQ(planner.problem().start_q, p.start_q);
-  EXPECT_TRUE(planner.shift(gone_on(p, first, 3), 3).success());
+  EXPECT_TRUE(planner.shift(started_at(p, first, 3), 3).success());
 }
 
 // The Replanner shifts the tree when told that its warm start is the current plan gone on by
@@ -327,13 +328,13 @@ TEST(Replanner, MotionGoneOnAlongThePlanShiftsTheTree) {
   Replanner replanner;
   const Plan first = replanner.plan(p, true);
   ASSERT_TRUE(first.success()) << failures(first);
-  const Plan warm = continued(first, 3);
-  const Plan re = replanner.plan(gone_on(p, first, 3), false, &warm, 3);
+  const Plan warm = gone_on(first, 3);
+  const Plan re = replanner.plan(started_at(p, first, 3), false, &warm, 3);
   ASSERT_TRUE(re.success()) << failures(re);
   EXPECT_EQ(replanner.last_report().method, "incremental");
   EXPECT_TRUE(replanner.last_report().incremental);
-  const Plan on = continued(re, 5);
-  const Plan other = replanner.plan(gone_on(p, re, 5), false, &on, 4);  // not knot 4
+  const Plan on = gone_on(re, 5);
+  const Plan other = replanner.plan(started_at(p, re, 5), false, &on, 4);  // not knot 4
   ASSERT_TRUE(other.success()) << failures(other);
   EXPECT_EQ(replanner.last_report().method, "warm-start");
 }

@@ -445,18 +445,10 @@ Plan IncrementalPlanner::shift(const Problem& next, int m) {
     if (to.step < 0) return std::nullopt;
     return to;
   });
-  for (const FactorEntry& e : added) {
-    if (tracked(e)) t.constraints.bind(e);
-  }
   t.contexts = std::move(contexts);
   stats_.factors_replaced = static_cast<int>(removed_slots.size());
   stats_.factors_added = static_cast<int>(added.size());
-  t.entries = std::move(keep);
-  for (size_t slot : removed_slots) t.queue_remove(slot);
-  for (FactorEntry& e : added) {
-    t.entries.push_back(std::move(e));
-    t.queue_add(t.entries.size() - 1);
-  }
+  t.replace(std::move(keep), std::move(added), removed_slots);
   retired_steps_ += static_cast<uint32_t>(m) + 1;
   problem_ = next;
   return answer_replan(t0);
@@ -516,17 +508,9 @@ void IncrementalPlanner::replace_factors(const ProblemChange& change, const Prob
   for (int id : change.remove) t.contexts.erase(id);
   // Multipliers carry to a replacement under the same key.
   for (const FactorKey& k : dropped) t.constraints.erase(k);
-  for (const FactorEntry& e : added) {
-    if (tracked(e)) t.constraints.bind(e);
-  }
   stats_.factors_replaced = static_cast<int>(removed_slots.size());
   stats_.factors_added = static_cast<int>(added.size());
-  t.entries = std::move(keep);
-  for (size_t slot : removed_slots) t.queue_remove(slot);
-  for (FactorEntry& e : added) {
-    t.entries.push_back(std::move(e));
-    t.queue_add(t.entries.size() - 1);
-  }
+  t.replace(std::move(keep), std::move(added), removed_slots);
 }
 
 std::optional<Plan> IncrementalPlanner::run_updates(double previous_cost, PlanStatus& status,

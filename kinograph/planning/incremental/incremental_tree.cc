@@ -67,6 +67,19 @@ void IncrementalTree::compact_if_sparse() {
   for (size_t i = 0; i < entries.size(); ++i) queue_add(i);
 }
 
+void IncrementalTree::replace(std::vector<FactorEntry> keep, std::vector<FactorEntry> added,
+                              const std::vector<size_t>& removed_slots) {
+  for (const FactorEntry& e : added) {
+    if (e.constrained && e.constrained->has_constraints()) constraints.bind(e);
+  }
+  entries = std::move(keep);
+  for (size_t slot : removed_slots) queue_remove(slot);
+  for (FactorEntry& e : added) {
+    entries.push_back(std::move(e));
+    queue_add(entries.size() - 1);
+  }
+}
+
 void IncrementalTree::rename(const std::function<graph::Key(graph::Key)>& rename) {
   std::unordered_set<const graph::Factor*> renamed;
   for (size_t i = 0; i < isam->graph().size(); ++i) {

@@ -42,6 +42,10 @@ struct IncrementalTree {
   /// apart). Entries may be reordered or dropped meanwhile: a factor no entry holds any more is
   /// not added.
   void queue_add(size_t i) { pending_add_.push_back(entries[i].factor); }
+  /// The entries become `keep` then `added` (queued, their constraint rows bound to the records
+  /// under their keys), and `removed_slots` are queued to be emptied.
+  void replace(std::vector<FactorEntry> keep, std::vector<FactorEntry> added,
+               const std::vector<size_t>& removed_slots);
   /// Queues an ISAM2 slot to be emptied at the next update (once, however often queued).
   void queue_remove(size_t slot) { pending_remove_.push_back(slot); }
   /// A fresh tree from the current estimate at the next update when re-added factors left
