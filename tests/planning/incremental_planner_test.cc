@@ -311,7 +311,9 @@ TEST(IncrementalPlanner, ShiftRefusals) {
   ASSERT_TRUE(first.success());
   EXPECT_NE(planner.shift_refusal(started_at(p, first, 0), 0), "");
   EXPECT_NE(planner.shift_refusal(started_at(p, first, p.steps - 1), p.steps - 1), "");
-  EXPECT_NE(planner.shift_refusal(started_at(p, first, 5), 4), "");  // not where knot 4 is
+  Problem elsewhere = started_at(p, first, 4);
+  elsewhere.start_q(0) += 0.2;  // not where the plan has the robot at knot 4
+  EXPECT_NE(planner.shift_refusal(elsewhere, 4), "");
   Problem other_goal = started_at(p, first, 3);
   other_goal.goal.q = Eigen::Vector2d(1.1, 0.7);
   EXPECT_NE(planner.shift_refusal(other_goal, 3), "");
@@ -334,7 +336,9 @@ TEST(Replanner, MotionGoneOnAlongThePlanShiftsTheTree) {
   EXPECT_EQ(replanner.last_report().method, "incremental");
   EXPECT_TRUE(replanner.last_report().incremental);
   const Plan on = gone_on(re, 5);
-  const Plan other = replanner.plan(started_at(p, re, 5), false, &on, 4);  // not knot 4
+  Problem elsewhere = started_at(p, re, 5);
+  elsewhere.start_qd(0) += 0.2;  // not how the plan has the robot move at knot 5
+  const Plan other = replanner.plan(elsewhere, false, &on, 5);
   ASSERT_TRUE(other.success()) << failures(other);
   EXPECT_EQ(replanner.last_report().method, "warm-start");
 }

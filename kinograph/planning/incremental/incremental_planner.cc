@@ -61,8 +61,10 @@ bool same_tasks(const std::vector<TaskConstraint>& a, const std::vector<TaskCons
 
 // Steps from here on name the variables shift() retired (a trajectory's steps stay far below).
 constexpr uint32_t kRetiredStep = 0x80000000u;
-// How close the start of a shifted replan must be to the plan's knot (rad, rad/s).
-constexpr double kShiftStartTolerance = 1e-3;
+// How close the start of a shifted replan must be to the tree's knot (rad, rad/s): the tree's
+// estimate may lie a little off the plan that was answered (a batch plan carried into it, then
+// settled), and the start prior re-anchors the rest, as a measured start does.
+constexpr double kShiftStartTolerance = 0.05;
 
 // An initial trajectory through `q, qd, qdd` that starts at the problem's start and ends at
 // rest.

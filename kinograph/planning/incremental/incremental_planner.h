@@ -86,7 +86,8 @@ class IncrementalPlanner {
   /// shift_refusal() refuses comes back as "invalid_problem" with the state as it was.
   Plan shift(const Problem& next, int m);
   /// Why shift(next, m) cannot apply (empty when it can): no plan, the DFG formulation, other
-  /// steps, horizon or goal, m outside 1..N−2, or a start farther than 1e-3 from knot m.
+  /// steps, horizon or goal, m outside 1..N−2, or a start farther than 0.05 (rad, rad/s) from
+  /// the tree's knot m.
   std::string shift_refusal(const Problem& next, int m) const;
 
   /// Shorthands for a single change.
