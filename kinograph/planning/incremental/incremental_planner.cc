@@ -352,6 +352,10 @@ Plan IncrementalPlanner::shift(const Problem& next, int m) {
     if (it != before.end()) before.erase(it);
   }
   for (const auto& [id, o] : before) changed.insert(id);
+  // An obstacle without a collision world of its own in the tree gets one, and new factors.
+  for (const collision::Obstacle& o : next.obstacles) {
+    if (tree_->contexts.count(o.id) == 0 || !tree_->contexts.at(o.id)) changed.insert(o.id);
+  }
 
   // Steps from m on count from 0; the states before m and the end state's fixed rest (v_N,
   // a_N) are retired under steps of their own.
@@ -396,7 +400,7 @@ Plan IncrementalPlanner::shift(const Problem& next, int m) {
   try {
     for (const collision::Obstacle& o : next.obstacles) {
       if (next.model->collision.empty()) break;
-      if (changed.count(o.id) == 0 && t.contexts.count(o.id) > 0 && t.contexts.at(o.id)) {
+      if (changed.count(o.id) == 0) {
         contexts[o.id] = kept_contexts[o.id] = t.contexts.at(o.id);
         continue;
       }
