@@ -27,4 +27,17 @@ struct Obstacle {
   bool is_moving() const { return !trajectory.empty(); }
 };
 
+// Whether two shapes are the same solid (kind, size and mesh).
+inline bool same_shape(const Shape& a, const Shape& b) {
+  return a.kind == b.kind && a.size == b.size && a.mesh_path == b.mesh_path &&
+         a.mesh_scale == b.mesh_scale;
+}
+
+// Whether two fixed obstacles are the same solid at the same pose (ids not compared); false
+// when either moves.
+inline bool same_static_obstacle(const Obstacle& a, const Obstacle& b) {
+  return !a.is_moving() && !b.is_moving() && same_shape(a.shape, b.shape) &&
+         a.pose.matrix() == b.pose.matrix();
+}
+
 }  // namespace kinograph::collision

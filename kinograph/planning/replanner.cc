@@ -28,12 +28,6 @@ double joint_goal_change(const Goal& a, const Goal& b) {
   return (a.q - b.q).cwiseAbs().maxCoeff();
 }
 
-bool same_obstacle(const collision::Obstacle& a, const collision::Obstacle& b) {
-  return a.id == b.id && a.shape.kind == b.shape.kind && a.shape.size == b.shape.size &&
-         a.shape.mesh_path == b.shape.mesh_path && a.shape.mesh_scale == b.shape.mesh_scale &&
-         a.pose.matrix() == b.pose.matrix() && a.trajectory.empty() && b.trajectory.empty();
-}
-
 // The change from `from` to `to`: obstacles by id, the goal when `new_goal`, the start and the
 // horizon when they differ. Obstacles that move along a trajectory are kept as they are unless
 // they were added or removed.
@@ -44,7 +38,7 @@ ProblemChange change_between(const Problem& from, const Problem& to, bool new_go
   for (const auto& o : to.obstacles) {
     const auto it = planned.find(o.id);
     const bool moving = it != planned.end() && it->second->is_moving() && o.is_moving();
-    if (it == planned.end() || (!moving && !same_obstacle(*it->second, o))) {
+    if (it == planned.end() || (!moving && !collision::same_static_obstacle(*it->second, o))) {
       change.add_or_move.push_back(o);
     }
     if (it != planned.end()) planned.erase(it);

@@ -34,16 +34,6 @@ bool has_bound_multipliers(const ConstrainedFactor& f, const Multipliers& m) {
   return false;
 }
 
-bool same_shape(const collision::Shape& a, const collision::Shape& b) {
-  return a.kind == b.kind && a.size == b.size && a.mesh_path == b.mesh_path &&
-         a.mesh_scale == b.mesh_scale;
-}
-
-bool same_static_obstacle(const collision::Obstacle& a, const collision::Obstacle& b) {
-  return same_shape(a.shape, b.shape) && !a.is_moving() && !b.is_moving() &&
-         a.pose.matrix() == b.pose.matrix();
-}
-
 bool same_goal(const Goal& a, const Goal& b) {
   return a.kind == b.kind && a.q == b.q && a.frame == b.frame &&
          a.pose.matrix() == b.pose.matrix() && a.position_only == b.position_only &&
@@ -346,7 +336,7 @@ Plan IncrementalPlanner::shift(const Problem& next, int m) {
   for (const collision::Obstacle& o : problem_.obstacles) before[o.id] = &o;
   for (const collision::Obstacle& o : next.obstacles) {
     const auto it = before.find(o.id);
-    if (it == before.end() || o.is_moving() || !same_static_obstacle(*it->second, o)) {
+    if (it == before.end() || !collision::same_static_obstacle(*it->second, o)) {
       changed.insert(o.id);
     }
     if (it != before.end()) before.erase(it);
@@ -502,7 +492,7 @@ void IncrementalPlanner::replace_factors(const ProblemChange& change, const Prob
     const auto old = std::find_if(problem_.obstacles.begin(), problem_.obstacles.end(),
                                   [&o](const collision::Obstacle& x) { return x.id == o.id; });
     if (old != problem_.obstacles.end() && t.contexts.count(o.id) > 0 &&
-        same_shape(old->shape, o.shape) && !o.is_moving() && !old->is_moving()) {
+        collision::same_shape(old->shape, o.shape) && !o.is_moving() && !old->is_moving()) {
       ctx = t.contexts[o.id];
       if (ctx && !ctx->world.move_obstacle(o.id, o.pose).ok) ctx = nullptr;
     }

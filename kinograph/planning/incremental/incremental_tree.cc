@@ -85,11 +85,11 @@ void IncrementalTree::rename(const std::function<graph::Key(graph::Key)>& rename
   for (size_t i = 0; i < isam->graph().size(); ++i) {
     if (isam->graph()[i]) renamed.insert(isam->graph()[i].get());
   }
-  for (const graph::FactorPtr& f : pending_priors_) renamed.insert(f.get());  // none when called
   isam->rename_variables(rename);
   for (const FactorEntry& e : entries) {
     if (renamed.insert(e.factor.get()).second) e.factor->rename_keys(rename);
   }
+  for (const graph::FactorPtr& f : pending_priors_) f->rename_keys(rename);
   pending_values_.rename(rename);
 }
 
@@ -111,7 +111,9 @@ void IncrementalTree::retire(const std::vector<graph::Key>& keys) {
 
 graph::ISAM2Result IncrementalTree::update(bool force_relinearize, IncrementalStats& stats) {
   std::unordered_map<const graph::Factor*, size_t> entry_of;
-  for (size_t i = 0; i < entries.size(); ++i) entry_of.emplace(entries[i].factor.get(), i);
+  if (!pending_add_.empty()) {
+    for (size_t i = 0; i < entries.size(); ++i) entry_of.emplace(entries[i].factor.get(), i);
+  }
   std::vector<size_t> added;  // entries, each once
   std::unordered_set<size_t> seen;
   for (const graph::FactorPtr& f : pending_add_) {
