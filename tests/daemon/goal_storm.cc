@@ -68,8 +68,17 @@ class Answers {
     std::lock_guard lock(mutex_);
     const auto now = Clock::now();
     if (status_) {
-      max_heartbeat_gap_s_ =
-          std::max(max_heartbeat_gap_s_, std::chrono::duration<double>(now - status_at_).count());
+      // Received gap against the daemon's own stamps: a stall of the daemon widens both, one of
+      // this client (or of the network) only the first.
+      const double gap = std::chrono::duration<double>(now - status_at_).count();
+      const double sent_gap = 1e-6 * static_cast<double>(s.utime - status_->utime);
+      if (gap > max_heartbeat_gap_s_) {
+        max_heartbeat_gap_s_ = gap;
+        max_gap_sent_gap_s_ = sent_gap;
+        max_gap_at_s_ = std::chrono::duration<double>(now - start_).count();
+        max_gap_end_utime_ = s.utime;
+      }
+      max_heartbeat_sent_gap_s_ = std::max(max_heartbeat_sent_gap_s_, sent_gap);
     }
     status_ = s;
     status_at_ = now;
@@ -123,7 +132,12 @@ class Answers {
   std::vector<double> latencies_ms_;
   std::optional<kinograph::planner_status_t> status_;
   Clock::time_point status_at_;
-  double max_heartbeat_gap_s_ = 0;
+  const Clock::time_point start_ = Clock::now();
+  double max_heartbeat_gap_s_ = 0;       // between two heartbeats' arrival here
+  double max_heartbeat_sent_gap_s_ = 0;  // between two heartbeats' utime stamps (daemon's clock)
+  double max_gap_sent_gap_s_ = 0;        // the stamps' gap of the longest arrival gap
+  double max_gap_at_s_ = 0;              // when that gap ended, seconds after this client started
+  int64_t max_gap_end_utime_ = 0;        // and the stamp of the heartbeat that ended it
   int malformed_ = 0;
   int64_t echoed_ = 0;
   int answered_after_refusal_ = 0;
@@ -314,7 +328,11 @@ int main(int argc, char** argv) {
        << ", \"last_goal_valid\": " << (last_valid ? "true" : "false")
        << ", \"answer_latency_ms_p50\": " << percentile(answers.latencies_ms_, 0.5)
        << ", \"answer_latency_ms_p99\": " << percentile(answers.latencies_ms_, 0.99)
-       << ", \"max_heartbeat_gap_s\": " << answers.max_heartbeat_gap_s_;
+       << ", \"max_heartbeat_gap_s\": " << answers.max_heartbeat_gap_s_
+       << ", \"max_heartbeat_gap_stamped_s\": " << answers.max_gap_sent_gap_s_
+       << ", \"max_heartbeat_gap_at_s\": " << answers.max_gap_at_s_
+       << ", \"max_heartbeat_gap_end_utime\": " << answers.max_gap_end_utime_
+       << ", \"max_heartbeat_stamp_gap_s\": " << answers.max_heartbeat_sent_gap_s_;
   if (st) {
     json << ", \"heartbeat\": {\"received\": " << st->num_goals_received
          << ", \"answered\": " << st->num_goals_answered
