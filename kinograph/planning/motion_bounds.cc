@@ -6,12 +6,13 @@
 namespace kinograph::planning {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
+// A duration no motion within the limits reaches.
+constexpr double kNever = std::numeric_limits<double>::infinity();
 
 // Rest to rest over distance L ≥ 0: accelerate, coast at vmax if it is reached, decelerate.
 double rest_to_rest(double L, double vmax, double amax) {
   if (L <= 0) return 0;
-  if (vmax <= 0) return kInf;
+  if (vmax <= 0) return kNever;
   if (std::isinf(amax)) return L / vmax;
   if (L <= vmax * vmax / amax) return 2 * std::sqrt(L / amax);  // triangle: peak below vmax
   return L / vmax + vmax / amax;
@@ -27,7 +28,7 @@ double min_time_to_rest(double distance, double v0, double vmax, double amax) {
   // Work in the direction of travel: d ≥ 0, u0 the start velocity along it.
   const double d = std::abs(distance);
   const double u0 = distance < 0 ? -v0 : v0;
-  if (std::isinf(amax)) return d == 0 ? 0.0 : (vmax <= 0 ? kInf : d / vmax);
+  if (std::isinf(amax)) return d == 0 ? 0.0 : (vmax <= 0 ? kNever : d / vmax);
   if (u0 < 0) {
     // Moving away: stop first (the shortest way to rest), then go from rest.
     return -u0 / amax + rest_to_rest(d + stopping_distance(u0, amax), vmax, amax);
