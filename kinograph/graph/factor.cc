@@ -74,7 +74,7 @@ void Factor::jacobian_changed() {
 }
 
 void Factor::whitened(const double* const* x, Eigen::Ref<Eigen::VectorXd> r,
-                      Eigen::Ref<Eigen::MatrixXd>* J) const {
+                      Eigen::Ref<Eigen::MatrixXd>* J, RowSupport* support) const {
   const FactorValues xv(x, dims_.data());
   if (J == nullptr) {
     evaluate(xv, r, nullptr);
@@ -82,7 +82,10 @@ void Factor::whitened(const double* const* x, Eigen::Ref<Eigen::VectorXd> r,
     return;
   }
   J->setZero();
-  const Jacobians jac(J->data(), J->rows(), J->outerStride(), offsets_.data(), dims_.data());
+  if (support != nullptr) support->all = true;
+  // A noise model may mix rows, so only an unwhitened factor may leave rows out.
+  const Jacobians jac(J->data(), J->rows(), J->outerStride(), offsets_.data(), dims_.data(),
+                      noise_ ? nullptr : support);
   evaluate(xv, r, &jac);
   if (noise_) noise_->whiten_system(r, *J);
 }
@@ -128,25 +131,49 @@ bool all_finite(const Eigen::Ref<const Eigen::MatrixXd>& M) {
 }
 
 int compact_nonzero_rows(Eigen::Ref<Eigen::MatrixXd> J, Eigen::Ref<Eigen::VectorXd> r,
-                         bool* finite) {
+                         bool* finite, const RowSupport* support) {
   // J is column-major: rows are found and moved column by column, never by strided row scans.
   // A row of finite entries is all zero exactly when the sum of its magnitudes is zero.
   const Eigen::Index m = J.rows();
   thread_local Eigen::ArrayXd magnitude;
   thread_local std::vector<Eigen::Index> rows;
-  if (magnitude.size() < m) magnitude.resize(m);
-  auto mag = magnitude.head(m);
-  mag.setZero();
-  for (Eigen::Index c = 0; c < J.cols(); ++c) mag += J.col(c).array().abs();
-  if (finite != nullptr) {
-    // A NaN or ±inf entry makes its row's magnitude non-finite; only an overflowing sum of
-    // finite entries needs the exact test.
-    *finite = mag.allFinite() || all_finite(J);
-    if (!*finite) return static_cast<int>(m);
-  }
   rows.clear();
-  for (Eigen::Index i = 0; i < m; ++i) {
-    if (mag[i] != 0) rows.push_back(i);
+  if (support != nullptr && !support->all) {
+    // Only the listed rows, each summed in the same column order as below.
+    const auto& listed = support->rows;
+    const Eigen::Index n = static_cast<Eigen::Index>(listed.size());
+    if (magnitude.size() < n) magnitude.resize(n);
+    auto mag = magnitude.head(n);
+    mag.setZero();
+    for (Eigen::Index c = 0; c < J.cols(); ++c) {
+      const double* col = J.col(c).data();
+      for (Eigen::Index t = 0; t < n; ++t) mag[t] += std::abs(col[listed[t]]);
+    }
+    if (finite != nullptr) {
+      // Only an overflowing sum of finite entries needs the exact test.
+      *finite = true;
+      for (Eigen::Index t = 0; t < n; ++t) {
+        if (!std::isfinite(mag[t]) && !J.row(listed[t]).allFinite()) *finite = false;
+      }
+      if (!*finite) return static_cast<int>(m);
+    }
+    for (Eigen::Index t = 0; t < n; ++t) {
+      if (mag[t] != 0) rows.push_back(listed[t]);
+    }
+  } else {
+    if (magnitude.size() < m) magnitude.resize(m);
+    auto mag = magnitude.head(m);
+    mag.setZero();
+    for (Eigen::Index c = 0; c < J.cols(); ++c) mag += J.col(c).array().abs();
+    if (finite != nullptr) {
+      // A NaN or ±inf entry makes its row's magnitude non-finite; only an overflowing sum of
+      // finite entries needs the exact test.
+      *finite = mag.allFinite() || all_finite(J);
+      if (!*finite) return static_cast<int>(m);
+    }
+    for (Eigen::Index i = 0; i < m; ++i) {
+      if (mag[i] != 0) rows.push_back(i);
+    }
   }
   const Eigen::Index kept = static_cast<Eigen::Index>(rows.size());
   if (kept == m) return static_cast<int>(kept);

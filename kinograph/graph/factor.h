@@ -24,18 +24,33 @@ class FactorValues {
   const int* dims_;
 };
 
+/// The rows of a whitened Jacobian that may be non-zero. A factor with many rows that are
+/// usually inactive (a collision hinge per pair) lists them, so a solver touches only those.
+struct RowSupport {
+  bool all = true;        ///< every row may be non-zero (`rows` unused)
+  std::vector<int> rows;  ///< otherwise these, ascending; the other rows hold anything
+};
+
 /// Writable view of a factor's Jacobian, one dense block per key, stacked side by side in key
 /// order (residual_dim rows). Blocks arrive zeroed, so authors fill only non-zero entries.
 class Jacobians {
  public:
   using Block = Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>>;
   Jacobians(double* data, Eigen::Index rows, Eigen::Index outer_stride, const int* col_offsets,
-            const int* dims)
-      : data_(data), rows_(rows), stride_(outer_stride), offsets_(col_offsets), dims_(dims) {}
+            const int* dims, RowSupport* support = nullptr)
+      : data_(data),
+        rows_(rows),
+        stride_(outer_stride),
+        offsets_(col_offsets),
+        dims_(dims),
+        support_(support) {}
   /// de/dx_i: residual_dim × dim(key i).
   Block block(int i) const {
     return Block(data_ + offsets_[i] * stride_, rows_, dims_[i], Eigen::OuterStride<>(stride_));
   }
+  /// Where the caller takes a list of the rows that may be non-zero (null: it reads every row,
+  /// which must then hold the Jacobian).
+  RowSupport* row_support() const { return support_; }
 
  private:
   double* data_;
@@ -43,6 +58,7 @@ class Jacobians {
   Eigen::Index stride_;
   const int* offsets_;
   const int* dims_;
+  RowSupport* support_;
 };
 
 /// One cost term over a fixed set of vector variables. Keys, their dimensions and the residual
@@ -94,9 +110,10 @@ class Factor {
   double error(const Values& values) const;
 
   /// Raw-pointer entry used by the solvers' hot loops: `x` holds one pointer per key; `J` may be
-  /// null. Applies the noise model.
+  /// null. Applies the noise model. With `support` (and J) the factor may say which rows of J
+  /// may be non-zero; the others are then left as they are, and the caller must not read them.
   void whitened(const double* const* x, Eigen::Ref<Eigen::VectorXd> r,
-                Eigen::Ref<Eigen::MatrixXd>* J) const;
+                Eigen::Ref<Eigen::MatrixXd>* J, RowSupport* support = nullptr) const;
 
   /// For a factor linear in its variables (its whitened Jacobian then does not depend on them),
   /// a number that changes whenever that Jacobian may change (noise model, penalty); −1 for
@@ -134,8 +151,10 @@ bool all_finite(const Eigen::Ref<const Eigen::MatrixXd>& M);
 /// skip most of the work. Order of the kept rows is preserved.
 /// With `finite` non-null it also says whether every entry of J is finite, from the same pass
 /// (then J and r are left as they were when it is false).
+/// With `support`, only its rows are read (and checked for finiteness); the result is the same
+/// as for a J that is zero outside them.
 int compact_nonzero_rows(Eigen::Ref<Eigen::MatrixXd> J, Eigen::Ref<Eigen::VectorXd> r,
-                         bool* finite = nullptr);
+                         bool* finite = nullptr, const RowSupport* support = nullptr);
 
 /// H = JᵀJ of a factor's (kept) Jacobian rows. From 16 columns on (GP prior, collocation) a
 /// symmetric rank update, half the flops of the product (21×42: 3.1 instead of 4.4 µs); below,

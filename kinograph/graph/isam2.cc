@@ -191,19 +191,25 @@ bool ISAM2::linearize_fresh(const Factor& factor, LinearizedFactor& lf, double* 
   const int rows = factor.residual_dim();
   auto r = r_.head(rows);
   Eigen::Ref<Eigen::MatrixXd> J = J_.topLeftCorner(rows, factor.jacobian_cols());
-  factor.whitened(ptrs_.data(), r, &J);
-  if (!r.allFinite() || !all_finite(J)) return false;
-  lf.error = 0.5 * r.squaredNorm();
-  if (error != nullptr) *error = lf.error;
+  const long version = options_.reuse_constant_jacobians ? factor.jacobian_version() : -1;
+  // A kept linear factor's J must be whole.
+  RowSupport* support = version >= 0 ? nullptr : &support_;
+  factor.whitened(ptrs_.data(), r, &J, support);
+  if (!r.allFinite() || (version >= 0 && !all_finite(J))) return false;
+  const double factor_error = 0.5 * r.squaredNorm();  // before the compaction reorders r
+  Eigen::MatrixXd kept_J;
   const int off = static_cast<int>(free_cols_.size());
-  lf.jacobian_version = options_.reuse_constant_jacobians ? factor.jacobian_version() : -1;
-  if (lf.jacobian_version >= 0) {
-    lf.J.resize(rows, off);
-    for (int c = 0; c < off; ++c) lf.J.col(c) = J.col(free_cols_[c]);
-  } else {
-    lf.J.resize(0, 0);
+  if (version >= 0) {
+    kept_J.resize(rows, off);
+    for (int c = 0; c < off; ++c) kept_J.col(c) = J.col(free_cols_[c]);
   }
-  const int active = compact_nonzero_rows(J, r);
+  bool finite = true;
+  const int active = compact_nonzero_rows(J, r, &finite, support);
+  if (!finite) return false;
+  lf.jacobian_version = version;
+  lf.J = std::move(kept_J);
+  lf.error = factor_error;
+  if (error != nullptr) *error = lf.error;
   lf.vars = free_vars_;
   lf.offsets = free_offsets_;
   form_normal_equations(J, active, lf);

@@ -259,6 +259,7 @@ class ISAM2 {
   // Workspaces for linearizing one factor.
   Eigen::VectorXd r_;
   Eigen::MatrixXd J_;
+  RowSupport support_;
   std::vector<const double*> ptrs_;
   std::vector<int> free_vars_, free_offsets_, free_cols_;
 };

@@ -275,7 +275,9 @@ bool NormalEquations::run(const FactorGraph& graph, const Values& values, double
       LinearCache* cache = version >= 0 && info.num_pairs > 0 ? &linear_[fi] : nullptr;
       const bool kept = cache != nullptr && cache->version == version;
       Eigen::Ref<Eigen::MatrixXd> J = J_.topLeftCorner(m, nc);
-      f.whitened(x_ptrs_.data(), r, kept ? nullptr : &J);
+      // A kept linear factor's J must be whole; a factor on no free variable is only summed.
+      RowSupport* support = cache == nullptr && info.num_pairs > 0 ? &support_ : nullptr;
+      f.whitened(x_ptrs_.data(), r, kept ? nullptr : &J, support);
       const auto non_finite = [&](const char* what) {
         if (reason) {
           *reason = "factor " + std::to_string(info.slot) + " (" + f.name() +
@@ -298,7 +300,7 @@ bool NormalEquations::run(const FactorGraph& graph, const Values& values, double
       } else {
         if (cache != nullptr) cache->J = J;  // before the compaction reorders its rows
         bool finite = true;
-        const int active = compact_nonzero_rows(J, r, &finite);
+        const int active = compact_nonzero_rows(J, r, &finite, support);
         if (!finite) return non_finite("Jacobian");
         if (active == 0) continue;  // e.g. a collision factor with every pair clear
         const auto Ja = J.topRows(active);

@@ -118,6 +118,7 @@ class NormalEquations {
   Eigen::VectorXd r_;
   Eigen::MatrixXd J_, JtJ_;
   Eigen::VectorXd Jtr_;
+  RowSupport support_;
   std::vector<const double*> x_ptrs_;
 };
 

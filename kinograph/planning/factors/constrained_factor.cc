@@ -109,9 +109,28 @@ void ConstrainedFactor::evaluate(const graph::FactorValues& x, Eigen::Ref<Eigen:
       }
     }
   }
-  if (J != nullptr) {
+  if (J == nullptr) return;
+  // Rows whose dr/dz is zero (a bound whose hinge is off) are left out instead of zeroed when
+  // the caller takes a row list: most of a collision factor's pairs are clear.
+  graph::RowSupport* support = J->row_support();
+  if (support != nullptr) {
+    support->rows.clear();
+    for (int i = 0; i < residual_dim(); ++i) {
+      if (f[i] != 0) support->rows.push_back(i);
+    }
+    support->all = static_cast<int>(support->rows.size()) == residual_dim();
+  }
+  if (support == nullptr || support->all) {
     for (size_t k = 0; k < keys().size(); ++k) {
       J->block(static_cast<int>(k)).array().colwise() *= f.array();
+    }
+    return;
+  }
+  for (size_t k = 0; k < keys().size(); ++k) {
+    auto block = J->block(static_cast<int>(k));
+    for (Eigen::Index c = 0; c < block.cols(); ++c) {
+      double* col = &block(0, c);
+      for (int i : support->rows) col[i] *= f[i];
     }
   }
 }
