@@ -1,4 +1,4 @@
-// EnvelopeCholesky against Eigen's dense LLᵀ: banded and arrow-shaped patterns, the solve, the
+// EnvelopeCholesky against Eigen's dense LLᵀ: banded, block-banded and arrow-shaped patterns, the solve, the
 // failure column of a matrix that is not positive definite, and when the envelope wins.
 #include "kinograph/graph/envelope_cholesky.h"
 
@@ -72,6 +72,25 @@ TEST(EnvelopeCholesky, BandedMatrixSolvesLikeDenseLlt) {
   const Pattern p = upper_pattern(A, band);
   expect_solves_like_dense(A, p);
   EXPECT_TRUE(EnvelopeCholesky::wins(p.n, p.col_ptr, p.row_idx));
+}
+
+// States of 7 variables coupled to the state before, as a trajectory graph in time order, with
+// holes: most rows of a state share their first column.
+bool block_band(int i, int j) { return j / 7 - i / 7 <= 1 && (i * 5 + j) % 11 != 0; }
+
+TEST(EnvelopeCholesky, BlockBandedMatrixSolvesLikeDenseLlt) {
+  const Eigen::MatrixXd A = random_spd(7 * 30, 5, block_band);
+  expect_solves_like_dense(A, upper_pattern(A, block_band));
+}
+
+TEST(EnvelopeCholesky, NotPositiveDefiniteInsideAStateNamesTheColumn) {
+  Eigen::MatrixXd A = random_spd(7 * 10, 6, block_band);
+  A(7 * 4 + 3, 7 * 4 + 3) = -1.0;
+  const Pattern p = upper_pattern(A, block_band);
+  EnvelopeCholesky chol(p.n, p.col_ptr, p.row_idx);
+  std::copy(p.values.begin(), p.values.end(), chol.values());
+  EXPECT_FALSE(chol.factorize());
+  EXPECT_EQ(chol.failed_column(), 7 * 4 + 3);
 }
 
 TEST(EnvelopeCholesky, ArrowWithTheHubLastSolvesAndWins) {
