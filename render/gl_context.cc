@@ -1,16 +1,13 @@
 #include "render/gl_context.h"
 
-// gl.h first: osmesa.h pulls in GL/gl.h, which must see GL_GLEXT_PROTOTYPES.
-#include "render/gl.h"
-// clang-format off
-#include <GL/osmesa.h>
-// clang-format on
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "render/gl.h"
 
 namespace kinograph::render {
 
@@ -40,6 +37,7 @@ struct GlContext::Impl {
 };
 
 GlContext::GlContext(const GlContextOptions& options) : impl_(std::make_unique<Impl>()) {
+  load_gl();
   const int attribs[] = {OSMESA_FORMAT,
                          OSMESA_RGBA,
                          OSMESA_DEPTH_BITS,
