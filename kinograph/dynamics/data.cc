@@ -16,7 +16,7 @@ Data::Data(const Model& model) {
 
   Scratch& s = scratch;
   for (auto* v : {&s.S, &s.Sdot, &s.Vw, &s.aw, &s.fw, &s.Fw, &s.alpha, &s.beta, &s.dF_dq, &s.dF_dqd,
-                  &s.SIc, &s.SBc, &s.SDc, &s.fext, &s.hc}) {
+                  &s.SIc, &s.SBc, &s.SDc, &s.fext, &s.fv, &s.hc}) {
     v->assign(n, Vector6::Zero());
   }
   for (auto* m : {&s.Iw, &s.Ic, &s.Ec}) m->assign(n, Matrix6::Zero());

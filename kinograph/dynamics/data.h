@@ -36,6 +36,7 @@ class Data {
     std::vector<Matrix6> Iw, Ic, Ec;                  // world inertias and composites
     std::vector<Vector6> SIc, SBc, SDc;               // S_i^T times the composites
     std::vector<Vector6> fext;                        // external wrenches per body
+    std::vector<Vector6> fv;  // velocity part of each body's wrench: [ad_V]ᵀ I V + f_ext
     std::vector<Eigen::Isometry3d> joint_pose;        // T_parent,body(q)
     std::vector<double> mass;                         // body mass, COM and inertia about the
     std::vector<Eigen::Vector3d> com;                 // COM (body frame), split out of G once

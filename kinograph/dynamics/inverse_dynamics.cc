@@ -119,11 +119,40 @@ void mass_matrix_from_composites(const Model& model, Data& data) {
   }
 }
 
-// The world-frame Newton–Euler pass on the current geometry: twists, accelerations, wrenches
-// and their subtree sums Fw, and τ into data.tau; with `for_derivatives` also the composites
-// hc and Ec that derivative_assembly needs.
-void world_pass(const Model& model, Data& data, const VectorRef& qd, const VectorRef& qdd,
-                bool for_derivatives) {
+// The velocity half of the world-frame Newton–Euler pass on the current geometry: twists, Ṡ,
+// β and each body's velocity wrench fv; with `for_derivatives` also the composites hc and Ec
+// that derivative_assembly needs. None of it depends on q̈.
+void world_velocity_pass(const Model& model, Data& data, const VectorRef& qd,
+                         bool for_derivatives) {
+  const int n = model.nq();
+  auto& s = data.scratch;
+  for (int i = 0; i < n; ++i) {
+    const int p = model.bodies[i].parent;
+    const Vector6 Vp = p < 0 ? Vector6::Zero() : s.Vw[p];
+    const Vector6& S = s.S[i];
+    s.Vw[i] = Vp + S * qd[i];
+    s.Sdot[i] = ad_apply(s.Vw[i], S);
+    s.beta[i] = ad_apply(S, Vp);
+    const Matrix6& I = s.Iw[i];
+    const Vector6 h = I * s.Vw[i];
+    s.fv[i] = ad_transpose_apply(s.Vw[i], h) + s.fext[i];
+    if (!for_derivatives) continue;
+    s.hc[i] = h;
+    s.Ec[i].noalias() = ad(s.Vw[i]).transpose() * I;
+  }
+  if (!for_derivatives) return;
+  for (int i = n - 1; i >= 0; --i) {
+    const int p = model.bodies[i].parent;
+    if (p < 0) continue;
+    s.hc[p] += s.hc[i];
+    s.Ec[p] += s.Ec[i];
+  }
+}
+
+// The acceleration half, after world_velocity_pass at the same q, q̇: accelerations, α,
+// wrenches and their subtree sums Fw, and τ into data.tau.
+void world_acceleration_pass(const Model& model, Data& data, const VectorRef& qd,
+                             const VectorRef& qdd) {
   const int n = model.nq();
   auto& s = data.scratch;
   Vector6 a0;
@@ -133,32 +162,20 @@ void world_pass(const Model& model, Data& data, const VectorRef& qd, const Vecto
     const Vector6 Vp = p < 0 ? Vector6::Zero() : s.Vw[p];
     const Vector6& ap = p < 0 ? a0 : s.aw[p];
     const Vector6& S = s.S[i];
-    s.Vw[i] = Vp + S * qd[i];
-    s.Sdot[i] = ad_apply(s.Vw[i], S);
     s.aw[i] = ap + s.Sdot[i] * qd[i] + S * qdd[i];
-    s.beta[i] = ad_apply(S, Vp);
     s.alpha[i] = ad_apply(S, ap) + ad_apply(s.Sdot[i], Vp);
-    const Matrix6& I = s.Iw[i];
-    const Vector6 h = I * s.Vw[i];
-    s.fw[i].noalias() = I * s.aw[i];
-    s.fw[i] -= ad_transpose_apply(s.Vw[i], h) + s.fext[i];
+    s.fw[i].noalias() = s.Iw[i] * s.aw[i];
+    s.fw[i] -= s.fv[i];
     s.Fw[i] = s.fw[i];
-    if (!for_derivatives) continue;
-    s.hc[i] = h;
-    s.Ec[i].noalias() = ad(s.Vw[i]).transpose() * I;
   }
   for (int i = n - 1; i >= 0; --i) {
     const int p = model.bodies[i].parent;
-    if (p < 0) continue;
-    s.Fw[p] += s.Fw[i];
-    if (!for_derivatives) continue;
-    s.hc[p] += s.hc[i];
-    s.Ec[p] += s.Ec[i];
+    if (p >= 0) s.Fw[p] += s.Fw[i];
   }
   for (int i = 0; i < n; ++i) data.tau[i] = s.S[i].dot(s.Fw[i]) + model.bodies[i].damping * qd[i];
 }
 
-// ∂τ/∂q, ∂τ/∂q̇ and M from a world_pass at the same q, q̇; and the body-frame V, V̇, F.
+// ∂τ/∂q, ∂τ/∂q̇ and M from the world passes at the same q, q̇; and the body-frame V, V̇, F.
 void derivative_assembly(const Model& model, Data& data) {
   const int n = model.nq();
   auto& s = data.scratch;
@@ -221,7 +238,8 @@ void rnea_derivatives(const Model& model, Data& data, const VectorRef& q, const 
   //   Ic = Σ I_k,  Ec = Σ ad_{V_k}^T I_k,  hc = Σ I_k V_k,
   // so every entry of ∂τ/∂q and ∂τ/∂q̇ is a few 6-vector dot products.
   world_geometry(model, data, q, ext);
-  world_pass(model, data, qd, qdd, true);
+  world_velocity_pass(model, data, qd, true);
+  world_acceleration_pass(model, data, qd, qdd);
   derivative_assembly(model, data);
 }
 
@@ -241,7 +259,9 @@ void passive_dynamics(const Model& model, Data& data, const VectorRef& q, const 
   mass_matrix_from_composites(model, data);
   data.qdd = qdd;
   for (int a = 0; a < m; ++a) data.qdd[passive[a]] = 0;
-  world_pass(model, data, qd, data.qdd, false);
+  // The velocity half does not depend on q̈: it serves both acceleration passes below.
+  world_velocity_pass(model, data, qd, derivatives);
+  world_acceleration_pass(model, data, qd, data.qdd);
   // τ is affine in q̈ with slope M: τ_p(q̈_p) = τ0_p + M_pp q̈_p = 0.
   s.Mpp.resize(m, m);
   s.bias_p.resize(m);
@@ -256,7 +276,7 @@ void passive_dynamics(const Model& model, Data& data, const VectorRef& q, const 
     data.tau.noalias() += data.M.col(passive[a]) * s.bias_p[a];
   }
   if (!derivatives) return;
-  world_pass(model, data, qd, data.qdd, true);
+  world_acceleration_pass(model, data, qd, data.qdd);
   derivative_assembly(model, data);
 }
 
