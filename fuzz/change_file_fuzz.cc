@@ -12,12 +12,14 @@
 
 namespace {
 
-void try_change(const std::string& text, const kinograph::planning::Scene& scene) {
+// parse_change for `scene`, whose reader writes the scene out once per process, not per input.
+void try_change(const std::string& text, const kinograph::planning::Scene& scene,
+                const kinograph::planning::ChangeReader& reader) {
   using namespace kinograph;
   static const std::string source = fuzz::source_path("robots/scenes/changes/fuzz.yaml");
   planning::SceneChange change;
   try {
-    change = planning::parse_change(text, scene, source);
+    change = reader.parse(text, source);
   } catch (const planning::SceneError& e) {
     fuzz::expect_names(e.what(), source);
     return;
@@ -34,8 +36,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       planning::load_scene(fuzz::source_path("robots/scenes/rr_reach.yaml"));
   static const planning::Scene iiwa =
       planning::load_scene(fuzz::source_path("robots/scenes/iiwa_desk.yaml"));
+  static const planning::ChangeReader rr_reader(rr), iiwa_reader(iiwa);
   const std::string text(reinterpret_cast<const char*>(data), size);
-  try_change(text, rr);
-  try_change(text, iiwa);
+  try_change(text, rr, rr_reader);
+  try_change(text, iiwa, iiwa_reader);
   return 0;
 }

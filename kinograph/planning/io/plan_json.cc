@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <sstream>
 #include <system_error>
@@ -521,8 +522,10 @@ Plan plan_from_json(const json& j, const dynamics::Model& model, const std::stri
 json read_plan_json(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw PlanFileError("cannot open plan file '" + path + "'");
+  // Parsed from the text: nlohmann reads a stream one character at a time through its buffer.
+  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
   try {
-    return json::parse(in);
+    return json::parse(text);
   } catch (const json::exception& e) {  // parse_error, and out_of_range for a number like 1e309
     throw PlanFileError("plan '" + path + "' is not valid JSON: " + e.what());
   }

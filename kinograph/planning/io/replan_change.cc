@@ -20,7 +20,21 @@ int index_of(const std::vector<std::string>& names, const std::string& name) {
 
 }  // namespace
 
+struct ChangeReader::SceneTree {
+  YAML::Node root;
+};
+
+ChangeReader::ChangeReader(const Scene& scene)
+    : scene_(scene),
+      tree_(std::make_unique<const SceneTree>(SceneTree{YAML::Load(scene_to_yaml(scene))})) {}
+
+ChangeReader::~ChangeReader() = default;
+
 SceneChange parse_change(const std::string& yaml, const Scene& scene, const std::string& source) {
+  return ChangeReader(scene).parse(yaml, source);
+}
+
+SceneChange ChangeReader::parse(const std::string& yaml, const std::string& source) const {
   YAML::Node root;
   try {
     root = YAML::Load(yaml);
@@ -31,13 +45,14 @@ SceneChange parse_change(const std::string& yaml, const Scene& scene, const std:
   const yaml::Reader reader(source);
   reader.expect_map(root, "", {"goal", "start", "horizon", "obstacles", "remove"});
 
-  // The scene with the change's entries in place, parsed by the scene parser (one schema).
-  YAML::Node merged = YAML::Load(scene_to_yaml(scene));
+  // The scene with the change's entries in place, parsed by the scene parser (one schema); a
+  // copy, as assigning into a yaml-cpp tree changes the nodes it shares.
+  YAML::Node merged = YAML::Clone(tree_->root);
   for (const char* key : {"goal", "start", "horizon"}) {
     if (root[key]) merged[key] = root[key];
   }
   SceneChange out;
-  std::vector<std::string> names = scene.obstacle_names;
+  std::vector<std::string> names = scene_.obstacle_names;
   std::vector<std::string> changed;
   if (root["obstacles"]) {
     const YAML::Node list = root["obstacles"];
@@ -76,7 +91,7 @@ SceneChange parse_change(const std::string& yaml, const Scene& scene, const std:
     for (size_t i = 0; i < list.size(); ++i) {
       const std::string key = "remove[" + std::to_string(i) + "]";
       const std::string name = reader.string(list[i], key);
-      const int idx = index_of(scene.obstacle_names, name);
+      const int idx = index_of(scene_.obstacle_names, name);
       if (idx < 0) {
         throw SceneError(source, key, line_of(list[i]),
                          "the scene has no obstacle '" + name + "' to remove");

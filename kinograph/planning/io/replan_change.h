@@ -11,6 +11,7 @@
 //   remove: [desk_leg_1]              # ids of scene obstacles to remove
 //
 // Examples live in robots/scenes/changes/.
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,21 @@ struct SceneChange {
 /// Throws SceneError naming the file and key (unknown keys, bad values, unknown ids to remove).
 SceneChange parse_change(const std::string& yaml, const Scene& scene,
                          const std::string& source = "");
+/// Parses change texts for one scene, which it writes out as YAML once for all of them (the
+/// change's entries are merged into that tree). `scene` must outlive the reader.
+class ChangeReader {
+ public:
+  explicit ChangeReader(const Scene& scene);
+  ~ChangeReader();
+  /// As parse_change(yaml, scene, source).
+  SceneChange parse(const std::string& yaml, const std::string& source = "") const;
+
+ private:
+  struct SceneTree;
+  const Scene& scene_;
+  std::unique_ptr<const SceneTree> tree_;
+};
+
 /// Reads a change file for `scene`. Throws SceneError.
 SceneChange load_change(const std::string& path, const Scene& scene);
 
