@@ -39,6 +39,7 @@ class ChangeReader {
   explicit ChangeReader(const Scene& scene);
   ~ChangeReader();
   /// As parse_change(yaml, scene, source).
+  /// @throws SceneError naming `source`, the key and the line of what is wrong.
   SceneChange parse(const std::string& yaml, const std::string& source = "") const;
 
  private:
