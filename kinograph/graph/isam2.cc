@@ -197,17 +197,16 @@ bool ISAM2::linearize_fresh(const Factor& factor, LinearizedFactor& lf, double* 
   factor.whitened(ptrs_.data(), r, &J, support);
   if (!r.allFinite() || (version >= 0 && !all_finite(J))) return false;
   const double factor_error = 0.5 * r.squaredNorm();  // before the compaction reorders r
-  Eigen::MatrixXd kept_J;
-  const int off = static_cast<int>(free_cols_.size());
-  if (version >= 0) {
-    kept_J.resize(rows, off);
-    for (int c = 0; c < off; ++c) kept_J.col(c) = J.col(free_cols_[c]);
-  }
   bool finite = true;
+  if (version >= 0) {  // whole and finite: its compaction below cannot fail
+    const int off = static_cast<int>(free_cols_.size());
+    lf.J.resize(rows, off);
+    for (int c = 0; c < off; ++c) lf.J.col(c) = J.col(free_cols_[c]);
+  }
   const int active = compact_nonzero_rows(J, r, &finite, support);
   if (!finite) return false;
+  if (version < 0) lf.J.resize(0, 0);
   lf.jacobian_version = version;
-  lf.J = std::move(kept_J);
   lf.error = factor_error;
   if (error != nullptr) *error = lf.error;
   lf.vars = free_vars_;
