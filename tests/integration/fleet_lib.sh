@@ -20,21 +20,27 @@ fail() {
   exit 1
 }
 
-# Waits (bounded, 60 s) until file $1 contains the text $2.
+# Waits (bounded, 60 s) until file $1 contains the text $2, after its first $3 lines (default
+# 0: anywhere).
 wait_for_line() {
-  for _ in $(seq 600); do grep -q -- "$2" "$1" 2>/dev/null && return 0; sleep 0.1; done
+  for _ in $(seq 600); do
+    tail -n "+$((${3:-0} + 1))" "$1" 2>/dev/null | grep -q -- "$2" && return 0
+    sleep 0.1
+  done
   return 1
 }
 
 # start_robot NAME SCENE [--neighbour ...]: kinographd for robot NAME (prefix NAME upper-cased)
-# logging to $WORK/NAME.log, awaited until subscribed.
+# logging to $WORK/NAME.log, awaited until subscribed. A restarted robot appends to its log: only
+# the new daemon's lines count, or a message sent at once could reach no one.
 start_robot() {
-  local name=$1 scene=$2 prefix
+  local name=$1 scene=$2 prefix before=0
   prefix=$(echo "$1" | tr '[:lower:]' '[:upper:]')
+  [ ! -f "$WORK/$name.log" ] || before=$(wc -l <"$WORK/$name.log")
   "$KGD" "$scene" --prefix "$prefix" --lcm-url "$URL" --status-period 0.2 "${@:3}" \
     >>"$WORK/$name.log" 2>&1 &
   PID[$name]=$!
-  wait_for_line "$WORK/$name.log" "on channels ${prefix}_" || fail "$name did not start"
+  wait_for_line "$WORK/$name.log" "on channels ${prefix}_" "$before" || fail "$name did not start"
 }
 
 # send_goal NAME ID Q SCENE [UTIME]: a joint goal, awaited (its first answer must be a valid
