@@ -5,11 +5,13 @@
 #include <gtest/gtest.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include "kinograph/dynamics/kinematics.h"
 #include "kinograph/dynamics/payload.h"
+#include "kinograph/planning/io/scene.h"
 #include "test_problems.h"
 
 namespace kinograph::planning {
@@ -160,6 +162,31 @@ TEST(BatchPlanner, IiwaCarriesTheBlockPastTheBox) {
               to_string(plan.stats.status).c_str(), plan.stats.iterations, plan.stats.outer_iterations,
               plan.stats.solve_time_s, plan.validation.min_clearance,
               plan.validation.max_tau_violation);
+}
+
+TEST(BatchPlanner, LimitRowsTheSolveAlreadyKeepsAreNotReSolved) {
+  // The desk task's knot-only solve comes within 10 % of a limit between some knots but keeps
+  // every limit there: the rows added for those intervals change nothing, so the plan is the
+  // knot-only solve's (as with no limit points between knots at all), on the graph with them.
+  const Problem p =
+      load_scene(std::string(KINOGRAPH_SOURCE_DIR) + "/robots/scenes/iiwa_desk.yaml").problem;
+  BatchSolution with_rows;
+  const Plan plan = BatchPlanner().plan(p, nullptr, &with_rows);
+  ASSERT_TRUE(plan.success()) << plan.stats.reason;
+  const auto interval_factors = std::count_if(
+      with_rows.graph.entries.begin(), with_rows.graph.entries.end(),
+      [](const FactorEntry& e) { return e.key.role == FactorRole::kInterval; });
+  EXPECT_GT(interval_factors, 0);
+  EXPECT_LE(worst_constraint(with_rows.graph.constraints(false), with_rows.graph.values)
+                .scaled_violation,
+            OuterLoopOptions().constraint_tolerance);
+  Problem knots_only = p;
+  knots_only.objectives.limit_substeps = 0;
+  const Plan reference = BatchPlanner().plan(knots_only);
+  ASSERT_TRUE(reference.success()) << reference.stats.reason;
+  EXPECT_EQ(plan.stats.iterations, reference.stats.iterations);
+  EXPECT_EQ(plan.q, reference.q);
+  EXPECT_EQ(plan.qd, reference.qd);
 }
 
 TEST(BatchPlanner, ImpossibleProblemsFailCleanly) {

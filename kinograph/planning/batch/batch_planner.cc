@@ -257,6 +257,7 @@ Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init, const s
     between.limits =
         intervals_near_limits(problem, plan_from_trajectory(problem, init), kNearLimit);
   }
+  bool added_to_converged = false;  // this round only adds limit rows to a converged solve
   for (int round = 0;; ++round) {
     PlanningGraph next;
     std::vector<DfgConstraintStep> dfg_steps;
@@ -275,6 +276,17 @@ Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init, const s
     }
     pg = std::move(next);
     OuterLoopOptions loop = dfg_steps.empty() ? options_.outer_loop : outer_loop_options(options_);
+    // Limit rows added to a converged solve that it already keeps change nothing: the solve was
+    // the optimum of a relaxation of this graph, and it is feasible here, so it is this one's.
+    if (added_to_converged) {
+      const ConstraintReport worst = worst_constraint(pg.constraints(false), pg.values);
+      if (worst.scaled_violation <= loop.constraint_tolerance) {
+        r.worst = worst;
+        spdlog::debug("{}: interval round {}: the added limit points hold (worst {:.3g}); not "
+                      "re-solved", problem.name, round, worst.scaled_violation);
+        break;
+      }
+    }
     loop.max_total_iterations -= r.iterations;  // one budget for all rounds
     AugmentedLagrangian al(pg.constraints(false), state, options_.augmented_lagrangian);
     // A re-solve starts feasible but for the rows just added: at the largest penalty it is a
@@ -316,6 +328,7 @@ Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init, const s
     }
     if (!added) break;
     between.knots_only = false;
+    added_to_converged = r.status == PlanStatus::kConverged;
   }
   if (r.status == PlanStatus::kInfeasible) r.reason = infeasible_reason(problem, r);
 
