@@ -419,21 +419,32 @@ void CollisionWorld::scan(const dynamics::Data& data, double t, double query_dis
   }
 }
 
+void CollisionWorld::closest_pairs(std::vector<PairIndex>& out) const {
+  out.clear();
+  for (int g = 0; g < static_cast<int>(robot_.size()); ++g) {
+    if (!checks_obstacles(g)) continue;
+    for (int o = 0; o < static_cast<int>(obstacles_.size()); ++o) out.push_back({g, o, false});
+  }
+  for (const auto& [a, b] : self_pairs_) out.push_back({a, b, true});
+}
+
 Proximity CollisionWorld::closest(const dynamics::Data& data, double t) {
   update_poses(data, t);
   Proximity best;
   best.distance = kInfinity;
   Proximity p;
+  pair_bounds_.clear();
   if (!options_.cull) {  // the brute-force reference: every pair to the end, in order
+    // A pair GJK gives no distance for keeps no bound (−inf), as it is no candidate for best.
+    auto measured = [&](bool valid) {
+      pair_bounds_.push_back(valid ? p.distance : -kInfinity);
+      if (valid && p.distance < best.distance) best = p;
+    };
     for (int g = 0; g < static_cast<int>(robot_.size()); ++g) {
       if (!checks_obstacles(g)) continue;
-      for (const ObstacleEntry& o : obstacles_) {
-        if (robot_obstacle(g, o, kInfinity, p) && p.distance < best.distance) best = p;
-      }
+      for (const ObstacleEntry& o : obstacles_) measured(robot_obstacle(g, o, kInfinity, p));
     }
-    for (const auto& [a, b] : self_pairs_) {
-      if (robot_robot(a, b, kInfinity, p) && p.distance < best.distance) best = p;
-    }
+    for (const auto& [a, b] : self_pairs_) measured(robot_robot(a, b, kInfinity, p));
     return best;
   }
   // Pairs in order of their lower bounds, each checked only up to the best distance so far
@@ -451,16 +462,22 @@ Proximity CollisionWorld::closest(const dynamics::Data& data, double t) {
     candidates_.push_back(Candidate{lower_bound_self(i), order++, i, -1});
   }
   if (candidates_.empty()) return best;
+  pair_bounds_.resize(candidates_.size());
+  for (const Candidate& c : candidates_) pair_bounds_[c.order] = c.bound;
   int best_order = order;
   auto check = [&](const Candidate& c) {
     const double max = best.distance + kCullSlack;
     // The capsule bound, dearer than the sorting bound, only for pairs about to go to GJK.
-    if (max < kInfinity && (c.b >= 0 ? capsule_bound(c.a, c.b) : capsule_bound_self(c.a)) > max) {
-      return;
+    if (max < kInfinity) {
+      const double capsule = c.b >= 0 ? capsule_bound(c.a, c.b) : capsule_bound_self(c.a);
+      pair_bounds_[c.order] = std::max(c.bound, capsule);
+      if (capsule > max) return;
     }
     const bool valid = c.b >= 0
                            ? robot_obstacle(c.a, obstacles_[c.b], max, p)
                            : robot_robot(self_pairs_[c.a].first, self_pairs_[c.a].second, max, p);
+    // No distance may also mean GJK gave none: then only the bounds are known.
+    if (valid) pair_bounds_[c.order] = p.distance;
     if (valid &&
         (p.distance < best.distance || (p.distance == best.distance && c.order < best_order))) {
       best = p;

@@ -86,6 +86,19 @@ class CollisionWorld {
   // enabled), culled against the best so far; distance +inf and robot_geom -1 when there is
   // nothing to check.
   Proximity closest(const dynamics::Data& data, double t = 0);
+  // A pair closest() considers: robot geometry `a` against obstacle index `b`, or (self) robot
+  // geometries a and b.
+  struct PairIndex {
+    int a = 0, b = 0;
+    bool self = false;
+  };
+  // The pairs closest() considers, in the order of pair_bounds(): every robot geometry that
+  // checks obstacles against each obstacle, then the self pairs. Fills `out` (reusing it).
+  void closest_pairs(std::vector<PairIndex>& out) const;
+  // After closest(): per pair of closest_pairs(), a lower bound of its signed distance (the
+  // distance itself where closest() measured it; culled pairs keep the bound that culled them).
+  // Valid until the next query on this world.
+  std::span<const double> pair_bounds() const { return pair_bounds_; }
 
  private:
   struct RobotGeom {
@@ -174,6 +187,7 @@ class CollisionWorld {
   int moving_ = 0;  // obstacles with a trajectory
   std::vector<Proximity> out_;
   std::vector<Candidate> candidates_;
+  std::vector<double> pair_bounds_;  // closest()'s lower bound per pair, by Candidate::order
   uint64_t pose_stamp_ = 0;
   const dynamics::Data* data_ = nullptr;  // of the current query, for geom_world
 };

@@ -34,17 +34,24 @@ double link_length(const dynamics::Body& body) {
 }  // namespace
 
 SegmentChecker::SegmentChecker(const dynamics::Model& model, SegmentCheckOptions options)
-    : model_(model), options_(options), lever_(Eigen::VectorXd::Zero(model.nq())), q_(model.nq()) {
+    : model_(model),
+      options_(options),
+      lever_(Eigen::VectorXd::Zero(model.nq())),
+      geom_lever_(Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(model.collision.size()),
+                                        model.nq())),
+      q_(model.nq()) {
   // For each geometry, walk up its chain: the distance from joint j's axis point (body j's
   // origin) to any point of the geometry is at most the geometry's reach in its own body plus
   // the lengths of the links between.
-  for (const dynamics::Geometry& g : model.collision) {
+  for (size_t i = 0; i < model.collision.size(); ++i) {
+    const dynamics::Geometry& g = model.collision[i];
     if (g.body < 0) continue;
     const ConvexShape shape(shape_of(g));
     double reach = (g.origin * shape.bound_center()).norm() + shape.bound_radius();
     for (int b = g.body; b >= 0; b = model.bodies[b].parent) {
       const bool prismatic = model.bodies[b].joint_type == dynamics::JointType::kPrismatic;
-      lever_[b] = std::max(lever_[b], prismatic ? 1.0 : reach);
+      geom_lever_(static_cast<Eigen::Index>(i), b) = prismatic ? 1.0 : reach;
+      lever_[b] = std::max(lever_[b], geom_lever_(static_cast<Eigen::Index>(i), b));
       reach += link_length(model.bodies[b]);
     }
   }
@@ -98,7 +105,42 @@ PathCheckResult SegmentChecker::check_path(CollisionWorld& world, dynamics::Data
     if (times.empty()) return 0.0;
     return i + 1 < m ? times[i] + u * (times[i + 1] - times[i]) : times[i];
   };
-  // Any point moves at most the sweep; two points of the robot approach by at most twice it.
+  // How fast each joint can change each pair's distance. Against an obstacle: the geometry's
+  // own lever. Between two geometries: joints that move both alike change nothing, so only the
+  // joints below their common ancestor count, each with the lever of the geometry it moves.
+  world.closest_pairs(pairs_);
+  const int pair_count = static_cast<int>(pairs_.size()), nq = model_.nq();
+  pair_lever_.setZero(pair_count, nq);
+  ancestor_.resize(static_cast<size_t>(nq));
+  auto mark_chain = [&](int g) {
+    std::fill(ancestor_.begin(), ancestor_.end(), 0);
+    for (int b = model_.collision[static_cast<size_t>(g)].body; b >= 0; b = model_.bodies[b].parent)
+      ancestor_[static_cast<size_t>(b)] = 1;
+  };
+  auto add_chain_outside = [&](int k, int g) {  // g's joints not marked in ancestor_
+    for (int b = model_.collision[static_cast<size_t>(g)].body; b >= 0;
+         b = model_.bodies[b].parent) {
+      if (!ancestor_[static_cast<size_t>(b)]) pair_lever_(k, b) += geom_lever_(g, b);
+    }
+  };
+  for (int k = 0; k < pair_count; ++k) {
+    const CollisionWorld::PairIndex& pr = pairs_[static_cast<size_t>(k)];
+    if (!pr.self) {
+      pair_lever_.row(k) = geom_lever_.row(pr.a);
+      continue;
+    }
+    mark_chain(pr.b);
+    add_chain_outside(k, pr.a);
+    mark_chain(pr.a);
+    add_chain_outside(k, pr.b);
+  }
+  rate_.resize(pair_count);
+  allowance_.resize(pair_count);
+  last_bound_.resize(pair_count);
+  used_.resize(pair_count);
+  dq_.resize(nq);
+  // The whole robot's sweep: any point moves at most it, two points approach by at most twice
+  // it. It sets the least step and the sweep bound.
   const double relative = world.self_pairs().empty() ? 1.0 : 2.0;
   auto sweep_of = [&](int i) {
     return relative * (path.row(i + 1) - path.row(i)).cwiseAbs().dot(lever_.transpose());
@@ -120,30 +162,47 @@ PathCheckResult SegmentChecker::check_path(CollisionWorld& world, dynamics::Data
       result.s = u;
       result.closest = p;
     }
-    return p.distance;
   };
 
   int i = 0;     // current segment
   double u = 0;  // fraction along it
-  double d = sample(0, 0);
+  sample(0, 0);
+  last_bound_ = Eigen::Map<const Eigen::VectorXd>(world.pair_bounds().data(), pair_count);
   if (m == 1) {
-    result.lower_bound = d;
+    result.lower_bound = result.min_distance;
     return result;
   }
   while (i < m - 1) {
-    // Sweep budget to the next sample; with moving obstacles also a time budget.
-    double budget = std::max(options_.max_sweep_step, d - clearance);
+    // Each pair's allowance to the next sample, the least step, and with moving obstacles a
+    // time budget.
+    allowance_ = last_bound_.array() - clearance;
+    used_.setZero();
+    double least = options_.max_sweep_step;
     double time_budget = moving ? options_.max_time_step : std::numeric_limits<double>::infinity();
     double swept = 0;
     while (i < m - 1) {
+      dq_ = (path.row(i + 1) - path.row(i)).cwiseAbs().transpose();
+      rate_.noalias() = pair_lever_ * dq_;
       const double seg_sweep = sweep_of(i);
       const double seg_time = std::abs(time_at(i, 1) - time_at(i, 0));
       const double left = 1 - u;
-      // The fraction of this segment the budgets allow.
-      double f = left;
-      if (seg_sweep * left > budget) f = std::min(f, budget / seg_sweep);
+      // The fraction of this segment the budgets allow: until the first pair's allowance runs
+      // out, but at least the least step.
+      // A pair whose distance this segment cannot change sets no limit; an allowance that is
+      // not a number allows nothing.
+      double by_pairs = left;
+      for (int k = 0; k < pair_count; ++k) {
+        if (rate_[k] > 0 && !(rate_[k] * left <= allowance_[k])) {
+          by_pairs = std::min(by_pairs, allowance_[k] > 0 ? allowance_[k] / rate_[k] : 0.0);
+        }
+      }
+      const double by_least =
+          seg_sweep * left > least ? std::max(0.0, least) / seg_sweep : left;
+      double f = std::max(by_pairs, by_least);
       if (moving && seg_time * left > time_budget) f = std::min(f, time_budget / seg_time);
-      budget -= seg_sweep * f;
+      allowance_ -= f * rate_;
+      used_ += f * rate_;
+      least -= seg_sweep * f;
       time_budget -= seg_time * f;
       swept += seg_sweep * f;
       if (f < left) {
@@ -152,7 +211,8 @@ PathCheckResult SegmentChecker::check_path(CollisionWorld& world, dynamics::Data
       }
       ++i;
       u = 0;
-      if (i == m - 1 || budget <= 0 || time_budget <= 0) break;
+      // A spent allowance stops the walk in the next segment that moves its pair.
+      if (i == m - 1 || time_budget <= 0) break;
     }
     result.swept += swept / relative;
     if (result.samples >= options_.max_path_samples || result.swept > options_.max_path_sweep) {
@@ -161,9 +221,14 @@ PathCheckResult SegmentChecker::check_path(CollisionWorld& world, dynamics::Data
       result.stopped_s = u;
       break;
     }
-    const double next = sample(i, u);
-    result.lower_bound = std::min(result.lower_bound, 0.5 * (d + next - swept));
-    d = next;
+    sample(i, u);
+    // Along the stretch each pair stays at least (d_a + d_b − its sweep) / 2 away.
+    const auto next = Eigen::Map<const Eigen::VectorXd>(world.pair_bounds().data(), pair_count);
+    if (pair_count > 0) {
+      result.lower_bound =
+          std::min(result.lower_bound, 0.5 * (last_bound_ + next - used_).minCoeff());
+    }
+    last_bound_ = next;
   }
   result.lower_bound = std::min(result.lower_bound, result.min_distance);
   return result;

@@ -82,14 +82,15 @@ class SegmentChecker {
                            const Eigen::Ref<const Eigen::VectorXd>& q1, double t0 = 0,
                            double t1 = 0);
   // Minimum signed distance along the polyline through the rows of `path` (row i at obstacle
-  // time times[i]; `times` empty = all at 0) by conservative advancement: from a sample at
-  // distance d the next one is d − clearance further along the path's sweep (at least
-  // max_sweep_step, and at most max_time_step later when obstacles move), so no stretch where
-  // the robot could come closer than `clearance` is skipped, yet clear stretches cost one
-  // query. With self-collision pairs in the world the budget is halved: both geometries of a
-  // pair move, so their distance changes up to twice the sweep. Allocates nothing after the
-  // first call with a given joint count. Stops after max_path_samples queries or max_path_sweep
-  // of sweep (complete false).
+  // time times[i]; `times` empty = all at 0) by conservative advancement, pair by pair: a pair
+  // at distance (or lower bound) d at a sample lets the walk on until its own geometry could
+  // have closed d − clearance, counting only the joints that move one of its geometries
+  // relative to the other; the next sample is where the first pair's allowance runs out (at
+  // least max_sweep_step of the whole robot's sweep on, and at most max_time_step later when
+  // obstacles move). So no stretch where a pair could come closer than `clearance` is skipped,
+  // yet clear stretches, and stretches whose near pairs barely move, cost one query. Allocates
+  // nothing after the first call with a given joint count and pair count. Stops after
+  // max_path_samples queries or max_path_sweep of sweep (complete false).
   PathCheckResult check_path(CollisionWorld& world, dynamics::Data& data,
                              const Eigen::Ref<const Eigen::MatrixXd>& path,
                              const std::vector<double>& times = {}, double clearance = 0);
@@ -105,7 +106,17 @@ class SegmentChecker {
   const dynamics::Model& model_;
   SegmentCheckOptions options_;
   Eigen::VectorXd lever_;
+  // Per robot geometry (row) and joint: the same bound for that geometry's points alone (0 for
+  // joints that do not move it).
+  Eigen::MatrixXd geom_lever_;
   Eigen::VectorXd q_;
+  // check_path's work: the world's pairs; per pair and joint the bound on how fast a joint
+  // changes the pair's distance; per pair its rate on the segment, allowance, bounds at the
+  // last and the next sample, and what the stretch used of the allowance.
+  std::vector<CollisionWorld::PairIndex> pairs_;
+  Eigen::MatrixXd pair_lever_;
+  Eigen::VectorXd rate_, allowance_, last_bound_, used_, dq_;
+  std::vector<char> ancestor_;
 };
 
 }  // namespace kinograph::collision

@@ -246,6 +246,54 @@ TEST(CollisionWorldCulling, MatchesBruteForceOnIiwa) {
   EXPECT_GT(total_reported, 100);  // the scene is close enough for the comparison to matter
 }
 
+// closest()'s per-pair bounds on the same kind of scene: never above the pair's distance, equal
+// to it where closest() measured it, and in closest_pairs() order.
+TEST(CollisionWorldCulling, PairBoundsAreLowerBoundsOfEachPair) {
+  const dynamics::Model model = dynamics::Model::from_urdf_file(kRobots + "iiwa14/iiwa14.urdf");
+  dynamics::Data data(model);
+  CollisionWorldOptions culled_opts;
+  culled_opts.self_collision = true;
+  CollisionWorldOptions brute_opts = culled_opts;
+  brute_opts.cull = false;
+  CollisionWorld culled(model, culled_opts), brute(model, brute_opts);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const Shape shapes[] = {Shape::box(0.3, 0.2, 0.4), Shape::sphere(0.12), Shape::box(0.6, 0.6, 0.6)};
+  for (int id = 0; id < 3; ++id) {
+    const Eigen::Isometry3d pose = at(0.6 * u(rng), 0.6 * u(rng), 0.6 + 0.4 * u(rng));
+    ASSERT_TRUE(culled.add_obstacle(make_obstacle(id, shapes[id], pose)));
+    ASSERT_TRUE(brute.add_obstacle(make_obstacle(id, shapes[id], pose)));
+  }
+  std::vector<CollisionWorld::PairIndex> pairs;
+  culled.closest_pairs(pairs);
+  int measured = 0, bounded = 0;
+  for (int trial = 0; trial < 100; ++trial) {
+    Eigen::VectorXd q(model.nq());
+    for (int j = 0; j < model.nq(); ++j) q[j] = 2.0 * u(rng);
+    dynamics::forward_kinematics(model, data, q);
+    const Proximity best = culled.closest(data);
+    (void)brute.closest(data);
+    const auto bounds = culled.pair_bounds();
+    const auto exact = brute.pair_bounds();
+    ASSERT_EQ(bounds.size(), pairs.size());
+    ASSERT_EQ(exact.size(), pairs.size());
+    for (size_t k = 0; k < pairs.size(); ++k) {
+      EXPECT_LE(bounds[k], exact[k] + 1e-12) << "trial " << trial << " pair " << k;
+      (bounds[k] == exact[k] ? measured : bounded) += 1;
+    }
+    // The closest pair's entry is its distance.
+    const auto is_best = [&](const CollisionWorld::PairIndex& pr) {
+      return pr.self ? best.obstacle < 0 && pr.a == best.robot_geom && pr.b == best.other_geom
+                     : best.obstacle == pr.b && pr.a == best.robot_geom;
+    };
+    const auto it = std::find_if(pairs.begin(), pairs.end(), is_best);
+    ASSERT_NE(it, pairs.end());
+    EXPECT_EQ(bounds[static_cast<size_t>(it - pairs.begin())], best.distance);
+  }
+  EXPECT_GT(bounded, 100);  // most pairs are culled by their bounds, not measured
+  EXPECT_GT(measured, 100);
+}
+
 TEST(CollisionWorldSelf, NonAdjacentPairsOnlyAndExclusions) {
   const dynamics::Model model = dynamics::Model::from_urdf_file(kRobots + "rr/rr.urdf");
   dynamics::Data data(model);

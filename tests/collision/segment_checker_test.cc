@@ -200,6 +200,73 @@ TEST_F(RrSegment, PathCheckIsBoundedByDenseSampling) {
   EXPECT_GT(penetrating, 0);  // the seed must exercise the penetrating case
 }
 
+// A pair's allowance is spent only by the joints that move it: with a ball 3 cm from the upper
+// arm and only the elbow swinging, that pair never limits the walk, and the forearm, 0.4 m from
+// the ball, needs a handful of samples where one budget for the whole robot takes the upper
+// arm's 3 cm for every step.
+TEST_F(RrSegment, PathCheckBudgetsEachPairByTheJointsThatMoveIt) {
+  CollisionWorld world(model);
+  Obstacle o;
+  o.id = 1;
+  o.shape = Shape::sphere(0.03);
+  o.pose = at(0.1, 0, 0.5);
+  ASSERT_TRUE(world.add_obstacle(o));
+  Eigen::MatrixXd path(2, 2);
+  path << 0, -1.5, 0, 1.5;
+  SegmentChecker checker(model);
+  const PathCheckResult r = checker.check_path(world, data, path);
+  EXPECT_NEAR(r.min_distance, 0.03, 1e-9);
+  EXPECT_LT(r.samples, 15);
+  EXPECT_GT(r.lower_bound, 0.02);
+}
+
+// The same on the iiwa with its self pairs, whose walk budgets each pair by the joints that move
+// its geometries apart: the certified bound stays below the densely sampled minimum, every
+// penetration dense sampling finds is found, with a fraction of its queries.
+TEST(IiwaPath, PairByPairWalkIsBoundedByDenseSampling) {
+  const dynamics::Model model = dynamics::Model::from_urdf_file(kRobots + "iiwa14/iiwa14.urdf");
+  dynamics::Data data(model);
+  CollisionWorldOptions opts;
+  opts.self_collision = true;
+  CollisionWorld world(model, opts);
+  Obstacle o;
+  o.id = 1;
+  o.shape = Shape::box(0.3, 0.3, 0.3);
+  o.pose = at(0.45, 0.1, 0.7);
+  ASSERT_TRUE(world.add_obstacle(o));
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1.5, 1.5), step(-0.25, 0.25);
+  const SegmentCheckOptions dense_opts{.max_joint_step = 10, .max_sweep_step = 0.002};
+  SegmentChecker checker(model), dense(model, dense_opts);
+  int penetrating = 0, walk_samples = 0, dense_samples = 0;
+  for (int trial = 0; trial < 25; ++trial) {
+    Eigen::MatrixXd path(6, model.nq());
+    for (int j = 0; j < model.nq(); ++j) path(0, j) = u(rng);
+    for (int i = 1; i < path.rows(); ++i) {
+      for (int j = 0; j < model.nq(); ++j) path(i, j) = path(i - 1, j) + step(rng);
+    }
+    double dense_min = std::numeric_limits<double>::infinity();
+    for (int i = 0; i + 1 < path.rows(); ++i) {
+      const SegmentCheckResult r =
+          dense.check(world, data, path.row(i).transpose(), path.row(i + 1).transpose());
+      dense_min = std::min(dense_min, r.min_distance);
+      dense_samples += r.samples;
+    }
+    const PathCheckResult r = checker.check_path(world, data, path);
+    walk_samples += r.samples;
+    EXPECT_TRUE(r.complete);
+    EXPECT_LE(r.lower_bound, dense_min + 1e-9) << trial;
+    EXPECT_LE(r.lower_bound, r.min_distance);
+    EXPECT_GE(r.min_distance, dense_min - 1e-9 - SegmentCheckOptions().max_sweep_step) << trial;
+    if (dense_min < 0) {
+      ++penetrating;
+      EXPECT_LT(r.min_distance, 0) << trial;
+    }
+  }
+  EXPECT_GT(penetrating, 0);  // the seed must exercise the penetrating case
+  EXPECT_LT(walk_samples, dense_samples / 3);  // in contact it steps by max_sweep_step
+}
+
 // Far from every obstacle a long path costs a handful of queries; the ends are always checked.
 TEST_F(RrSegment, PathCheckSkipsClearStretches) {
   CollisionWorld world(model);
