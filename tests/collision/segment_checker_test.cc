@@ -23,6 +23,15 @@ Eigen::Isometry3d at(double x, double y, double z) {
   return T;
 }
 
+// Adds obstacle `id` of `shape` at `pose` to `world`.
+void add_obstacle(CollisionWorld& world, Shape shape, const Eigen::Isometry3d& pose, int id = 1) {
+  Obstacle o;
+  o.id = id;
+  o.shape = shape;
+  o.pose = pose;
+  ASSERT_TRUE(world.add_obstacle(o));
+}
+
 class RrSegment : public testing::Test {
  protected:
   RrSegment() : model(dynamics::Model::from_urdf_file(kRobots + "rr/rr.urdf")), data(model) {}
@@ -206,11 +215,7 @@ TEST_F(RrSegment, PathCheckIsBoundedByDenseSampling) {
 // arm's 3 cm for every step.
 TEST_F(RrSegment, PathCheckBudgetsEachPairByTheJointsThatMoveIt) {
   CollisionWorld world(model);
-  Obstacle o;
-  o.id = 1;
-  o.shape = Shape::sphere(0.03);
-  o.pose = at(0.1, 0, 0.5);
-  ASSERT_TRUE(world.add_obstacle(o));
+  add_obstacle(world, Shape::sphere(0.03), at(0.1, 0, 0.5));
   Eigen::MatrixXd path(2, 2);
   path << 0, -1.5, 0, 1.5;
   SegmentChecker checker(model);
@@ -229,11 +234,7 @@ TEST(IiwaPath, PairByPairWalkIsBoundedByDenseSampling) {
   CollisionWorldOptions opts;
   opts.self_collision = true;
   CollisionWorld world(model, opts);
-  Obstacle o;
-  o.id = 1;
-  o.shape = Shape::box(0.3, 0.3, 0.3);
-  o.pose = at(0.45, 0.1, 0.7);
-  ASSERT_TRUE(world.add_obstacle(o));
+  add_obstacle(world, Shape::box(0.3, 0.3, 0.3), at(0.45, 0.1, 0.7));
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(-1.5, 1.5), step(-0.25, 0.25);
   const SegmentCheckOptions dense_opts{.max_joint_step = 10, .max_sweep_step = 0.002};
