@@ -93,22 +93,10 @@ SegmentCheckResult SegmentChecker::check(CollisionWorld& world, dynamics::Data& 
   return result;
 }
 
-PathCheckResult SegmentChecker::check_path(CollisionWorld& world, dynamics::Data& data,
-                                           const Eigen::Ref<const Eigen::MatrixXd>& path,
-                                           const std::vector<double>& times, double clearance) {
-  PathCheckResult result;
-  result.min_distance = result.lower_bound = std::numeric_limits<double>::infinity();
-  const int m = static_cast<int>(path.rows());
-  if (m == 0) return result;
-  const bool moving = world.has_moving_obstacles();
-  auto time_at = [&](int i, double u) {
-    if (times.empty()) return 0.0;
-    return i + 1 < m ? times[i] + u * (times[i + 1] - times[i]) : times[i];
-  };
-  // How fast each joint can change each pair's distance. Against an obstacle: the geometry's
-  // own lever. Between two geometries: joints that move both alike change nothing, so only the
-  // joints below their common ancestor count, each with the lever of the geometry it moves.
-  world.closest_pairs(pairs_);
+void SegmentChecker::set_pair_levers() {
+  // Against an obstacle: the geometry's own lever. Between two geometries: joints that move both
+  // alike change nothing, so only the joints below their common ancestor count, each with the
+  // lever of the geometry it moves.
   const int pair_count = static_cast<int>(pairs_.size()), nq = model_.nq();
   pair_lever_.setZero(pair_count, nq);
   ancestor_.resize(static_cast<size_t>(nq));
@@ -134,6 +122,23 @@ PathCheckResult SegmentChecker::check_path(CollisionWorld& world, dynamics::Data
     mark_chain(pr.a);
     add_chain_outside(k, pr.b);
   }
+}
+
+PathCheckResult SegmentChecker::check_path(CollisionWorld& world, dynamics::Data& data,
+                                           const Eigen::Ref<const Eigen::MatrixXd>& path,
+                                           const std::vector<double>& times, double clearance) {
+  PathCheckResult result;
+  result.min_distance = result.lower_bound = std::numeric_limits<double>::infinity();
+  const int m = static_cast<int>(path.rows());
+  if (m == 0) return result;
+  const bool moving = world.has_moving_obstacles();
+  auto time_at = [&](int i, double u) {
+    if (times.empty()) return 0.0;
+    return i + 1 < m ? times[i] + u * (times[i + 1] - times[i]) : times[i];
+  };
+  world.closest_pairs(pairs_);
+  const int pair_count = static_cast<int>(pairs_.size()), nq = model_.nq();
+  set_pair_levers();
   rate_.resize(pair_count);
   allowance_.resize(pair_count);
   last_bound_.resize(pair_count);

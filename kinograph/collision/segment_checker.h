@@ -103,6 +103,10 @@ class SegmentChecker {
   const Eigen::VectorXd& lever() const { return lever_; }
 
  private:
+  // Fills pair_lever_ for pairs_: per pair and joint, how fast the joint can change the pair's
+  // distance (m/rad).
+  void set_pair_levers();
+
   const dynamics::Model& model_;
   SegmentCheckOptions options_;
   Eigen::VectorXd lever_;
