@@ -76,15 +76,14 @@ void IntervalInterpolant::point(double s, const Eigen::VectorXd& y, const Eigen:
     }
   }
   if (m == 0) {
+    if (!with_tau) return;  // the cubic needs no dynamics
     if (derivatives) {
       dynamics::rnea_derivatives(model_, data_, p.q, p.qd, p.qdd);
-      if (with_tau) {
-        // Each input block b moves every joint by the same coefficient: dτ_b = Σ c_b ∂τ/∂x.
-        p.dtau.resize(n, 4 * n);
-        for (int b = 0; b < 4; ++b) {
-          p.dtau.middleCols(b * n, n) = cq[b] * data_.dtau_dq + cv[b] * data_.dtau_dqd;
-          p.dtau.middleCols(b * n, n) += ca[b] * data_.M;
-        }
+      // Each input block b moves every joint by the same coefficient: dτ_b = Σ c_b ∂τ/∂x.
+      p.dtau.resize(n, 4 * n);
+      for (int b = 0; b < 4; ++b) {
+        p.dtau.middleCols(b * n, n) = cq[b] * data_.dtau_dq + cv[b] * data_.dtau_dqd;
+        p.dtau.middleCols(b * n, n) += ca[b] * data_.M;
       }
     } else {
       dynamics::rnea(model_, data_, p.q, p.qd, p.qdd);
@@ -216,7 +215,7 @@ void IntervalInterpolant::start(const Eigen::Ref<const Eigen::VectorXd>& q0,
   }
 }
 
-void IntervalInterpolant::at(double s, bool derivatives, InterpolantPoint& p) {
+void IntervalInterpolant::at(double s, bool derivatives, InterpolantPoint& p, bool with_tau) {
   const double tiny = 1e-12 * dt_;
   if (!(s >= -tiny && s <= dt_ + tiny)) {
     throw std::invalid_argument("interpolant: sample time outside [0, dt]");
@@ -225,14 +224,14 @@ void IntervalInterpolant::at(double s, bool derivatives, InterpolantPoint& p) {
     throw std::invalid_argument("interpolant: derivatives asked of an interval started without");
   }
   if (unactuated_.empty()) {
-    point(s, y_part_, S_part_, derivatives, true, p);
+    point(s, y_part_, S_part_, derivatives, with_tau, p);
     return;
   }
   // The node at or before s; a time on a node reads it, others take a partial step from it.
   const int node = std::min(steps_, static_cast<int>(std::floor((s + tiny) / h_)));
   const double rest = s - node * h_;
   if (rest <= tiny) {
-    point(node * h_, y_[node], S_[node], derivatives, true, p);
+    point(node * h_, y_[node], S_[node], derivatives, with_tau, p);
     return;
   }
   if (coarse_) {
@@ -240,7 +239,7 @@ void IntervalInterpolant::at(double s, bool derivatives, InterpolantPoint& p) {
   } else {
     rk4_step(node * h_, rest, y_[node], S_[node], derivatives, y_part_, S_part_);
   }
-  point(s, y_part_, S_part_, derivatives, true, p);
+  point(s, y_part_, S_part_, derivatives, with_tau, p);
 }
 
 void IntervalInterpolant::evaluate(const Eigen::Ref<const Eigen::VectorXd>& q0,

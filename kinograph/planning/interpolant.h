@@ -60,8 +60,10 @@ class IntervalInterpolant {
              const Eigen::Ref<const Eigen::VectorXd>& qdd1, double dt, bool derivatives);
   /// The point s seconds into the started interval (s in [0, dt]: one shorter RK4 step from the
   /// node before s, or the nodes' Hermite when coarse). `derivatives` also fills the d* members and needs a start() with them.
+  /// Without `with_tau`, τ and dτ are left as they were when every joint is actuated (the
+  /// cubic then needs no dynamics), and dτ is not filled otherwise.
   /// Throws std::invalid_argument for s outside [0, dt] or derivatives without them.
-  void at(double s, bool derivatives, InterpolantPoint& p);
+  void at(double s, bool derivatives, InterpolantPoint& p, bool with_tau = true);
 
   /// Where the unactuated joints arrive at dt, y = [q_u; q̇_u] (joints in unactuated() order),
   /// and, after a start() with derivatives, dy/dz (2m × 4n): the shooting defect's ingredients
@@ -82,7 +84,8 @@ class IntervalInterpolant {
 
  private:
   // The state at time s with the unactuated state y = [q_u; q̇_u] and its sensitivity S = dy/dz
-  // (q, q̇, q̈ and with derivatives their d*); with_tau adds τ (and dτ).
+  // (q, q̇, q̈ and with derivatives their d*); with_tau adds dτ, and τ when every joint is
+  // actuated (with unactuated joints τ comes with their dynamics).
   void point(double s, const Eigen::VectorXd& y, const Eigen::MatrixXd& S, bool derivatives,
              bool with_tau, InterpolantPoint& p);
   // The slope ẏ = [q̇_u; q̈_u] at (s, y, S) into k and, with derivatives, its total derivative

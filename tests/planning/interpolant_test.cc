@@ -258,6 +258,37 @@ TEST(IntervalDynamicsFactor, LinearizationIsExactWithRowsOnAndOff) {
   }
 }
 
+// A fully actuated arm whose check points have position and velocity rows on but every torque
+// row off: their Jacobian rows come from the cubic alone, without the dynamics' derivatives.
+TEST(IntervalDynamicsFactor, LinearizationIsExactWithOnlyMotionRowsOn) {
+  const auto model = load_robot("robots/rr/rr.urdf");
+  IntervalDynamicsOptions o;
+  o.checks = 5;
+  const double dt = 0.1;
+  IntervalDynamicsFactor f(0, dt, model, o);
+  std::mt19937 rng(33);
+  const graph::Values x = random_interval(model->nq(), dt, rng);
+  Eigen::VectorXd z;
+  f.values_at(x, z);
+  auto m = std::make_shared<Multipliers>(f.residual_dim(), 4.0);
+  int motion_on = 0;
+  for (int i = 0; i < f.residual_dim(); ++i) {
+    const RowSpec& row = f.rows()[i];
+    ASSERT_EQ(row.kind, RowKind::kBounds);
+    const bool torque = row.scale == o.torque_scale;
+    ASSERT_TRUE(z[i] <= row.upper && z[i] >= row.lower) << "row " << i;
+    if (torque || i % 3 == 0) continue;  // torque rows and some motion rows stay off
+    m->upper[i] = m->penalty * (row.upper - z[i]) / row.scale + 1;  // on through λ
+    ++motion_on;
+  }
+  ASSERT_GT(motion_on, 0);
+  f.bind(m);
+  graph::testing::JacobianCheckOptions c;
+  c.tolerance = 1e-6;
+  const auto check = check_jacobians(f, x, c);
+  EXPECT_TRUE(check.ok) << check.report();
+}
+
 // The factor keeps its last evaluation while the variables stay the same; a bound row whose
 // hinge was off then (its Jacobian row left unfilled) and is on now must not be read from it.
 TEST(IntervalDynamicsFactor, KeptEvaluationIsExactWhenRowsTurnOn) {

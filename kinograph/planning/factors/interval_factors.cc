@@ -122,13 +122,17 @@ void IntervalDynamicsFactor::compute(const graph::FactorValues& x, Eigen::Ref<Ei
     for (int b = 0; b < 4; ++b) J->block(key_of[b]).row(row) -= S.block(row, b * n, 1, n);
   }
   for (int i = 0; i < checks; ++i) {
-    bool needed = false;
+    bool needed = false, tau_needed = false;  // a row of the point needs its Jacobian row
     for (int row = point_begin_[i]; row < point_begin_[i + 1]; ++row) {
       z[row] = value(layout_[row], points_[i]);
-      needed = needed || (derivatives && jacobian_row_needed(row, z[row]));
+      if (derivatives && jacobian_row_needed(row, z[row])) {
+        needed = true;
+        tau_needed = tau_needed || layout_[row].kind == Kind::kTau;
+      }
     }
     if (!needed) continue;
-    interpolant_.at(times_[i], true, with_derivatives_);
+    // Position and velocity rows alone need no dynamics' derivatives.
+    interpolant_.at(times_[i], true, with_derivatives_, tau_needed);
     for (int row = point_begin_[i]; row < point_begin_[i + 1]; ++row) {
       if (!jacobian_row_needed(row, z[row])) continue;
       const Kind kind = layout_[row].kind;
