@@ -219,6 +219,36 @@ TEST(IntervalDynamicsFactor, JacobiansFullyActuated) {
   expect_raw_jacobians(load_robot("robots/rr/rr.urdf"), 2, 22);
 }
 
+// The factor's hinged residual Jacobian at x against central differences.
+void expect_exact_linearization(const ConstrainedFactor& f, const graph::Values& x,
+                                const std::string& what = "") {
+  graph::testing::JacobianCheckOptions c;
+  c.tolerance = 1e-6;
+  const auto check = check_jacobians(f, x, c);
+  EXPECT_TRUE(check.ok) << what << "\n" << check.report();
+}
+
+// An interval factor with five check points (Δt = 0.1 s) at a random interval x, its raw
+// values z, and multipliers (μ = 4, every λ zero) to turn rows on with.
+struct FiveCheckInterval {
+  FiveCheckInterval(std::shared_ptr<const dynamics::Model> model, unsigned seed, bool off_defect)
+      : f(0, 0.1, model, [] {
+          IntervalDynamicsOptions o;
+          o.checks = 5;
+          return o;
+        }()) {
+    std::mt19937 rng(seed);
+    x = off_defect ? off_defect_interval(model->nq(), 0.1, rng)
+                   : random_interval(model->nq(), 0.1, rng);
+    f.values_at(x, z);
+    m = std::make_shared<Multipliers>(f.residual_dim(), 4.0);
+  }
+  IntervalDynamicsFactor f;
+  graph::Values x;
+  Eigen::VectorXd z;
+  std::shared_ptr<Multipliers> m;
+};
+
 // While linearizing, the factor skips the derivatives of check points whose rows are all off.
 // The hinged residual's Jacobian must still be exact: rows violated, rows inside their bound
 // but kept on by a multiplier, and rows off, against central differences of the residual.
@@ -227,15 +257,10 @@ TEST(IntervalDynamicsFactor, LinearizationIsExactWithRowsOnAndOff) {
     auto model = std::make_shared<dynamics::Model>(*robot);
     const std::string& urdf = model->name;
     for (dynamics::Body& b : model->bodies) b.limits.effort = std::min(b.limits.effort, 0.5);
-    IntervalDynamicsOptions o;
-    o.checks = 5;
-    const double dt = 0.1;
-    IntervalDynamicsFactor f(0, dt, model, o);
-    std::mt19937 rng(31);
-    const graph::Values x = off_defect_interval(model->nq(), dt, rng);
-    Eigen::VectorXd z;
-    f.values_at(x, z);
-    auto m = std::make_shared<Multipliers>(f.residual_dim(), 4.0);
+    FiveCheckInterval t(model, 31, true);
+    IntervalDynamicsFactor& f = t.f;
+    const Eigen::VectorXd& z = t.z;
+    Multipliers* m = t.m.get();
     int on = 0, off = 0, kept_on = 0;
     for (int i = 0; i < f.residual_dim(); ++i) {
       const RowSpec& r = f.rows()[i];
@@ -247,46 +272,31 @@ TEST(IntervalDynamicsFactor, LinearizationIsExactWithRowsOnAndOff) {
       }
       (violated ? on : off) += 1;
     }
-    f.bind(m);
+    f.bind(t.m);
     ASSERT_GT(on, 0) << urdf;
     ASSERT_GT(off, kept_on) << urdf;
     ASSERT_GT(kept_on, 0) << urdf;
-    graph::testing::JacobianCheckOptions c;
-    c.tolerance = 1e-6;
-    const auto check = check_jacobians(f, x, c);
-    EXPECT_TRUE(check.ok) << urdf << "\n" << check.report();
+    expect_exact_linearization(f, t.x, urdf);
   }
 }
 
 // A fully actuated arm whose check points have position and velocity rows on but every torque
 // row off: their Jacobian rows come from the cubic alone, without the dynamics' derivatives.
 TEST(IntervalDynamicsFactor, LinearizationIsExactWithOnlyMotionRowsOn) {
-  const auto model = load_robot("robots/rr/rr.urdf");
-  IntervalDynamicsOptions o;
-  o.checks = 5;
-  const double dt = 0.1;
-  IntervalDynamicsFactor f(0, dt, model, o);
-  std::mt19937 rng(33);
-  const graph::Values x = random_interval(model->nq(), dt, rng);
-  Eigen::VectorXd z;
-  f.values_at(x, z);
-  auto m = std::make_shared<Multipliers>(f.residual_dim(), 4.0);
+  FiveCheckInterval t(load_robot("robots/rr/rr.urdf"), 33, false);
   int motion_on = 0;
-  for (int i = 0; i < f.residual_dim(); ++i) {
-    const RowSpec& row = f.rows()[i];
+  for (int i = 0; i < t.f.residual_dim(); ++i) {
+    const RowSpec& row = t.f.rows()[i];
     ASSERT_EQ(row.kind, RowKind::kBounds);
-    const bool torque = row.scale == o.torque_scale;
-    ASSERT_TRUE(z[i] <= row.upper && z[i] >= row.lower) << "row " << i;
+    const bool torque = row.scale == IntervalDynamicsOptions().torque_scale;
+    ASSERT_TRUE(t.z[i] <= row.upper && t.z[i] >= row.lower) << "row " << i;
     if (torque || i % 3 == 0) continue;  // torque rows and some motion rows stay off
-    m->upper[i] = m->penalty * (row.upper - z[i]) / row.scale + 1;  // on through λ
+    t.m->upper[i] = t.m->penalty * (row.upper - t.z[i]) / row.scale + 1;  // on through λ
     ++motion_on;
   }
   ASSERT_GT(motion_on, 0);
-  f.bind(m);
-  graph::testing::JacobianCheckOptions c;
-  c.tolerance = 1e-6;
-  const auto check = check_jacobians(f, x, c);
-  EXPECT_TRUE(check.ok) << check.report();
+  t.f.bind(t.m);
+  expect_exact_linearization(t.f, t.x);
 }
 
 // The factor keeps its last evaluation while the variables stay the same; a bound row whose
@@ -315,10 +325,7 @@ TEST(IntervalDynamicsFactor, KeptEvaluationIsExactWhenRowsTurnOn) {
   }
   ASSERT_GT(turned_on, 0);
   f.bind(on);
-  graph::testing::JacobianCheckOptions c;
-  c.tolerance = 1e-6;
-  const auto check = check_jacobians(f, x, c);
-  EXPECT_TRUE(check.ok) << check.report();
+  expect_exact_linearization(f, x);
 }
 
 TEST(IntervalDynamicsFactor, RowsOfTheAcrobot) {
