@@ -180,6 +180,11 @@ TEST(BatchPlanner, LimitRowsTheSolveAlreadyKeepsAreNotReSolved) {
   EXPECT_LE(worst_constraint(with_rows.graph.constraints(false), with_rows.graph.values)
                 .scaled_violation,
             OuterLoopOptions().constraint_tolerance);
+  // Every constraint of the solution's graph has its multipliers (the incremental planner
+  // carries them into its tree).
+  for (const FactorEntry* e : with_rows.graph.constraints(false)) {
+    EXPECT_NO_THROW((void)with_rows.constraints.at(e->key)) << "step " << e->key.step;
+  }
   Problem knots_only = p;
   knots_only.objectives.limit_substeps = 0;
   const Plan reference = BatchPlanner().plan(knots_only);

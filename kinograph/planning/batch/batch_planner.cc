@@ -281,6 +281,8 @@ Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init, const s
     if (added_to_converged) {
       const ConstraintReport worst = worst_constraint(pg.constraints(false), pg.values);
       if (worst.scaled_violation <= loop.constraint_tolerance) {
+        // The new rows' multipliers start at zero, as a solve would start them.
+        for (const FactorEntry* e : pg.constraints(false)) state.bind(*e);
         r.worst = worst;
         spdlog::debug("{}: interval round {}: the added limit points hold (worst {:.3g}); not "
                       "re-solved", problem.name, round, worst.scaled_violation);
