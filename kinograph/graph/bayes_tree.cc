@@ -215,6 +215,7 @@ bool BayesTree::factorize(const std::vector<int>& ids,
     // Gather the clique's own factors and its children's marginals (orphans included).
     for (int f : c.factors) {
       const LinearizedFactor& lf = linearized[f];
+      if (lf.zero) continue;
       const int nv = static_cast<int>(lf.vars.size());
       for (int a = 0; a < nv; ++a) {
         const int va = lf.vars[a], la = local_offset_[va], da = dims_[va];

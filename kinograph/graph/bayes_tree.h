@@ -19,6 +19,9 @@ struct LinearizedFactor {
   Eigen::VectorXd g;         ///< Jᵀr
   double error = 0;          ///< ½‖r‖² at the linearization point
   bool active = false;       ///< false for removed factors (slot kept empty)
+  /// No row of the factor is active (e.g. an inequality that holds): H and g are zero and not
+  /// formed, and the factor adds nothing to its clique.
+  bool zero = false;
   /// The factor's Factor::jacobian_version when H was formed, and for a linear factor its
   /// whitened Jacobian over the free variables (H and J are kept while the version holds).
   long jacobian_version = -1;

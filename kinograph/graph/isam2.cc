@@ -179,7 +179,7 @@ bool ISAM2::relinearize_kept_jacobian(const Factor& factor, LinearizedFactor& lf
   if (!r.allFinite()) return false;
   lf.error = 0.5 * r.squaredNorm();
   if (error != nullptr) *error = lf.error;
-  lf.g.noalias() = lf.J.transpose() * r;
+  if (!lf.zero) lf.g.noalias() = lf.J.transpose() * r;  // zero: J has no nonzero row
   lf.active = true;
   ++jacobians_kept_;
   return true;
@@ -217,16 +217,16 @@ bool ISAM2::linearize_fresh(const Factor& factor, LinearizedFactor& lf, double* 
 }
 
 // lf.H = JᵀJ and lf.g = Jᵀr over the first `active` rows (those not all zero) and the free
-// columns; r is the residual in r_.
+// columns; r is the residual in r_. Without an active row the factor is only marked zero: in a
+// planning graph most inequality rows hold, and their factors need no work in the cliques.
 void ISAM2::form_normal_equations(Eigen::Ref<Eigen::MatrixXd> J, int active, LinearizedFactor& lf) {
+  lf.zero = active == 0;
+  if (lf.zero) return;
   auto r = r_.head(J.rows());
   const int off = static_cast<int>(free_cols_.size());
   const auto Ja = J.topRows(active);
   const auto ra = r.head(active);
-  if (active == 0) {
-    lf.H.setZero(off, off);
-    lf.g.setZero(off);
-  } else if (off == J.cols() && active <= kLazyProductRows) {
+  if (off == J.cols() && active <= kLazyProductRows) {
     lf.H.noalias() = Ja.transpose().lazyProduct(Ja);
     lf.g.noalias() = Ja.transpose() * ra;
   } else if (off == J.cols()) {
@@ -584,6 +584,7 @@ bool ISAM2::linearize_queued(const UpdateWork& work, ISAM2Result& res) {
   }
   res.factors_linearized = static_cast<int>(work.to_linearize.size());
   res.factors_reused = factors_reused_ - reused_before;
+  for (int f : work.to_linearize) res.factors_zero += linearized_[f].zero ? 1 : 0;
   return true;
 }
 
@@ -708,6 +709,7 @@ Eigen::VectorXd ISAM2::damping_diagonal(const std::vector<int>& vars) const {
   for (int s : vars) {
     for (int f : var_factors_[s]) {
       const LinearizedFactor& lf = linearized_[f];
+      if (lf.zero) continue;
       for (size_t i = 0; i < lf.vars.size(); ++i) {
         if (lf.vars[i] != s) continue;
         diag_H.segment(theta_.offset(s), theta_.dim(s)) +=

@@ -125,6 +125,7 @@ struct ISAM2Result {
   int variables_relinearized = 0;   ///< variables whose linearization point moved
   int factors_linearized = 0;  ///< new factors plus those touching relinearized variables
   int factors_reused = 0;      ///< of those, linearizations kept from the error evaluation
+  int factors_zero = 0;        ///< of those, factors without an active row (they add nothing)
   int jacobians_kept = 0;      ///< evaluations of linear factors that kept JᵀJ (all trials)
   int cliques_solved = 0;      ///< cliques back-substituted (last trial)
   /// Numeric eliminations (Gauss–Newton); with Dogleg, one plus the dogleg steps tried.

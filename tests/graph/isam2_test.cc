@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <map>
@@ -291,6 +292,23 @@ class UnitNormFactor final : public Factor {
   }
 };
 
+// One-sided limit x_0 ≤ limit on a 2-D point: r = max(0, x_0 − limit), with no active row
+// (zero residual and Jacobian) while the limit holds.
+class UpperLimitFactor final : public Factor {
+ public:
+  UpperLimitFactor(Key a, double limit, NoiseModelPtr noise)
+      : Factor({a}, {2}, 1, std::move(noise)), limit_(limit) {}
+  void evaluate(const FactorValues& x, Eigen::Ref<Eigen::VectorXd> e,
+                const Jacobians* J) const override {
+    const double over = x[0][0] - limit_;
+    e[0] = std::max(over, 0.0);
+    if (J) J->block(0) = Eigen::RowVector2d(over > 0 ? 1.0 : 0.0, 0.0);
+  }
+
+ private:
+  double limit_;
+};
+
 Values batch_optimum(const FactorGraph& graph, Values start) {
   LevenbergMarquardtOptions o;
   o.relative_error_tol = 1e-14;
@@ -342,6 +360,58 @@ TEST(ISAM2, NonlinearUpdatesConvergeToTheBatchOptimum) {
   const Values optimum = batch_optimum(reference, initial);
   EXPECT_LT((isam.estimate().vector() - optimum.vector()).cwiseAbs().maxCoeff(), 1e-6);
   EXPECT_NEAR(isam.error(), reference.error(optimum), 1e-8 * reference.error(optimum));
+}
+
+TEST(ISAM2, FactorsWithoutActiveRowsAddNothingUntilTheyTurnActive) {
+  // A chain of 2-D points with a limit on each; first pulled below the limits (no limit row
+  // active), then the last point's prior is replaced by one beyond its limit, so its limit must
+  // act again: a limit still counted as zero would leave the point at the new prior.
+  const int n = 6;
+  ISAM2 isam;
+  FactorGraph reference;
+  Values initial;
+  std::vector<FactorPtr> first;
+  for (int i = 0; i < n; ++i) initial.insert(X(i), Eigen::Vector2d(0.1 * i, 0.2));
+  for (int i = 0; i < n; ++i) {
+    first.push_back(std::make_shared<UpperLimitFactor>(X(i), 1.0, isotropic(1, 0.1)));
+    if (i > 0) {
+      first.push_back(std::make_shared<RangeFactor>(X(i), X(i - 1), 0.3, isotropic(1, 0.1)));
+    }
+  }
+  std::vector<FactorPtr> priors;
+  for (int i = 0; i < n; ++i) {
+    priors.push_back(std::make_shared<PriorFactor>(X(i), Eigen::Vector2d(0.1 * i, 0.2 * (i % 2)),
+                                                   isotropic(2, 0.5)));
+  }
+  std::vector<FactorPtr> added = first;
+  added.insert(added.end(), priors.begin(), priors.end());
+  const auto res = isam.update(added, {}, initial);
+  ASSERT_TRUE(res.ok()) << res.reason;
+  EXPECT_EQ(res.factors_zero, n);  // every limit holds
+  const size_t last_prior = res.new_factor_indices.back();
+
+  const auto beyond = std::make_shared<PriorFactor>(X(n - 1), Eigen::Vector2d(2.0, 0.0),
+                                                    isotropic(2, 0.5));
+  ASSERT_TRUE(isam.update({beyond}, {last_prior}).ok());
+  ISAM2UpdateOptions force;
+  force.force_relinearize = true;
+  for (int it = 0; it < 40; ++it) ASSERT_TRUE(isam.update({}, {}, {}, force).ok());
+
+  for (const auto& f : first) reference.add(f);
+  for (int i = 0; i + 1 < n; ++i) reference.add(priors[i]);
+  reference.add(beyond);
+  const Values optimum = batch_optimum(reference, initial);
+  // The limit holds the last point near 1; without it the point would settle far beyond.
+  EXPECT_GT(optimum.at(X(n - 1))[0], 1.0 + 1e-3);
+  EXPECT_LT(optimum.at(X(n - 1))[0], 1.1);
+  FactorGraph unlimited;
+  for (const auto& f : reference.factors()) {
+    if (f && f != first[first.size() - 2]) unlimited.add(f);  // all but the last point's limit
+  }
+  EXPECT_GT(batch_optimum(unlimited, initial).at(X(n - 1))[0], 1.2);
+  // The chain is weakly held across its length: the estimate agrees to 1e-4, the error to 1e-9.
+  EXPECT_LT((isam.estimate().vector() - optimum.vector()).cwiseAbs().maxCoeff(), 1e-4);
+  EXPECT_NEAR(isam.error(), reference.error(optimum), 1e-9 * reference.error(optimum));
 }
 
 TEST(ISAM2, ThresholdRelinearizationReachesTheOptimumWithoutForcing) {
