@@ -813,11 +813,22 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t
     // trajectory: its goal, held from the start, is what ran into the neighbour.
     const bool refused = plan.q.rows() < 2 && problem.goal.kind == planning::Goal::Kind::kJoint;
     std::string why;
-    const std::optional<fleet::Blocker> blocker = neighbours_->blocker(
+    const double contact = plan.success() ? 0.0 : problem.objectives.collision_epsilon;
+    std::optional<fleet::Blocker> blocker = neighbours_->blocker(
         *around, *origin, *problem.model,
-        refused ? fleet::standing_plan(problem.goal.q, problem.horizon) : plan, wait_s,
-        plan.success() ? 0.0 : problem.objectives.collision_epsilon, checked_from(wait_s), why);
-    if (refused) {
+        refused ? fleet::standing_plan(problem.goal.q, problem.horizon) : plan, wait_s, contact,
+        checked_from(wait_s), why);
+    bool goal_blocked = refused;
+    // A failed plan ends wherever its solve stopped, so keeping clear says little; its goal,
+    // held from the horizon on, is where any plan must stand while a neighbour may still pass.
+    if (!blocker && !refused && !plan.success() &&
+        problem.goal.kind == planning::Goal::Kind::kJoint) {
+      blocker = neighbours_->blocker(
+          *around, *origin, *problem.model, fleet::standing_plan(problem.goal.q, problem.horizon),
+          wait_s, contact, std::max(checked_from(wait_s), wait_s + problem.horizon), why);
+      goal_blocked = blocker.has_value();
+    }
+    if (goal_blocked) {
       why = "its goal: " + why;
     } else if (!plan.success() && !plan.stats.reason.empty()) {
       why += " (" + neighbours_->name_bodies(plan.stats.reason) + ")";
