@@ -185,6 +185,43 @@ TEST(ConstrainedFactor, MultiplierUpdateClipsInequalities) {
   EXPECT_EQ(m.lower[0], 0);
 }
 
+// z = q², counting its evaluations, with the evaluations kept (as the dynamics rows keep them).
+class CountingFactor : public ConstrainedFactor {
+ public:
+  CountingFactor() : ConstrainedFactor({q_key(0)}, {1}, {RowSpec{RowKind::kSoft, 0, 0, 1, 2}}) {
+    cache_evaluations();
+  }
+  void compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
+               const graph::Jacobians* J) const override {
+    ++calls;
+    z[0] = x[0][0] * x[0][0];
+    if (J != nullptr) J->block(0)(0, 0) = 2 * x[0][0];
+  }
+  mutable int calls = 0;
+};
+
+TEST(ConstrainedFactor, ValuesAtTheLastLinearizationAreNotComputedAgain) {
+  graph::Values v;
+  v.insert(q_key(0), Eigen::VectorXd::Constant(1, 0.3));
+  CountingFactor f;
+  Eigen::VectorXd r, z;
+  Eigen::MatrixXd J;
+  f.linearize(v, r, J);
+  EXPECT_EQ(f.calls, 1);
+  f.values_at(v, z);  // the stopping rule's and the multiplier update's reading
+  EXPECT_EQ(f.calls, 1);
+  EXPECT_DOUBLE_EQ(z[0], 0.09);
+  EXPECT_DOUBLE_EQ(f.terms(v).soft_cost, 0.5 * std::pow(2 * 0.09, 2));
+  EXPECT_EQ(f.calls, 1);
+  v.update(q_key(0), Eigen::VectorXd::Constant(1, 0.5));
+  f.values_at(v, z);  // elsewhere: computed
+  EXPECT_EQ(f.calls, 2);
+  EXPECT_DOUBLE_EQ(z[0], 0.25);
+  f.linearize(v, r, J);  // the Jacobian was never computed there
+  EXPECT_EQ(f.calls, 3);
+  EXPECT_DOUBLE_EQ(J(0, 0), 2 * 2 * 0.5);
+}
+
 TEST(DynamicsStepFactor, JacobiansOnIiwaWithPayloadAndAcrobot) {
   std::mt19937 rng(3);
   auto iiwa = std::make_shared<const dynamics::Model>(dynamics::attach_box_payload(

@@ -160,14 +160,19 @@ void ConstrainedFactor::cache_evaluations() {
   kept_[1].filled.assign(static_cast<size_t>(residual_dim()), 0);
 }
 
-bool ConstrainedFactor::reusable(const graph::FactorValues& x, bool with_jacobian) const {
-  const Evaluation& k = kept_[with_jacobian ? 1 : 0];
+bool ConstrainedFactor::kept_at(const Evaluation& k, const graph::FactorValues& x) const {
   if (!k.valid) return false;
   for (size_t b = 0; b < keys().size(); ++b) {
     const int i = static_cast<int>(b);
     const size_t bytes = sizeof(double) * static_cast<size_t>(dims()[b]);
     if (std::memcmp(x[i].data(), k.x.data() + block_offsets()[b], bytes) != 0) return false;
   }
+  return true;
+}
+
+bool ConstrainedFactor::reusable(const graph::FactorValues& x, bool with_jacobian) const {
+  const Evaluation& k = kept_[with_jacobian ? 1 : 0];
+  if (!kept_at(k, x)) return false;
   if (!with_jacobian) return true;
   for (int row = 0; row < residual_dim(); ++row) {
     if (!k.filled[static_cast<size_t>(row)] && jacobian_row_needed(row, k.z[row])) return false;
@@ -180,6 +185,12 @@ void ConstrainedFactor::cached_compute(const graph::FactorValues& x,
                                        const graph::Jacobians* J) const {
   if (kept_.empty()) {
     compute(x, z, J);
+    return;
+  }
+  // Values alone may come from the last linearization: the outer loop and the incremental
+  // planner's stopping rule read them at the point just linearized.
+  if (J == nullptr && !kept_at(kept_[0], x) && kept_at(kept_[1], x)) {
+    z = kept_[1].z;
     return;
   }
   Evaluation& k = kept_[J != nullptr ? 1 : 0];

@@ -132,6 +132,8 @@ class ConstrainedFactor : public graph::Factor {
   /// and the last without Jacobians are kept and reused while the variables are bitwise the
   /// same, so results are those of compute(). The outer loop linearizes at the point LM stopped
   /// at twice (its last trial, the next solve's start); only the multipliers differ between.
+  /// Values alone (compute_at) are read from either, so a cost or violation read at the point
+  /// just linearized costs no evaluation.
   void cache_evaluations();
 
  private:
@@ -147,6 +149,8 @@ class ConstrainedFactor : public graph::Factor {
   // needed now (called while this factor is evaluating, so inactive rows are known).
   void cached_compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
                       const graph::Jacobians* J) const;
+  // Whether `k` was evaluated at x.
+  bool kept_at(const Evaluation& k, const graph::FactorValues& x) const;
   // Whether the kept evaluation is at x (and has the Jacobian rows needed now, if asked).
   bool reusable(const graph::FactorValues& x, bool with_jacobian) const;
 
