@@ -143,6 +143,13 @@ Plan IncrementalPlanner::plan(const Problem& problem, const Plan* warm) {
     stats_.penalty = tree_->constraints.penalty();
     p.stats.solve_time_s = seconds_since(t0);
     plan_ = p;
+    if (!p.success()) {
+      if (std::optional<Plan> batch = carried_batch_plan(problem, warm)) {
+        add_counts(batch->stats, p.stats);
+        p = std::move(*batch);
+      }
+      p.stats.solve_time_s = seconds_since(t0);
+    }
     return p;
   }
   // The batch planner's own initializations (straight line, detours) find the way; its final
@@ -188,6 +195,21 @@ Plan IncrementalPlanner::plan(const Problem& problem, const Plan* warm) {
   p.stats.solve_time_s = seconds_since(t0);
   plan_ = p;
   return p;
+}
+
+std::optional<Plan> IncrementalPlanner::carried_batch_plan(const Problem& problem,
+                                                           const Plan* warm) {
+  BatchSolution solution;
+  const Plan batch = BatchPlanner(options_.batch).plan(problem, warm, &solution);
+  if (!batch.success()) return std::nullopt;
+  std::unique_ptr<IncrementalTree> before = std::move(tree_);
+  std::optional<Plan> carried = carry_first_plan(problem, batch, solution);
+  if (!carried || !carried->success()) {
+    tree_ = std::move(before);  // carry_first_plan changed nothing else when it failed
+    return std::nullopt;
+  }
+  plan_ = *carried;
+  return carried;
 }
 
 std::optional<Plan> IncrementalPlanner::carry_first_plan(const Problem& problem, const Plan& batch,

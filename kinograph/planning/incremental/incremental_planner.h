@@ -68,8 +68,10 @@ class IncrementalPlanner {
 
   /// Plans `problem` with BatchPlanner (straight line, detours) and builds the Bayes tree at its
   /// plan from its final graph and multipliers (then settles it, settle_first_plan). With `warm`
-  /// the outer loop runs on the incremental graph from the warm start instead. Problems that
-  /// cannot be planned come back with status "invalid_problem" (and no state is kept).
+  /// the outer loop runs on the incremental graph from the warm start instead, and when that
+  /// does not validate the batch planner's warm start (with its restarts) is carried as above.
+  /// Problems that cannot be planned come back with status "invalid_problem" (and no state is
+  /// kept).
   Plan plan(const Problem& problem, const Plan* warm = nullptr);
 
   /// Applies `change` to the current problem and replans incrementally. Needs a previous plan
@@ -107,6 +109,10 @@ class IncrementalPlanner {
   const IncrementalPlannerOptions& options() const { return options_; }
 
  private:
+  /// The batch planner's plan of `problem` (warm-started from `warm` when not null), carried
+  /// into a new tree when it validates; null, with the planner as it was, when it does not
+  /// validate or cannot be carried.
+  std::optional<Plan> carried_batch_plan(const Problem& problem, const Plan* warm);
   /// The first plan carried from a batch solve (null: it could not be carried).
   std::optional<Plan> carry_first_plan(const Problem& problem, const Plan& batch,
                                        BatchSolution& solution);
