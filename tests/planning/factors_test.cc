@@ -185,11 +185,17 @@ TEST(ConstrainedFactor, MultiplierUpdateClipsInequalities) {
   EXPECT_EQ(m.lower[0], 0);
 }
 
-// z = q², counting its evaluations, with the evaluations kept (as the dynamics rows keep them).
+// z = q², counting its evaluations, with the evaluations kept (as the dynamics rows keep them)
+// or only the values (as the collision rows).
 class CountingFactor : public ConstrainedFactor {
  public:
-  CountingFactor() : ConstrainedFactor({q_key(0)}, {1}, {RowSpec{RowKind::kSoft, 0, 0, 1, 2}}) {
-    cache_evaluations();
+  explicit CountingFactor(bool values_only = false)
+      : ConstrainedFactor({q_key(0)}, {1}, {RowSpec{RowKind::kSoft, 0, 0, 1, 2}}) {
+    if (values_only) {
+      cache_values();
+    } else {
+      cache_evaluations();
+    }
   }
   void compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
                const graph::Jacobians* J) const override {
@@ -220,6 +226,25 @@ TEST(ConstrainedFactor, ValuesAtTheLastLinearizationAreNotComputedAgain) {
   f.linearize(v, r, J);  // the Jacobian was never computed there
   EXPECT_EQ(f.calls, 3);
   EXPECT_DOUBLE_EQ(J(0, 0), 2 * 2 * 0.5);
+}
+
+TEST(ConstrainedFactor, KeptValuesServeOnlyValues) {
+  graph::Values v;
+  v.insert(q_key(0), Eigen::VectorXd::Constant(1, 0.3));
+  CountingFactor f(/*values_only=*/true);
+  Eigen::VectorXd r, z;
+  Eigen::MatrixXd J;
+  f.linearize(v, r, J);
+  f.values_at(v, z);
+  EXPECT_EQ(f.calls, 1);
+  EXPECT_DOUBLE_EQ(z[0], 0.09);
+  f.linearize(v, r, J);  // no Jacobian is kept
+  EXPECT_EQ(f.calls, 2);
+  v.update(q_key(0), Eigen::VectorXd::Constant(1, -0.4));
+  f.values_at(v, z);
+  f.values_at(v, z);
+  EXPECT_EQ(f.calls, 3);
+  EXPECT_DOUBLE_EQ(z[0], 0.16);
 }
 
 TEST(DynamicsStepFactor, JacobiansOnIiwaWithPayloadAndAcrobot) {

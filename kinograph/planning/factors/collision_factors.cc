@@ -91,6 +91,7 @@ CollisionFactor::CollisionFactor(int k, double s, double dt, double epsilon, dou
   if (!(s >= 0 && s < 1)) throw std::invalid_argument("CollisionFactor needs 0 <= s < 1");
   const double s2 = s * s, s3 = s2 * s;
   h_ << 2 * s3 - 3 * s2 + 1, s3 - 2 * s2 + s, -2 * s3 + 3 * s2, s3 - s2;
+  cache_values();
 }
 
 void CollisionFactor::compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,

@@ -160,6 +160,21 @@ void ConstrainedFactor::cache_evaluations() {
   kept_[1].filled.assign(static_cast<size_t>(residual_dim()), 0);
 }
 
+void ConstrainedFactor::cache_values() {
+  kept_.resize(1);
+  kept_[0].x.resize(jacobian_cols());
+  kept_[0].z.resize(residual_dim());
+}
+
+void ConstrainedFactor::keep(Evaluation& k, const graph::FactorValues& x,
+                             const Eigen::Ref<const Eigen::VectorXd>& z) const {
+  for (size_t b = 0; b < keys().size(); ++b) {
+    k.x.segment(block_offsets()[b], dims()[b]) = x[static_cast<int>(b)];
+  }
+  k.z = z;
+  k.valid = true;
+}
+
 bool ConstrainedFactor::kept_at(const Evaluation& k, const graph::FactorValues& x) const {
   if (!k.valid) return false;
   for (size_t b = 0; b < keys().size(); ++b) {
@@ -187,6 +202,16 @@ void ConstrainedFactor::cached_compute(const graph::FactorValues& x,
     compute(x, z, J);
     return;
   }
+  if (kept_.size() == 1) {  // cache_values(): the last values, from either kind of evaluation
+    Evaluation& k = kept_[0];
+    if (J == nullptr && kept_at(k, x)) {
+      z = k.z;
+      return;
+    }
+    compute(x, z, J);
+    keep(k, x, z);
+    return;
+  }
   // Values alone may come from the last linearization: the outer loop and the incremental
   // planner's stopping rule read them at the point just linearized.
   if (J == nullptr && !kept_at(kept_[0], x) && kept_at(kept_[1], x)) {
@@ -205,11 +230,7 @@ void ConstrainedFactor::cached_compute(const graph::FactorValues& x,
     return;
   }
   compute(x, z, J);
-  for (size_t b = 0; b < keys().size(); ++b) {
-    k.x.segment(offsets[b], dims()[b]) = x[static_cast<int>(b)];
-  }
-  k.z = z;
-  k.valid = true;
+  keep(k, x, z);
   if (J == nullptr) return;
   for (size_t b = 0; b < keys().size(); ++b) {
     k.J.middleCols(offsets[b], dims()[b]) = J->block(static_cast<int>(b));

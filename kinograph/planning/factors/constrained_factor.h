@@ -135,6 +135,11 @@ class ConstrainedFactor : public graph::Factor {
   /// Values alone (compute_at) are read from either, so a cost or violation read at the point
   /// just linearized costs no evaluation.
   void cache_evaluations();
+  /// For a subclass whose compute() is expensive and whose Jacobian is too large to keep (the
+  /// collision rows): only the last values are kept, from either kind of evaluation, and read
+  /// again while the variables are bitwise the same (cost, violation and multiplier updates at
+  /// the point just linearized). Not with cache_evaluations().
+  void cache_values();
 
  private:
   // A kept raw evaluation: inputs (keys concatenated), z and, in the one with Jacobians,
@@ -149,6 +154,9 @@ class ConstrainedFactor : public graph::Factor {
   // needed now (called while this factor is evaluating, so inactive rows are known).
   void cached_compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
                       const graph::Jacobians* J) const;
+  // Records x and z as `k`'s evaluation.
+  void keep(Evaluation& k, const graph::FactorValues& x,
+            const Eigen::Ref<const Eigen::VectorXd>& z) const;
   // Whether `k` was evaluated at x.
   bool kept_at(const Evaluation& k, const graph::FactorValues& x) const;
   // Whether the kept evaluation is at x (and has the Jacobian rows needed now, if asked).
@@ -161,7 +169,8 @@ class ConstrainedFactor : public graph::Factor {
   int num_constraints_ = 0;
   std::shared_ptr<const Multipliers> m_;  // null until bound
   double penalty_read_ = 1;               // μ of the last bind or penalty_changed
-  // Empty unless cache_evaluations(); else the last evaluation without, then with, Jacobians.
+  // Empty unless cached: cache_values() keeps the last values; cache_evaluations() the last
+  // evaluation without, then with, Jacobians.
   mutable std::vector<Evaluation> kept_;
 };
 
