@@ -115,6 +115,12 @@ class Factor {
   void whitened(const double* const* x, Eigen::Ref<Eigen::VectorXd> r,
                 Eigen::Ref<Eigen::MatrixXd>* J, RowSupport* support = nullptr) const;
 
+  /// Whether evaluate() may run on a pool thread while other factors of its graph are being
+  /// evaluated: it touches only the factor's own state, thread_local scratch and WorkerLocal
+  /// workspaces. A factor that shares a plain workspace with others keeps the default (false)
+  /// and is evaluated on the caller's thread.
+  virtual bool parallel_safe() const { return false; }
+
   /// For a factor linear in its variables (its whitened Jacobian then does not depend on them),
   /// a number that changes whenever that Jacobian may change (noise model, penalty); −1 for
   /// every other factor. Numbers are unique across all factors of the process, so a solver may

@@ -50,7 +50,8 @@ bool LevenbergMarquardt::uses_envelope() const {
 }
 
 void LevenbergMarquardt::set_options(const LevenbergMarquardtOptions& options) {
-  if (options.ordering != options_.ordering || options.factorization != options_.factorization) {
+  if (options.ordering != options_.ordering || options.factorization != options_.factorization ||
+      options.threads != options_.threads) {
     equations_.reset();
     candidate_.reset();
     cholesky_.reset();
@@ -91,7 +92,8 @@ void LevenbergMarquardt::build_structure(const FactorGraph& graph, const Values&
   cholesky_.reset();
   equations_.reset();
   if (o.factorization == Factorization::kAuto || o.factorization == Factorization::kEnvelope) {
-    auto natural = std::make_unique<NormalEquations>(graph, values, OrderingMethod::kNatural);
+    auto natural = std::make_unique<NormalEquations>(graph, values, OrderingMethod::kNatural,
+                                                     o.threads);
     const int n = natural->dim();
     if (n > 0 && (o.factorization == Factorization::kEnvelope ||
                   EnvelopeCholesky::wins(n, natural->col_ptr(), natural->row_idx()))) {
@@ -101,7 +103,9 @@ void LevenbergMarquardt::build_structure(const FactorGraph& graph, const Values&
     }
     if (o.ordering == OrderingMethod::kNatural) equations_ = std::move(natural);
   }
-  if (!equations_) equations_ = std::make_unique<NormalEquations>(graph, values, o.ordering);
+  if (!equations_) {
+    equations_ = std::make_unique<NormalEquations>(graph, values, o.ordering, o.threads);
+  }
   if (equations_->dim() > 0) {
     cholesky_ = std::make_unique<SparseCholesky>(equations_->dim(), equations_->col_ptr(),
                                                  equations_->row_idx(), o.factorization);

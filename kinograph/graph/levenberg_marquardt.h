@@ -47,6 +47,10 @@ struct LevenbergMarquardtOptions {
   /// How H + λD is factorized (kAuto: the envelope in natural order when it adds little fill,
   /// as for a trajectory, else CHOLMOD's choice in `ordering`).
   Factorization factorization = Factorization::kAuto;
+  /// Threads that evaluate the factors (the caller's and up to threads − 1 of the process's
+  /// pool, as many as the machine has cores for). The solve is the same to the bit for any
+  /// value; 1 keeps it on the caller's thread, e.g. beside other busy processes.
+  int threads = 2;
   /// Take Jacobians at every trial point, so an accepted step is not linearized a second time.
   bool linearize_at_evaluation = true;
   /// Fill OptimizationResult::history, one entry per trial.
@@ -72,7 +76,7 @@ class LevenbergMarquardt {
   OptimizationResult optimize(const FactorGraph& graph, Values& values);
 
   const LevenbergMarquardtOptions& options() const { return options_; }
-  /// Changing ordering or factorization forces a rebuild on the next optimize().
+  /// Changing ordering, factorization or threads forces a rebuild on the next optimize().
   void set_options(const LevenbergMarquardtOptions& options);
   /// The cached CHOLMOD factorization (null before the first solve or when the envelope
   /// factorization is used), e.g. to see which form kAuto chose.

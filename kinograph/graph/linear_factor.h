@@ -16,6 +16,7 @@ class LinearFactor final : public Factor {
 
   void evaluate(const FactorValues& x, Eigen::Ref<Eigen::VectorXd> e,
                 const Jacobians* J) const override;
+  bool parallel_safe() const override { return true; }  // touches only its own state
 
   const std::vector<Eigen::MatrixXd>& A() const { return A_; }
   const Eigen::VectorXd& b() const { return b_; }

@@ -1,10 +1,13 @@
 #include "kinograph/graph/normal_equations.h"
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <stdexcept>
 
 #include "kinograph/graph/cancellation.h"
+#include "kinograph/graph/worker_pool.h"
 
 namespace kinograph::graph {
 
@@ -12,6 +15,13 @@ namespace {
 
 // Factors linearized between two looks at the cancellation flag: a few hundred microseconds.
 constexpr size_t kFactorsPerCancellationCheck = 256;
+// Graphs with fewer factors that may run on any thread than this, or whose last evaluation
+// took less than this many seconds of one thread's time, are evaluated on the caller's alone:
+// sharing the work out would cost about as much as it saves.
+constexpr size_t kMinParallelFactors = 32;
+constexpr double kMinParallelSeconds = 100e-6;
+// Factors a worker takes at a time.
+constexpr size_t kChunk = 4;
 
 // How messages name a factor: "factor 3 (Name)".
 std::string factor_label(size_t index, const Factor& f) {
@@ -70,8 +80,10 @@ struct NormalEquations::BlockPattern {
 };
 
 NormalEquations::NormalEquations(const FactorGraph& graph, const Values& values,
-                                 OrderingMethod ordering)
-    : graph_id_(graph.structure_id()), layout_id_(values.layout_id()) {
+                                 OrderingMethod ordering, int threads)
+    : graph_id_(graph.structure_id()),
+      layout_id_(values.layout_id()),
+      threads_(std::clamp(threads, 1, kMaxWorkers)) {
   const Incidence inc = incidence(graph, values);
   const int num_free = static_cast<int>(inc.slot_of_natural.size());
   const std::vector<int> order = compute_ordering(num_free, inc.factor_vars, ordering);
@@ -81,7 +93,7 @@ NormalEquations::NormalEquations(const FactorGraph& graph, const Values& values,
   pattern.within = lay_out_columns(pattern.rows);
   allocate_storage();
   index_factors(graph, values, inc, pos_of_natural, pattern);
-  size_workspaces(inc);
+  size_workspaces(graph, inc);
 }
 
 NormalEquations::Incidence NormalEquations::incidence(const FactorGraph& graph,
@@ -222,14 +234,192 @@ void NormalEquations::add_pairs(const std::vector<int>& pos, const BlockPattern&
   }
 }
 
-// Linear caches and the per-factor workspaces, sized for the largest factor.
-void NormalEquations::size_workspaces(const Incidence& inc) {
+// Linear caches, the workers' workspaces (the caller's at once) and which factors may run on
+// any worker.
+void NormalEquations::size_workspaces(const FactorGraph& graph, const Incidence& inc) {
   linear_.assign(factors_.size(), LinearCache());
-  r_.setZero(inc.max_rows);
-  J_.setZero(inc.max_rows, inc.max_cols);
-  JtJ_.setZero(inc.max_cols, inc.max_cols);
-  Jtr_.setZero(inc.max_cols);
-  x_ptrs_.resize(inc.max_keys);
+  max_rows_ = inc.max_rows;
+  max_cols_ = inc.max_cols;
+  max_keys_ = inc.max_keys;
+  workspaces_.resize(static_cast<size_t>(threads_));
+  workspace(0);
+  if (threads_ <= 1) return;
+  for (size_t fi = 0; fi < factors_.size(); ++fi) {
+    (graph[factors_[fi].slot]->parallel_safe() ? any_worker_ : caller_only_)
+        .push_back(static_cast<int>(fi));
+  }
+}
+
+NormalEquations::Workspace& NormalEquations::workspace(int worker) {
+  Workspace& ws = workspaces_[static_cast<size_t>(worker)];
+  if (ws.x_ptrs.size() != static_cast<size_t>(max_keys_)) {  // first use by this worker
+    ws.r.setZero(max_rows_);
+    ws.J.setZero(max_rows_, max_cols_);
+    ws.JtJ.setZero(max_cols_, max_cols_);
+    ws.Jtr.setZero(max_cols_);
+    ws.x_ptrs.resize(max_keys_);
+  }
+  return ws;
+}
+
+template <bool kWithJacobian>
+NormalEquations::Outcome NormalEquations::evaluate(size_t fi, const FactorGraph& graph,
+                                                   const double* base, Workspace& ws,
+                                                   double* jtj, Eigen::Index stride, double* jtr) {
+  const FactorInfo& info = factors_[fi];
+  const Factor& f = *graph[info.slot];
+  const int m = f.residual_dim();
+  const int nk = static_cast<int>(f.keys().size());
+  for (int k = 0; k < nk; ++k) ws.x_ptrs[k] = base + key_value_offset_[info.first_key + k];
+  auto r = ws.r.head(m);
+  r.setZero();
+  Outcome o;
+  if constexpr (!kWithJacobian) {
+    f.whitened(ws.x_ptrs.data(), r, nullptr);
+    if (!r.allFinite()) {
+      o.non_finite = "residual";
+      return o;
+    }
+    o.half_squared = 0.5 * r.squaredNorm();
+    return o;
+  } else {
+    const int nc = f.jacobian_cols();
+    // A linear factor whose Jacobian is unchanged keeps J and JᵀJ: only r and Jᵀr are new.
+    const long version = f.jacobian_version();
+    LinearCache* cache = version >= 0 && info.num_pairs > 0 ? &linear_[fi] : nullptr;
+    const bool kept = cache != nullptr && cache->version == version;
+    Eigen::Ref<Eigen::MatrixXd> J = ws.J.topLeftCorner(m, nc);
+    // A kept linear factor's J must be whole; a factor on no free variable is only summed.
+    RowSupport* support = cache == nullptr && info.num_pairs > 0 ? &ws.support : nullptr;
+    f.whitened(ws.x_ptrs.data(), r, kept ? nullptr : &J, support);
+    if (!r.allFinite()) {
+      o.non_finite = "residual";
+      return o;
+    }
+    // A factor that adds to H learns whether J is finite from the row compaction below.
+    if (!kept && info.num_pairs == 0 && !all_finite(J)) {
+      o.non_finite = "Jacobian";
+      return o;
+    }
+    o.half_squared = 0.5 * r.squaredNorm();
+    if (info.num_pairs == 0) return o;
+    Eigen::Map<Eigen::VectorXd> Jtr(jtr, nc);
+    o.jtr = jtr;
+    if (kept) {
+      Jtr.noalias() = cache->J.transpose() * r;
+      o.jtj = cache->JtJ.data();
+      o.stride = cache->JtJ.outerStride();
+      return o;
+    }
+    if (cache != nullptr) cache->J = J;  // before the compaction reorders its rows
+    bool finite = true;
+    const int active = compact_nonzero_rows(J, r, &finite, support);
+    if (!finite) {
+      o.non_finite = "Jacobian";
+      return o;
+    }
+    if (active == 0) return o;  // e.g. a collision factor with every pair clear
+    const auto Ja = J.topRows(active);
+    Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>> JtJ(jtj, nc, nc,
+                                                             Eigen::OuterStride<>(stride));
+    jacobian_gram(Ja, JtJ, /*upper_only=*/true);  // only upper blocks are scattered
+    Jtr.noalias() = Ja.transpose() * r.head(active);
+    o.jtj = jtj;
+    o.stride = stride;
+    if (cache != nullptr) {
+      cache->JtJ = JtJ;
+      cache->version = version;
+    }
+    return o;
+  }
+}
+
+void NormalEquations::add(size_t fi, const Factor& f, const Outcome& o) {
+  const FactorInfo& info = factors_[fi];
+  const int nk = static_cast<int>(f.keys().size());
+  const auto& offsets = f.block_offsets();
+  const auto& dims = f.dims();
+  for (int k = 0; k < nk; ++k) {
+    const int col = key_col_[info.first_key + k];
+    if (col >= 0) {
+      g_.segment(col, dims[k]) += Eigen::Map<const Eigen::VectorXd>(o.jtr + offsets[k], dims[k]);
+    }
+  }
+  const double* jtj = o.jtj;
+  const Eigen::Index stride = o.stride;
+  double* h = h_.data();
+  for (int p = info.first_pair; p < info.first_pair + info.num_pairs; ++p) {
+    const Pair& pair = pairs_[p];
+    const int ro = offsets[pair.row_key], co = offsets[pair.col_key];
+    const int dr = dims[pair.row_key], dc = dims[pair.col_key];
+    if (ro <= co) {  // the block lies in JᵀJ's upper triangle
+      for (int k = 0; k < dc; ++k) {
+        double* dst = h + col_ptr_[pair.first_col + k] + pair.within;
+        const double* src = jtj + (co + k) * stride + ro;
+        const int rows = pair.diagonal ? k + 1 : dr;
+        for (int i = 0; i < rows; ++i) dst[i] += src[i];
+      }
+    } else {  // below the diagonal of JᵀJ: read the mirrored entries from the upper triangle
+      for (int k = 0; k < dc; ++k) {
+        double* dst = h + col_ptr_[pair.first_col + k] + pair.within;
+        const double* src = jtj + ro * stride + co + k;
+        for (int i = 0; i < dr; ++i) dst[i] += src[i * stride];
+      }
+    }
+  }
+}
+
+template <bool kWithJacobian>
+bool NormalEquations::evaluate_in_parallel(const FactorGraph& graph, const double* base) {
+  if (threads_ <= 1 || any_worker_.size() < kMinParallelFactors ||
+      serial_seconds_ < kMinParallelSeconds) {
+    return false;
+  }
+  if (outcomes_.size() != factors_.size()) {  // first parallel run: room for every JᵀJ and Jᵀr
+    outcomes_.resize(factors_.size());
+    buffer_offset_.resize(factors_.size());
+    size_t size = 0;
+    for (size_t fi = 0; fi < factors_.size(); ++fi) {
+      buffer_offset_[fi] = size;
+      const size_t nc = static_cast<size_t>(graph[factors_[fi].slot]->jacobian_cols());
+      if (factors_[fi].num_pairs > 0) size += nc * nc + nc;
+    }
+    buffer_.assign(size, 0.0);
+  }
+  std::atomic<size_t> next{0};
+  std::atomic<bool> stop{false};
+  const auto one = [&](size_t fi, Workspace& ws) {
+    const Eigen::Index nc = graph[factors_[fi].slot]->jacobian_cols();
+    double* at = buffer_.data() + buffer_offset_[fi];
+    outcomes_[fi] = evaluate<kWithJacobian>(fi, graph, base, ws, at + nc, nc, at);
+  };
+  auto body = [&](int worker) {
+    Workspace& ws = workspace(worker);
+    size_t done = 0;
+    try {
+      if (worker == 0) {
+        for (int fi : caller_only_) {
+          if (++done % kFactorsPerCancellationCheck == 0) throw_if_cancelled();
+          one(static_cast<size_t>(fi), ws);
+        }
+      }
+      const size_t n = any_worker_.size();
+      for (size_t i = next.fetch_add(kChunk); i < n && !stop; i = next.fetch_add(kChunk)) {
+        for (size_t j = i; j < std::min(n, i + kChunk); ++j) {
+          if (worker == 0 && ++done % kFactorsPerCancellationCheck == 0) throw_if_cancelled();
+          one(static_cast<size_t>(any_worker_[j]), ws);
+        }
+      }
+    } catch (...) {
+      stop = true;  // the other workers leave the rest
+      throw;
+    }
+  };
+  const auto t0 = std::chrono::steady_clock::now();
+  const int ran = run_on_workers(threads_, body);
+  serial_seconds_ =
+      ran * std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return true;
 }
 
 template <bool kWithJacobian>
@@ -243,104 +433,36 @@ bool NormalEquations::run(const FactorGraph& graph, const Values& values, double
     g_.setZero();
   }
   const double* base = values.vector().data();
+  const auto t0 = std::chrono::steady_clock::now();
+  const bool parallel = evaluate_in_parallel<kWithJacobian>(graph, base);
+  Workspace& ws = workspace(0);
   double total = 0;
   for (size_t fi = 0; fi < factors_.size(); ++fi) {
-    // A linearization of a long trajectory is most of a solver iteration: a shutdown asked for
-    // meanwhile must not wait for its end.
-    if (fi % kFactorsPerCancellationCheck == kFactorsPerCancellationCheck - 1) {
-      throw_if_cancelled();
-    }
-    const FactorInfo& info = factors_[fi];
-    const Factor& f = *graph[info.slot];
-    const int m = f.residual_dim();
-    const int nk = static_cast<int>(f.keys().size());
-    for (int k = 0; k < nk; ++k) x_ptrs_[k] = base + key_value_offset_[info.first_key + k];
-    auto r = r_.head(m);
-    r.setZero();
-    if constexpr (!kWithJacobian) {
-      f.whitened(x_ptrs_.data(), r, nullptr);
-      if (!r.allFinite()) {
-        if (reason) {
-          *reason = "factor " + std::to_string(info.slot) + " (" + f.name() +
-                    ") has a non-finite residual";
-        }
-        return false;
-      }
-      total += 0.5 * r.squaredNorm();
-      continue;
+    const Factor& f = *graph[factors_[fi].slot];
+    Outcome o;
+    if (parallel) {
+      o = outcomes_[fi];
     } else {
-      const int nc = f.jacobian_cols();
-      // A linear factor whose Jacobian is unchanged keeps J and JᵀJ: only r and Jᵀr are new.
-      const long version = f.jacobian_version();
-      LinearCache* cache = version >= 0 && info.num_pairs > 0 ? &linear_[fi] : nullptr;
-      const bool kept = cache != nullptr && cache->version == version;
-      Eigen::Ref<Eigen::MatrixXd> J = J_.topLeftCorner(m, nc);
-      // A kept linear factor's J must be whole; a factor on no free variable is only summed.
-      RowSupport* support = cache == nullptr && info.num_pairs > 0 ? &support_ : nullptr;
-      f.whitened(x_ptrs_.data(), r, kept ? nullptr : &J, support);
-      const auto non_finite = [&](const char* what) {
-        if (reason) {
-          *reason = "factor " + std::to_string(info.slot) + " (" + f.name() +
-                    ") has a non-finite " + what;
-        }
-        return false;
-      };
-      if (!r.allFinite()) return non_finite("residual");
-      // A factor that adds to H learns whether J is finite from the row compaction below.
-      if (!kept && info.num_pairs == 0 && !all_finite(J)) return non_finite("Jacobian");
-      total += 0.5 * r.squaredNorm();
-      if (info.num_pairs == 0) continue;
-      auto Jtr = Jtr_.head(nc);
-      const double* jtj = nullptr;
-      Eigen::Index stride = 0;
-      if (kept) {
-        Jtr.noalias() = cache->J.transpose() * r;
-        jtj = cache->JtJ.data();
-        stride = cache->JtJ.outerStride();
-      } else {
-        if (cache != nullptr) cache->J = J;  // before the compaction reorders its rows
-        bool finite = true;
-        const int active = compact_nonzero_rows(J, r, &finite, support);
-        if (!finite) return non_finite("Jacobian");
-        if (active == 0) continue;  // e.g. a collision factor with every pair clear
-        const auto Ja = J.topRows(active);
-        auto JtJ = JtJ_.topLeftCorner(nc, nc);
-        jacobian_gram(Ja, JtJ, /*upper_only=*/true);  // only upper blocks are scattered
-        Jtr.noalias() = Ja.transpose() * r.head(active);
-        jtj = JtJ.data();
-        stride = JtJ.outerStride();
-        if (cache != nullptr) {
-          cache->JtJ = JtJ;
-          cache->version = version;
-        }
+      // A linearization of a long trajectory is most of a solver iteration: a shutdown asked
+      // for meanwhile must not wait for its end.
+      if (fi % kFactorsPerCancellationCheck == kFactorsPerCancellationCheck - 1) {
+        throw_if_cancelled();
       }
-      const auto& offsets = f.block_offsets();
-      const auto& dims = f.dims();
-      for (int k = 0; k < nk; ++k) {
-        const int col = key_col_[info.first_key + k];
-        if (col >= 0) g_.segment(col, dims[k]) += Jtr.segment(offsets[k], dims[k]);
-      }
-      double* h = h_.data();
-      for (int p = info.first_pair; p < info.first_pair + info.num_pairs; ++p) {
-        const Pair& pair = pairs_[p];
-        const int ro = offsets[pair.row_key], co = offsets[pair.col_key];
-        const int dr = dims[pair.row_key], dc = dims[pair.col_key];
-        if (ro <= co) {  // the block lies in JᵀJ's upper triangle
-          for (int k = 0; k < dc; ++k) {
-            double* dst = h + col_ptr_[pair.first_col + k] + pair.within;
-            const double* src = jtj + (co + k) * stride + ro;
-            const int rows = pair.diagonal ? k + 1 : dr;
-            for (int i = 0; i < rows; ++i) dst[i] += src[i];
-          }
-        } else {  // below the diagonal of JᵀJ: read the mirrored entries from the upper triangle
-          for (int k = 0; k < dc; ++k) {
-            double* dst = h + col_ptr_[pair.first_col + k] + pair.within;
-            const double* src = jtj + ro * stride + co + k;
-            for (int i = 0; i < dr; ++i) dst[i] += src[i * stride];
-          }
-        }
-      }
+      o = evaluate<kWithJacobian>(fi, graph, base, ws, ws.JtJ.data(), ws.JtJ.outerStride(),
+                                  ws.Jtr.data());
     }
+    if (o.non_finite != nullptr) {
+      if (reason) {
+        *reason = "factor " + std::to_string(factors_[fi].slot) + " (" + f.name() +
+                  ") has a non-finite " + o.non_finite;
+      }
+      return false;
+    }
+    total += o.half_squared;
+    if (o.jtj != nullptr) add(fi, f, o);
+  }
+  if (!parallel) {
+    serial_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
   *error = total;
   return true;

@@ -4,6 +4,7 @@
 // every factor's dense JᵀJ blocks straight into precomputed slots of H: no sparse J is formed and
 // nothing is allocated.
 #include <Eigen/Core>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -19,8 +20,12 @@ class NormalEquations {
  public:
   /// Builds the pattern. Throws std::invalid_argument naming the factor and key if a factor's
   /// key is missing from `values` or has another dimension. Factors whose keys are all fixed
-  /// still contribute to the error.
-  NormalEquations(const FactorGraph& graph, const Values& values, OrderingMethod ordering);
+  /// still contribute to the error. With `threads` > 1 the factors are evaluated on up to that
+  /// many threads (run_on_workers; those not Factor::parallel_safe on the caller's) and added
+  /// into H and g in graph order afterwards, so H, g and the cost are the same to the bit for
+  /// any number of threads.
+  NormalEquations(const FactorGraph& graph, const Values& values, OrderingMethod ordering,
+                  int threads = 1);
 
   /// Whether this structure was built for the graph's and values' current structure.
   bool matches(const FactorGraph& graph, const Values& values) const {
@@ -79,6 +84,21 @@ class NormalEquations {
   };
   struct Incidence;     // the free variables and each factor's keys, while building
   struct BlockPattern;  // per block column: its block rows and their offsets in the column
+  // One worker's scratch, sized for the largest factor.
+  struct Workspace {
+    Eigen::VectorXd r, Jtr;
+    Eigen::MatrixXd J, JtJ;
+    RowSupport support;
+    std::vector<const double*> x_ptrs;
+  };
+  // One factor's evaluation, between computing it and adding it into H and g.
+  struct Outcome {
+    double half_squared = 0;         // ½‖r‖²
+    const char* non_finite = nullptr;  // "residual" or "Jacobian" when one is not finite
+    const double* jtj = nullptr;     // JᵀJ (upper triangle, column-major); null: adds nothing
+    Eigen::Index stride = 0;         // outer stride of jtj
+    const double* jtr = nullptr;     // Jᵀr
+  };
 
   // Construction, in the constructor's order.
   static Incidence incidence(const FactorGraph& graph, const Values& values);
@@ -92,12 +112,22 @@ class NormalEquations {
   std::vector<int> place_keys(const std::vector<int>& slots, const Values& values,
                               const Incidence& inc, const std::vector<int>& pos_of_natural);
   void add_pairs(const std::vector<int>& pos, const BlockPattern& pattern, FactorInfo& info);
-  void size_workspaces(const Incidence& inc);
+  void size_workspaces(const FactorGraph& graph, const Incidence& inc);
 
-  // Evaluation of every factor: one loop, kept whole so that the compiler keeps the
-  // per-factor work inline (this is the solvers' hot path).
+  // Evaluation of every factor, on one thread or on several (this is the solvers' hot path).
   template <bool kWithJacobian>
   bool run(const FactorGraph& graph, const Values& values, double* error, std::string* reason);
+  // Factor fi (index into factors_) at x = base: r, and with kWithJacobian JᵀJ and Jᵀr written
+  // to jtj (outer stride `stride`) and jtr unless a kept linear factor's own serve.
+  template <bool kWithJacobian>
+  Outcome evaluate(size_t fi, const FactorGraph& graph, const double* base, Workspace& ws,
+                   double* jtj, Eigen::Index stride, double* jtr);
+  // Adds factor fi's evaluation into H and g.
+  void add(size_t fi, const Factor& f, const Outcome& o);
+  // The parallel evaluation into outcomes_ (and buffer_); false when nothing is to be run so.
+  template <bool kWithJacobian>
+  bool evaluate_in_parallel(const FactorGraph& graph, const double* base);
+  Workspace& workspace(int worker);
 
   uint64_t graph_id_ = 0;
   uint64_t layout_id_ = 0;
@@ -114,12 +144,19 @@ class NormalEquations {
   std::vector<int> key_col_;           // per factor key: first column of H, −1 if fixed
   std::vector<Pair> pairs_;
   std::vector<LinearCache> linear_;  // one per entry of factors_
-  // Workspaces sized for the largest factor.
-  Eigen::VectorXd r_;
-  Eigen::MatrixXd J_, JtJ_;
-  Eigen::VectorXd Jtr_;
-  RowSupport support_;
-  std::vector<const double*> x_ptrs_;
+  // Threads: each worker's workspace (made by the worker on first use), the factors that may
+  // run on any worker and those that run on the caller's, and per factor its last evaluation
+  // and the place of its JᵀJ and Jᵀr in buffer_.
+  int threads_ = 1;
+  int max_rows_ = 0, max_cols_ = 0, max_keys_ = 0;
+  std::vector<Workspace> workspaces_;
+  std::vector<int> any_worker_, caller_only_;
+  std::vector<Outcome> outcomes_;
+  std::vector<size_t> buffer_offset_;
+  std::vector<double> buffer_;
+  // One thread's time for the last evaluation (estimated when parallel): whether the next is
+  // worth sharing out. The first is shared out when the graph has enough factors to share.
+  double serial_seconds_ = std::numeric_limits<double>::infinity();
 };
 
 }  // namespace kinograph::graph

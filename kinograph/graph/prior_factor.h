@@ -14,6 +14,7 @@ class PriorFactor final : public Factor {
 
   void evaluate(const FactorValues& x, Eigen::Ref<Eigen::VectorXd> e,
                 const Jacobians* J) const override;
+  bool parallel_safe() const override { return true; }  // touches only its own state
 
   const Eigen::VectorXd& target() const { return target_; }
   /// Throws std::invalid_argument if the size differs.

@@ -242,7 +242,7 @@ TEST(DfgBuilder, ConstraintStepMatchesCondensedRows) {
       }
     }
     // Same rows and values as the condensed factor at the same state.
-    auto workspace = std::make_shared<dynamics::Data>(*model);
+    auto workspace = std::make_shared<DynamicsWorkspace>(model);
     const DynamicsStepFactor condensed(4, model, workspace, rows);
     Eigen::VectorXd z_dfg, z_condensed;
     s.factors.back()->values_at(values, z_dfg);
@@ -297,10 +297,10 @@ TEST(DfgBuilder, ConstrainedSingleStepAgreesWithCondensed) {
     values.set_fixed(options.keys.qd_key(0));
     graph.emplace<graph::PriorFactor>(options.keys.qdd_key(0), target);
     std::vector<std::shared_ptr<ConstrainedFactor>> constraints;
-    auto workspace = std::make_shared<dynamics::Data>(*model);
+    auto workspace = std::make_shared<DynamicsWorkspace>(model);
     if (dfg) {
       constraints =
-          add_dfg_constraints(graph, values, *model, *workspace, 0, rows, options).factors;
+          add_dfg_constraints(graph, values, *model, workspace->local(), 0, rows, options).factors;
     } else {
       auto f = std::make_shared<DynamicsStepFactor>(0, model, workspace, rows);
       graph.add(f);

@@ -258,7 +258,7 @@ TEST(DynamicsStepFactor, JacobiansOnIiwaWithPayloadAndAcrobot) {
     DynamicsStepOptions o;
     o.min_torque = 0.3;
     o.torque_scale = 2.0;
-    auto ws = std::make_shared<dynamics::Data>(*model);
+    auto ws = std::make_shared<DynamicsWorkspace>(model);
     DynamicsStepFactor f(0, model, ws, o);
     bind(f, 5);
     auto c = check_jacobians(f, v, {1e-6, 1e-5, false});
@@ -276,7 +276,7 @@ TEST(DynamicsStepFactor, JacobiansOnIiwaWithPayloadAndAcrobot) {
 TEST(PoseFactor, Jacobians) {
   std::mt19937 rng(4);
   auto model = load("robots/iiwa14/iiwa14.urdf");
-  auto ws = std::make_shared<dynamics::Data>(*model);
+  auto ws = std::make_shared<DynamicsWorkspace>(model);
   graph::Values v = random_states(7, 0, rng);
   Eigen::Isometry3d target = Eigen::Isometry3d::Identity();
   target.linear() = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).matrix();

@@ -191,7 +191,7 @@ TEST(DynamicsStepOptions, MinTorqueAddsSoftRows) {
   const auto model = testing::load_robot("robots/rr/rr.urdf");
   DynamicsStepOptions o;
   o.min_torque = 0.5;
-  auto ws = std::make_shared<dynamics::Data>(*model);
+  auto ws = std::make_shared<DynamicsWorkspace>(model);
   const DynamicsStepFactor f(0, model, ws, o);
   ASSERT_EQ(f.rows().size(), 4u);  // two effort bounds, two soft rows
   EXPECT_EQ(f.rows()[2].kind, RowKind::kSoft);
@@ -203,7 +203,7 @@ TEST(DynamicsStepOptions, TorqueScale) {
   const auto model = testing::load_robot("robots/rr/rr.urdf");
   DynamicsStepOptions o;
   o.torque_scale = 2.5;
-  auto ws = std::make_shared<dynamics::Data>(*model);
+  auto ws = std::make_shared<DynamicsWorkspace>(model);
   const DynamicsStepFactor f(0, model, ws, o);
   for (const RowSpec& r : f.rows()) EXPECT_EQ(r.scale, 2.5);
   // The violation of a row is measured in units of the scale.

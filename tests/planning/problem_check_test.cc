@@ -230,7 +230,7 @@ TEST(ViolationText, CollisionRowNamesLinkAndObstacle) {
 // row 0 of the condensed factor and of the DFG's torque rows.
 TEST(ViolationText, TorqueRowsOfBothFormulationsNameTheJoint) {
   Problem p = testing::acrobot_swingup();
-  const auto workspace = std::make_shared<dynamics::Data>(*p.model);
+  const auto workspace = std::make_shared<DynamicsWorkspace>(p.model);
   const FactorKey key{FactorRole::kDynamics, 55, 0, -1};
   const FactorEntry condensed = make_entry(
       std::make_shared<DynamicsStepFactor>(55, p.model, workspace, DynamicsStepOptions{}), key);

@@ -2,6 +2,7 @@
 
 #include <limits>
 #include <stdexcept>
+#include <utility>
 
 #include "kinograph/dynamics/kinematics.h"
 #include "kinograph/planning/clearance_world.h"
@@ -10,31 +11,46 @@
 
 namespace kinograph::planning {
 
-CollisionContext::CollisionContext(std::shared_ptr<const dynamics::Model> m,
-                                   const std::vector<collision::Obstacle>& obstacles,
-                                   double query_dist, const SelfPairs* self, bool cull)
-    : model(std::move(m)),
-      world(*model,
-            [&] {
-              collision::CollisionWorldOptions o;
-              o.query_distance = query_dist;
-              o.cull = cull;
-              if (self != nullptr) {
-                o.self_collision = true;
-                o.self_collision_excluded = self->allowed;
-              }
-              return o;
-            }()),
-      data(*model),
-      gradient_workspace(*model),
-      gradient(model->nq()),
-      q(model->nq()),
-      query_distance(query_dist) {
-  for (const collision::Obstacle& o : obstacles) {
-    const collision::Status s = world.add_obstacle(o);
-    if (!s.ok) throw std::invalid_argument("obstacle " + std::to_string(o.id) + ": " + s.reason);
-    obstacle_ids.push_back(o.id);
+namespace {
+collision::CollisionWorldOptions world_options_of(double query_distance, const SelfPairs* self,
+                                                  bool cull) {
+  collision::CollisionWorldOptions o;
+  o.query_distance = query_distance;
+  o.cull = cull;
+  if (self != nullptr) {
+    o.self_collision = true;
+    o.self_collision_excluded = self->allowed;
   }
+  return o;
+}
+}  // namespace
+
+CollisionScratch::CollisionScratch(const dynamics::Model& model,
+                                   const collision::CollisionWorldOptions& options)
+    : world(model, options),
+      data(model),
+      gradient_workspace(model),
+      gradient(model.nq()),
+      q(model.nq()) {}
+
+CollisionContext::CollisionContext(std::shared_ptr<const dynamics::Model> m,
+                                   const std::vector<collision::Obstacle>& obs, double query_dist,
+                                   const SelfPairs* self, bool cull)
+    : model(std::move(m)),
+      world_options(world_options_of(query_dist, self, cull)),
+      obstacles(obs),
+      scratch([this] {
+        auto s = std::make_unique<CollisionScratch>(*model, world_options);
+        for (const collision::Obstacle& o : obstacles) {
+          const collision::Status status = s->world.add_obstacle(o);
+          if (!status.ok) {
+            throw std::invalid_argument("obstacle " + std::to_string(o.id) + ": " + status.reason);
+          }
+        }
+        return s;
+      }),
+      query_distance(query_dist) {
+  for (const collision::Obstacle& o : obstacles) obstacle_ids.push_back(o.id);
   row_of.assign(model->collision.size(), std::vector<int>(obstacle_ids.size(), -1));
   for (size_t g = 0; g < model->collision.size(); ++g) {
     if (model->collision[g].body < 0) continue;
@@ -45,9 +61,24 @@ CollisionContext::CollisionContext(std::shared_ptr<const dynamics::Model> m,
   self_row_of.assign(model->collision.size(), std::vector<int>(model->collision.size(), -1));
   if (self != nullptr) {
     self_epsilon = self->epsilon;
-    for (const auto& [a, b] : world.self_pairs())
+    for (const auto& [a, b] : scratch.local().world.self_pairs())
       self_row_of[a][b] = self_row_of[b][a] = num_pairs++;
   }
+}
+
+collision::Status CollisionContext::move_obstacle(int id, const Eigen::Isometry3d& pose) {
+  collision::Status status = collision::Status::success();  // the caller's world always exists
+  scratch.for_each([&](CollisionScratch& s) {
+    collision::Status moved = s.world.move_obstacle(id, pose);
+    if (!moved.ok) status = std::move(moved);
+  });
+  if (!status.ok) return status;
+  for (collision::Obstacle& o : obstacles) {
+    if (o.id != id) continue;
+    o.pose = pose;
+    o.trajectory = {};
+  }
+  return status;
 }
 
 int CollisionContext::row(const collision::Proximity& p) const {
@@ -96,8 +127,9 @@ CollisionFactor::CollisionFactor(int k, double s, double dt, double epsilon, dou
 
 void CollisionFactor::compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
                               const graph::Jacobians* J) const {
-  CollisionContext& c = *ctx_;
-  const dynamics::Model& model = *c.model;
+  const CollisionContext& ctx = *ctx_;
+  CollisionScratch& c = ctx_->scratch.local();
+  const dynamics::Model& model = *ctx.model;
   Eigen::VectorXd& q = c.q;
   if (s_ == 0) {
     q = x[0];
@@ -105,9 +137,9 @@ void CollisionFactor::compute(const graph::FactorValues& x, Eigen::Ref<Eigen::Ve
     q = h_[0] * x[0] + h_[1] * dt_ * x[1] + h_[2] * x[2] + h_[3] * dt_ * x[3];
   }
   dynamics::forward_kinematics(model, c.data, q);
-  z.setConstant(c.query_distance);
+  z.setConstant(ctx.query_distance);
   for (const collision::Proximity& p : c.world.query(c.data, t_)) {
-    const int row = c.row(p);
+    const int row = ctx.row(p);
     if (row < 0) continue;
     z[row] = p.distance;
     if (J == nullptr) continue;

@@ -11,6 +11,7 @@
 #include "kinograph/collision/distance_gradient.h"
 #include "kinograph/dynamics/data.h"
 #include "kinograph/dynamics/model.h"
+#include "kinograph/graph/worker_local.h"
 #include "kinograph/planning/factors/constrained_factor.h"
 
 namespace kinograph::planning {
@@ -21,23 +22,38 @@ struct SelfPairs {
   double epsilon = 0.01;                     ///< m, the hinge's safety distance of these rows
 };
 
-/// The collision scene shared by all collision factors of one graph (single-threaded use):
-/// Bullet world with the problem's obstacles (and, with `self`, the robot's own pairs), a
-/// kinematics workspace, and the row of each (robot geometry, obstacle) pair, then of each
-/// self pair.
+/// What one worker evaluates collision rows with: its own Bullet world (queries write the
+/// world's caches) and kinematics workspace.
+struct CollisionScratch {
+  CollisionScratch(const dynamics::Model& model, const collision::CollisionWorldOptions& options);
+  collision::CollisionWorld world;
+  dynamics::Data data;
+  collision::DistanceGradientWorkspace gradient_workspace;
+  Eigen::VectorXd gradient;
+  Eigen::VectorXd q;  ///< the interpolated configuration
+};
+
+/// The collision scene shared by all collision factors of one graph: the problem's obstacles
+/// (and, with `self`, the robot's own pairs), the row of each (robot geometry, obstacle) pair,
+/// then of each self pair, and a CollisionScratch per worker so that the factors may be
+/// evaluated on several threads.
 struct CollisionContext {
   /// Builds the world; throws std::invalid_argument if an obstacle id repeats or a shape is bad.
   /// `cull` false runs GJK on every pair: the reference the culled world must match exactly.
   CollisionContext(std::shared_ptr<const dynamics::Model> model,
                    const std::vector<collision::Obstacle>& obstacles, double query_distance,
                    const SelfPairs* self = nullptr, bool cull = true);
+  CollisionContext(const CollisionContext&) = delete;
+  CollisionContext& operator=(const CollisionContext&) = delete;
+
+  /// Sets obstacle `id`'s fixed pose in every worker's world; fails for an unknown id. Not
+  /// while the context's factors are being evaluated.
+  collision::Status move_obstacle(int id, const Eigen::Isometry3d& pose);
 
   std::shared_ptr<const dynamics::Model> model;
-  collision::CollisionWorld world;
-  dynamics::Data data;
-  collision::DistanceGradientWorkspace gradient_workspace;
-  Eigen::VectorXd gradient;
-  Eigen::VectorXd q;                     ///< the interpolated configuration
+  collision::CollisionWorldOptions world_options;
+  std::vector<collision::Obstacle> obstacles;  ///< as now placed; each new world is built of them
+  graph::WorkerLocal<CollisionScratch> scratch;
   std::vector<int> obstacle_ids;         ///< obstacle of each column of row_of
   std::vector<int> geoms;                ///< robot geometries that take part
   std::vector<std::vector<int>> row_of;  ///< [robot geometry][obstacle slot] → row, −1 if none
@@ -63,6 +79,7 @@ class CollisionFactor final : public ConstrainedFactor {
   void compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
                const graph::Jacobians* J) const override;
   std::string describe_row(int row, double z, const RowContext& c) const override;
+  bool parallel_safe() const override { return true; }  // a world per worker
   /// The time (s) of the state the rows are checked at.
   double time() const { return t_; }
   /// The collision scene, whose row_of names each row's (geometry, obstacle) pair.

@@ -52,6 +52,7 @@ class DfgTwistFactor final : public graph::Factor {
 
   void evaluate(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> e,
                 const graph::Jacobians* J) const override;
+  bool parallel_safe() const override { return true; }  // touches only its own state
 
  private:
   DfgTwistFactor(detail::DfgLayout&& layout, const dynamics::Model& model, int body,
@@ -75,6 +76,7 @@ class DfgAccelFactor final : public graph::Factor {
 
   void evaluate(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> e,
                 const graph::Jacobians* J) const override;
+  bool parallel_safe() const override { return true; }  // touches only its own state
 
  private:
   DfgAccelFactor(detail::DfgLayout&& layout, const dynamics::Model& model, int body,
@@ -110,6 +112,7 @@ class DfgWrenchFactor final : public graph::Factor {
 
   void evaluate(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> e,
                 const graph::Jacobians* J) const override;
+  bool parallel_safe() const override { return true; }  // touches only its own state
 
   /// The external wrench F_ext,i; may change between solves (structure unchanged).
   const dynamics::Vector6& external() const { return external_; }
@@ -141,6 +144,7 @@ class DfgTorqueFactor final : public graph::Factor {
 
   void evaluate(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> e,
                 const graph::Jacobians* J) const override;
+  bool parallel_safe() const override { return true; }  // touches only its own state
 
  private:
   DfgTorqueFactor(detail::DfgLayout&& layout, const dynamics::Model& model, int body,

@@ -46,7 +46,7 @@ std::vector<RowSpec> DynamicsStepFactor::rows_for(const dynamics::Model& model,
 }
 
 DynamicsStepFactor::DynamicsStepFactor(int k, std::shared_ptr<const dynamics::Model> model,
-                                       std::shared_ptr<dynamics::Data> workspace,
+                                       std::shared_ptr<DynamicsWorkspace> workspace,
                                        const DynamicsStepOptions& options)
     : ConstrainedFactor({q_key(k), v_key(k), a_key(k)}, {model->nq(), model->nq(), model->nq()},
                         rows_for(*model, options)),
@@ -58,7 +58,7 @@ DynamicsStepFactor::DynamicsStepFactor(int k, std::shared_ptr<const dynamics::Mo
 
 void DynamicsStepFactor::compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
                                  const graph::Jacobians* J) const {
-  dynamics::Data& d = *data_;
+  dynamics::Data& d = data_->local();
   if (J == nullptr) {
     dynamics::rnea(*model_, d, x[0], x[1], x[2]);
   } else {

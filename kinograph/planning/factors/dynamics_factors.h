@@ -8,6 +8,7 @@
 #include "kinograph/dynamics/data.h"
 #include "kinograph/dynamics/model.h"
 #include "kinograph/planning/factors/constrained_factor.h"
+#include "kinograph/planning/factors/dynamics_workspace.h"
 
 namespace kinograph::planning {
 
@@ -21,15 +22,16 @@ struct DynamicsStepOptions {
 /// Per-state dynamics of an n-joint arm with keys q_k, q̇_k, q̈_k. Rows: for each unactuated
 /// joint an equality τ_j = 0, for each actuated joint with a finite effort limit a bound
 /// |τ_j| ≤ effort − ε; then, if min_torque > 0, n soft rows √(2w)·τ_j. Jacobians from
-/// dynamics::rnea_derivatives. Shares one Data workspace with its siblings (single-threaded).
+/// dynamics::rnea_derivatives. Shares a DynamicsWorkspace with its siblings.
 class DynamicsStepFactor final : public ConstrainedFactor {
  public:
   /// Throws std::invalid_argument if the step would have no rows.
   DynamicsStepFactor(int k, std::shared_ptr<const dynamics::Model> model,
-                     std::shared_ptr<dynamics::Data> workspace, const DynamicsStepOptions& options);
+                     std::shared_ptr<DynamicsWorkspace> workspace, const DynamicsStepOptions& options);
   void compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
                const graph::Jacobians* J) const override;
   std::string describe_row(int row, double z, const RowContext& c) const override;
+  bool parallel_safe() const override { return true; }
 
   /// Rows this factor would have for `model` (also used to tell whether it is needed).
   static std::vector<RowSpec> rows_for(const dynamics::Model& model,
@@ -40,7 +42,7 @@ class DynamicsStepFactor final : public ConstrainedFactor {
 
  private:
   std::shared_ptr<const dynamics::Model> model_;
-  std::shared_ptr<dynamics::Data> data_;
+  std::shared_ptr<DynamicsWorkspace> data_;
   std::vector<int> joint_of_row_;
 };
 

@@ -38,6 +38,7 @@ class IntervalDynamicsFactor final : public ConstrainedFactor {
                          const IntervalDynamicsOptions& options);
   void compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
                const graph::Jacobians* J) const override;
+  bool parallel_safe() const override { return true; }  // touches only its own state
   /// A defect row as the unactuated joint missing the next knot (joint, times, amount); a limit
   /// row as the joint's q, q̇ or τ against its limit at the interior point's own time.
   std::string describe_row(int row, double z, const RowContext& c) const override;

@@ -23,7 +23,7 @@ Eigen::Vector3d vee_skew_part(const Eigen::Matrix3d& M) {
 }  // namespace
 
 PoseFactor::PoseFactor(int k, std::shared_ptr<const dynamics::Model> model,
-                       std::shared_ptr<dynamics::Data> workspace, const std::string& frame,
+                       std::shared_ptr<DynamicsWorkspace> workspace, const std::string& frame,
                        const Eigen::Isometry3d& target, PoseParts parts, double scale)
     : ConstrainedFactor({q_key(k)}, {model->nq()}, pose_rows(parts, scale)),
       model_(std::move(model)),
@@ -38,7 +38,7 @@ PoseFactor::PoseFactor(int k, std::shared_ptr<const dynamics::Model> model,
 
 void PoseFactor::compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
                          const graph::Jacobians* J) const {
-  dynamics::Data& d = *data_;
+  dynamics::Data& d = data_->local();
   dynamics::forward_kinematics(*model_, d, x[0]);
   const Eigen::Isometry3d T = dynamics::frame_pose(*model_, d, frame_);
   const Eigen::Matrix3d Rt = target_.linear().transpose();

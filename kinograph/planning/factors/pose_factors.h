@@ -7,6 +7,7 @@
 #include "kinograph/dynamics/data.h"
 #include "kinograph/dynamics/model.h"
 #include "kinograph/planning/factors/constrained_factor.h"
+#include "kinograph/planning/factors/dynamics_workspace.h"
 
 namespace kinograph::planning {
 
@@ -20,10 +21,11 @@ class PoseFactor final : public ConstrainedFactor {
  public:
   /// Throws std::out_of_range for an unknown frame.
   PoseFactor(int k, std::shared_ptr<const dynamics::Model> model,
-             std::shared_ptr<dynamics::Data> workspace, const std::string& frame,
+             std::shared_ptr<DynamicsWorkspace> workspace, const std::string& frame,
              const Eigen::Isometry3d& target, PoseParts parts, double scale);
   void compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
                const graph::Jacobians* J) const override;
+  bool parallel_safe() const override { return true; }  // touches only its own state
   std::string describe_row(int row, double z, const RowContext& c) const override;
   /// The frame's name in the model.
   const std::string& frame_name() const { return model_->frames[frame_].name; }
@@ -32,7 +34,7 @@ class PoseFactor final : public ConstrainedFactor {
 
  private:
   std::shared_ptr<const dynamics::Model> model_;
-  std::shared_ptr<dynamics::Data> data_;
+  std::shared_ptr<DynamicsWorkspace> data_;
   int frame_;
   int body_;
   Eigen::Isometry3d target_;

@@ -26,6 +26,7 @@ class StateTargetFactor final : public ConstrainedFactor {
                                                  const Eigen::VectorXd& target, double weight);
   void compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
                const graph::Jacobians* J) const override;
+  bool parallel_safe() const override { return true; }  // touches only its own state
   std::string describe_row(int row, double z, const RowContext& c) const override;
   /// The stacked target (the rows' `lower`).
   Eigen::VectorXd target() const;

@@ -30,6 +30,7 @@ class GpPriorFactor final : public graph::Factor {
   GpPriorFactor(int k, int n, double dt, double qc);
   void evaluate(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> e,
                 const graph::Jacobians* J) const override;
+  bool parallel_safe() const override { return true; }  // touches only its own state
 
  private:
   int n_;
@@ -49,6 +50,7 @@ class CollocationFactor final : public ConstrainedFactor {
   CollocationFactor(int k, int n, double dt, double scale = 1.0, std::vector<int> joints = {});
   void compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
                const graph::Jacobians* J) const override;
+  bool parallel_safe() const override { return true; }  // touches only its own state
   std::string describe_row(int row, double z, const RowContext& c) const override;
 
  private:
@@ -71,6 +73,7 @@ class StateLimitFactor final : public ConstrainedFactor {
   StateLimitFactor(int k, int n, std::vector<Limit> limits, double scale = 1.0);
   void compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
                const graph::Jacobians* J) const override;
+  bool parallel_safe() const override { return true; }  // touches only its own state
   std::string describe_row(int row, double z, const RowContext& c) const override;
   /// What each row limits, in row order.
   const std::vector<Limit>& limits() const { return limits_; }

@@ -253,12 +253,12 @@ std::vector<DfgConstraintStep> use_dfg_dynamics(PlanningGraph& pg, const Problem
   rows.min_torque = problem.objectives.min_torque;
   rows.torque_scale = graph_options.torque_scale;
   if (!pg.dynamics_workspace) {
-    pg.dynamics_workspace = std::make_shared<dynamics::Data>(*problem.model);
+    pg.dynamics_workspace = std::make_shared<DynamicsWorkspace>(problem.model);
   }
   std::vector<DfgConstraintStep> out;
   graph::FactorGraph scratch;  // add_dfg_constraints' indices are not needed here
   for (int k : steps) {
-    out.push_back(add_dfg_constraints(scratch, pg.values, *problem.model, *pg.dynamics_workspace,
+    out.push_back(add_dfg_constraints(scratch, pg.values, *problem.model, pg.dynamics_workspace->local(),
                                       k, rows, options));
     DfgConstraintStep& step = out.back();
     step.indices.clear();

@@ -112,6 +112,7 @@ class DfgConstraintFactor final : public ConstrainedFactor {
   void compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
                const graph::Jacobians* J) const override;
   std::string name() const override;
+  bool parallel_safe() const override { return equation_->parallel_safe(); }
   const graph::FactorPtr& equation() const { return equation_; }
 
  private:
@@ -129,6 +130,7 @@ class DfgTorqueRowsFactor final : public ConstrainedFactor {
                       const DfgKeys& keys = {});
   void compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
                const graph::Jacobians* J) const override;
+  bool parallel_safe() const override { return true; }  // touches only its own state
   std::string describe_row(int row, double z, const RowContext& c) const override;
 
  private:

@@ -39,7 +39,7 @@ std::vector<StateLimitFactor::Limit> joint_limits(const dynamics::Model& model, 
 
 // Limits and condensed dynamics of states first..N, state by state.
 std::vector<FactorEntry> state_entries(const Problem& problem,
-                                       const std::shared_ptr<dynamics::Data>& workspace,
+                                       const std::shared_ptr<DynamicsWorkspace>& workspace,
                                        const GraphOptions& options, int first) {
   std::vector<FactorEntry> out;
   const auto& model = problem.model;
@@ -66,7 +66,7 @@ std::vector<FactorEntry> state_entries(const Problem& problem,
 
 // Task constraints on the free states from `first` on, task by task.
 std::vector<FactorEntry> task_entries(const Problem& problem,
-                                      const std::shared_ptr<dynamics::Data>& workspace,
+                                      const std::shared_ptr<DynamicsWorkspace>& workspace,
                                       const GraphOptions& options, int first) {
   std::vector<FactorEntry> out;
   for (size_t t = 0; t < problem.task_constraints.size(); ++t) {
@@ -250,7 +250,7 @@ std::vector<FactorEntry> self_collision_entries(const Problem& problem,
 }
 
 std::vector<FactorEntry> tail_entries(
-    const Problem& problem, int first, const std::shared_ptr<dynamics::Data>& workspace,
+    const Problem& problem, int first, const std::shared_ptr<DynamicsWorkspace>& workspace,
     const std::map<int, std::shared_ptr<CollisionContext>>& obstacles,
     const GraphOptions& options) {
   if (first < 1 || first > problem.steps) {
@@ -286,7 +286,7 @@ FactorEntry start_entry(const Problem& problem) {
   return e;
 }
 
-FactorEntry goal_entry(const Problem& problem, const std::shared_ptr<dynamics::Data>& workspace,
+FactorEntry goal_entry(const Problem& problem, const std::shared_ptr<DynamicsWorkspace>& workspace,
                        const GraphOptions& options) {
   const int N = problem.steps;
   if (problem.goal.kind == Goal::Kind::kJoint) {
@@ -316,7 +316,7 @@ PlanningGraph build_graph(const Problem& problem, const Trajectory& init,
   pg.form = form;
   pg.steps = N;
   pg.nq = n;
-  pg.dynamics_workspace = std::make_shared<dynamics::Data>(*problem.model);
+  pg.dynamics_workspace = std::make_shared<DynamicsWorkspace>(problem.model);
   pg.values = initial_values(problem, init);
   const bool pose_goal = problem.goal.kind == Goal::Kind::kPose;
   const bool with_collision = !problem.obstacles.empty() && !problem.model->collision.empty();

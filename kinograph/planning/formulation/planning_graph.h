@@ -11,6 +11,7 @@
 #include "kinograph/graph/values.h"
 #include "kinograph/planning/factors/collision_factors.h"
 #include "kinograph/planning/factors/constrained_factor.h"
+#include "kinograph/planning/factors/dynamics_workspace.h"
 #include "kinograph/planning/formulation/initialization.h"
 #include "kinograph/planning/interpolant.h"
 #include "kinograph/planning/plan.h"
@@ -112,7 +113,7 @@ struct PlanningGraph {
   std::vector<FactorEntry> entries;
   graph::FactorGraph graph;  ///< every non-anchor entry, at its slot
   graph::Values values;
-  std::shared_ptr<dynamics::Data> dynamics_workspace;
+  std::shared_ptr<DynamicsWorkspace> dynamics_workspace;
   /// Collision worlds by obstacle id; the batch form's one world of all obstacles is under −1.
   std::map<int, std::shared_ptr<CollisionContext>> collision;
   GraphForm form = GraphForm::kBatch;
@@ -159,7 +160,7 @@ std::vector<FactorEntry> self_collision_entries(const Problem& problem,
 /// or the goal. What a trajectory needs for the states it gains at its end.
 /// Throws std::invalid_argument for `first` outside 1..steps.
 std::vector<FactorEntry> tail_entries(
-    const Problem& problem, int first, const std::shared_ptr<dynamics::Data>& workspace,
+    const Problem& problem, int first, const std::shared_ptr<DynamicsWorkspace>& workspace,
     const std::map<int, std::shared_ptr<CollisionContext>>& obstacles,
     const GraphOptions& options);
 /// A collision world of `obstacles` with the problem's query distance.
@@ -169,7 +170,7 @@ std::shared_ptr<CollisionContext> collision_context(
 /// The start prior (incremental form): a stiff soft term on (q_0, q̇_0).
 FactorEntry start_entry(const Problem& problem);
 /// The goal: equality rows on q_N (joint goal, an anchor) or the pose goal's factor.
-FactorEntry goal_entry(const Problem& problem, const std::shared_ptr<dynamics::Data>& workspace,
+FactorEntry goal_entry(const Problem& problem, const std::shared_ptr<DynamicsWorkspace>& workspace,
                        const GraphOptions& options);
 
 /// The soft part of the cost (constraint rows left out) and, with `violation`, the largest

@@ -516,7 +516,7 @@ void IncrementalPlanner::replace_factors(const ProblemChange& change, const Prob
     if (old != problem_.obstacles.end() && t.contexts.count(o.id) > 0 &&
         collision::same_shape(old->shape, o.shape) && !o.is_moving() && !old->is_moving()) {
       ctx = t.contexts[o.id];
-      if (ctx && !ctx->world.move_obstacle(o.id, o.pose).ok) ctx = nullptr;
+      if (ctx && !ctx->move_obstacle(o.id, o.pose).ok) ctx = nullptr;
     }
     if (next.model->collision.empty()) continue;
     if (!ctx) ctx = collision_context(next, {o}, go);

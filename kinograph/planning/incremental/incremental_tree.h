@@ -22,7 +22,7 @@ struct IncrementalTree {
   std::unique_ptr<graph::ISAM2> isam;
   std::vector<FactorEntry> entries;  ///< live factors
   std::map<int, std::shared_ptr<CollisionContext>> contexts;  ///< collision world per obstacle
-  std::shared_ptr<dynamics::Data> workspace;
+  std::shared_ptr<DynamicsWorkspace> workspace;
   ConstraintState constraints;
   double last_violation = -1;  ///< worst scaled violation at the last multiplier round
 
