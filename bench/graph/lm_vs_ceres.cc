@@ -117,6 +117,7 @@ int main(int argc, char** argv) {
   }
   std::vector<Row> rows;
   LevenbergMarquardtOptions defaults;  // the paper's: λ₀ 0.01, 200 iterations, 1e-5
+  defaults.threads = 1;                 // as Ceres: one thread each
   rows.push_back(run("curve_fit", problems::curve_fit(), reps, defaults, "auto"));
   const auto chain = problems::chain(chain_n);
   rows.push_back(run("chain", chain, reps, defaults, "auto"));
@@ -126,6 +127,7 @@ int main(int argc, char** argv) {
     for (auto f : {Factorization::kAuto, Factorization::kSimplicial, Factorization::kSupernodal}) {
       LevenbergMarquardtOptions o;
       o.factorization = f;
+      o.threads = 1;
       rows.push_back(run(name, plan, reps, o, to_string(f)));
     }
   }

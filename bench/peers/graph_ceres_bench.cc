@@ -80,6 +80,7 @@ std::vector<Inner> solve_rounds(const planning::Problem& problem, int rounds, do
   graph::LevenbergMarquardtOptions options;
   options.record_history = true;
   options.relative_error_tol = tolerance;
+  options.threads = 1;  // as Ceres: one thread each
   const planning::OuterLoopOptions loop;
   std::vector<Inner> out;
   for (int r = 0; r < rounds; ++r) {
