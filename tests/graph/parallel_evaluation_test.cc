@@ -91,6 +91,16 @@ Chain chain(int n, Seen& seen, bool rendezvous) {
 
 bool two_cores() { return std::thread::hardware_concurrency() >= 2; }
 
+// Two LM iterations on a chain of 100 with `threads`.
+void solve_chain(int threads, Seen& seen, bool rendezvous) {
+  Chain c = chain(100, seen, rendezvous);
+  LevenbergMarquardtOptions o;
+  o.threads = threads;
+  o.max_iterations = 2;
+  Values v = c.values;
+  LevenbergMarquardt(o).optimize(c.graph, v);
+}
+
 TEST(ParallelEvaluation, SameNormalEquationsToTheBitOnAnyNumberOfThreads) {
   Seen seen;
   Chain c = chain(200, seen, false);
@@ -124,12 +134,7 @@ TEST(ParallelEvaluation, SameNormalEquationsToTheBitOnAnyNumberOfThreads) {
 TEST(ParallelEvaluation, TwoThreadsShareTheWorkAndCallerOnlyFactorsStayOnTheCaller) {
   if (!two_cores()) GTEST_SKIP() << "one core: the pool has no thread";
   Seen seen;
-  Chain c = chain(100, seen, true);
-  LevenbergMarquardtOptions o;
-  o.threads = 2;
-  o.max_iterations = 2;
-  Values v = c.values;
-  LevenbergMarquardt(o).optimize(c.graph, v);
+  solve_chain(2, seen, true);
   EXPECT_FALSE(seen.waited_out);       // the rendezvous was met by two threads at once
   EXPECT_EQ(seen.threads.size(), 2u);
   ASSERT_EQ(seen.caller_only_threads.size(), 1u);
@@ -138,12 +143,7 @@ TEST(ParallelEvaluation, TwoThreadsShareTheWorkAndCallerOnlyFactorsStayOnTheCall
 
 TEST(ParallelEvaluation, OneThreadKeepsEverythingOnTheCaller) {
   Seen seen;
-  Chain c = chain(100, seen, false);
-  LevenbergMarquardtOptions o;
-  o.threads = 1;
-  o.max_iterations = 2;
-  Values v = c.values;
-  LevenbergMarquardt(o).optimize(c.graph, v);
+  solve_chain(1, seen, false);
   ASSERT_EQ(seen.threads.size(), 1u);
   EXPECT_EQ(*seen.threads.begin(), std::this_thread::get_id());
 }

@@ -71,9 +71,8 @@ TEST(ParallelLinearization, AcrobotWithBetweenKnotDynamics) {
   expect_same_on_two_threads([&] { return build_graph(p, init); }, "acrobot");
 }
 
-TEST(ParallelLinearization, IiwaAtTheDeskWithCollisionAndSelfCollisionHinges) {
-  const Problem p =
-      load_scene(std::string(KINOGRAPH_SOURCE_DIR) + "/robots/scenes/iiwa_desk.yaml").problem;
+// The same for a problem with obstacles, from its straight line to the goal.
+void expect_same_with_collision_rows(const Problem& p, const std::string& what) {
   const Trajectory init = straight_line(p, p.goal.q);
   expect_same_on_two_threads(
       [&] {
@@ -81,19 +80,17 @@ TEST(ParallelLinearization, IiwaAtTheDeskWithCollisionAndSelfCollisionHinges) {
         EXPECT_FALSE(pg.collision.empty());
         return pg;
       },
+      what);
+}
+
+TEST(ParallelLinearization, IiwaAtTheDeskWithCollisionAndSelfCollisionHinges) {
+  expect_same_with_collision_rows(
+      load_scene(std::string(KINOGRAPH_SOURCE_DIR) + "/robots/scenes/iiwa_desk.yaml").problem,
       "iiwa at the desk");
 }
 
 TEST(ParallelLinearization, RrWithCollisionHinges) {
-  const Problem p = rr_reach();
-  const Trajectory init = straight_line(p, p.goal.q);
-  expect_same_on_two_threads(
-      [&] {
-        PlanningGraph pg = build_graph(p, init);
-        EXPECT_FALSE(pg.collision.empty());
-        return pg;
-      },
-      "rr with a ball");
+  expect_same_with_collision_rows(rr_reach(), "rr with a ball");
 }
 
 }  // namespace
