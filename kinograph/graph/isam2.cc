@@ -12,6 +12,7 @@
 #include "kinograph/graph/cancellation.h"
 #include "kinograph/graph/ordering.h"
 #include "kinograph/graph/stopwatch.h"
+#include "kinograph/graph/worker_pool.h"
 
 namespace kinograph::graph {
 
@@ -30,6 +31,9 @@ std::vector<int> free_slots(const Values& values) {
 // Up to this many active rows JᵀJ is formed coefficient by coefficient: the blocked product's
 // packing costs more than the product for a collision factor's one or two rows.
 constexpr int kLazyProductRows = 8;
+// Fewer factors to evaluate than this, or fewer that may run on any thread, are evaluated on
+// the caller's thread: sharing them out would cost about as much as it saves.
+constexpr size_t kMinParallelFactors = 64;
 
 // Powell's dogleg point at `radius` between the steepest-descent step `sd` and the Gauss–Newton
 // step `gn` (norms given); returns whether the radius limited it.
@@ -123,85 +127,85 @@ void ISAM2::sync_layout() {
 // Linearizing one factor.
 
 bool ISAM2::evaluate_factor(int f, const Values& at, LinearizedFactor* out, double* error,
-                            std::string* reason) {
+                            FactorScratch& w) {
   const Factor& factor = *graph_[f];
   const auto& slots = factor_slots_[f];
   const int nk = static_cast<int>(slots.size());
-  ptrs_.resize(nk);
-  for (int i = 0; i < nk; ++i) ptrs_[i] = at.vector().data() + at.offset(slots[i]);
+  w.ptrs.resize(nk);
+  for (int i = 0; i < nk; ++i) w.ptrs[i] = at.vector().data() + at.offset(slots[i]);
   const int rows = factor.residual_dim();
   const int cols = factor.jacobian_cols();
-  if (J_.rows() < rows || J_.cols() < cols) {
-    J_.resize(std::max<Eigen::Index>(rows, J_.rows()), std::max<Eigen::Index>(cols, J_.cols()));
+  if (w.J.rows() < rows || w.J.cols() < cols) {
+    w.J.resize(std::max<Eigen::Index>(rows, w.J.rows()), std::max<Eigen::Index>(cols, w.J.cols()));
   }
-  if (r_.size() < rows) r_.resize(rows);
-  auto r = r_.head(rows);
+  if (w.r.size() < rows) w.r.resize(rows);
+  auto r = w.r.head(rows);
   r.setZero();
   if (out == nullptr) {
-    factor.whitened(ptrs_.data(), r, nullptr);
+    factor.whitened(w.ptrs.data(), r, nullptr);
     *error = 0.5 * r.squaredNorm();
     return true;
   }
-  collect_free_columns(factor, slots, at);
+  collect_free_columns(factor, slots, at, w);
   const long version = factor.jacobian_version();
   const bool kept = options_.reuse_constant_jacobians && version >= 0 &&
-                    out->jacobian_version == version && out->vars == free_vars_;
-  if (kept ? relinearize_kept_jacobian(factor, *out, error)
-           : linearize_fresh(factor, *out, error)) {
-    return true;
-  }
-  if (reason != nullptr) {
-    *reason = "factor " + std::to_string(f) + " (" + factor.name() +
-              ") returned a non-finite residual or Jacobian";
-  }
-  return false;
+                    out->jacobian_version == version && out->vars == w.free_vars;
+  return kept ? relinearize_kept_jacobian(factor, *out, error, w)
+              : linearize_fresh(factor, *out, error, w);
 }
 
-// The factor's free variables (free_vars_), their first columns among the free ones
-// (free_offsets_) and the stacked Jacobian's column of each free column (free_cols_).
+std::string ISAM2::non_finite_reason(int f) const {
+  return "factor " + std::to_string(f) + " (" + graph_[f]->name() +
+         ") returned a non-finite residual or Jacobian";
+}
+
+// The factor's free variables (w.free_vars), their first columns among the free ones
+// (w.free_offsets) and the stacked Jacobian's column of each free column (w.free_cols).
 void ISAM2::collect_free_columns(const Factor& factor, const std::vector<int>& slots,
-                                 const Values& at) {
-  free_vars_.clear();
-  free_offsets_.clear();
-  free_cols_.clear();
+                                 const Values& at, FactorScratch& w) {
+  w.free_vars.clear();
+  w.free_offsets.clear();
+  w.free_cols.clear();
   for (size_t i = 0; i < slots.size(); ++i) {
     if (at.is_fixed_slot(slots[i])) continue;
-    free_vars_.push_back(slots[i]);
-    free_offsets_.push_back(static_cast<int>(free_cols_.size()));
-    for (int c = 0; c < factor.dims()[i]; ++c) free_cols_.push_back(factor.block_offsets()[i] + c);
+    w.free_vars.push_back(slots[i]);
+    w.free_offsets.push_back(static_cast<int>(w.free_cols.size()));
+    for (int c = 0; c < factor.dims()[i]; ++c) w.free_cols.push_back(factor.block_offsets()[i] + c);
   }
 }
 
 // A linear factor whose Jacobian is unchanged since lf.H was formed: only r and Jᵀr are new.
-bool ISAM2::relinearize_kept_jacobian(const Factor& factor, LinearizedFactor& lf, double* error) {
-  auto r = r_.head(factor.residual_dim());
-  factor.whitened(ptrs_.data(), r, nullptr);
+bool ISAM2::relinearize_kept_jacobian(const Factor& factor, LinearizedFactor& lf, double* error,
+                                      FactorScratch& w) {
+  auto r = w.r.head(factor.residual_dim());
+  factor.whitened(w.ptrs.data(), r, nullptr);
   if (!r.allFinite()) return false;
   lf.error = 0.5 * r.squaredNorm();
   if (error != nullptr) *error = lf.error;
   if (!lf.zero) lf.g.noalias() = lf.J.transpose() * r;  // zero: J has no nonzero row
   lf.active = true;
-  ++jacobians_kept_;
+  ++w.jacobians_kept;
   return true;
 }
 
 // Residual, Jacobian and JᵀJ, Jᵀr over the free columns; a linear factor also keeps its
 // free-column Jacobian so the next linearization can skip JᵀJ.
-bool ISAM2::linearize_fresh(const Factor& factor, LinearizedFactor& lf, double* error) {
+bool ISAM2::linearize_fresh(const Factor& factor, LinearizedFactor& lf, double* error,
+                            FactorScratch& w) {
   const int rows = factor.residual_dim();
-  auto r = r_.head(rows);
-  Eigen::Ref<Eigen::MatrixXd> J = J_.topLeftCorner(rows, factor.jacobian_cols());
+  auto r = w.r.head(rows);
+  Eigen::Ref<Eigen::MatrixXd> J = w.J.topLeftCorner(rows, factor.jacobian_cols());
   const long version = options_.reuse_constant_jacobians ? factor.jacobian_version() : -1;
   // A kept linear factor's J must be whole.
-  RowSupport* support = version >= 0 ? nullptr : &support_;
-  factor.whitened(ptrs_.data(), r, &J, support);
+  RowSupport* support = version >= 0 ? nullptr : &w.support;
+  factor.whitened(w.ptrs.data(), r, &J, support);
   if (!r.allFinite() || (version >= 0 && !all_finite(J))) return false;
   const double factor_error = 0.5 * r.squaredNorm();  // before the compaction reorders r
   bool finite = true;
   if (version >= 0) {  // whole and finite: its compaction below cannot fail
-    const int off = static_cast<int>(free_cols_.size());
+    const int off = static_cast<int>(w.free_cols.size());
     lf.J.resize(rows, off);
-    for (int c = 0; c < off; ++c) lf.J.col(c) = J.col(free_cols_[c]);
+    for (int c = 0; c < off; ++c) lf.J.col(c) = J.col(w.free_cols[c]);
   }
   const int active = compact_nonzero_rows(J, r, &finite, support);
   if (!finite) return false;
@@ -209,21 +213,22 @@ bool ISAM2::linearize_fresh(const Factor& factor, LinearizedFactor& lf, double* 
   lf.jacobian_version = version;
   lf.error = factor_error;
   if (error != nullptr) *error = lf.error;
-  lf.vars = free_vars_;
-  lf.offsets = free_offsets_;
-  form_normal_equations(J, active, lf);
+  lf.vars = w.free_vars;
+  lf.offsets = w.free_offsets;
+  form_normal_equations(J, active, lf, w);
   lf.active = true;
   return true;
 }
 
 // lf.H = JᵀJ and lf.g = Jᵀr over the first `active` rows (those not all zero) and the free
-// columns; r is the residual in r_. Without an active row the factor is only marked zero: in a
+// columns; r is the residual in w.r. Without an active row the factor is only marked zero: in a
 // planning graph most inequality rows hold, and their factors need no work in the cliques.
-void ISAM2::form_normal_equations(Eigen::Ref<Eigen::MatrixXd> J, int active, LinearizedFactor& lf) {
+void ISAM2::form_normal_equations(Eigen::Ref<Eigen::MatrixXd> J, int active, LinearizedFactor& lf,
+                                  const FactorScratch& w) {
   lf.zero = active == 0;
   if (lf.zero) return;
-  auto r = r_.head(J.rows());
-  const int off = static_cast<int>(free_cols_.size());
+  auto r = w.r.head(J.rows());
+  const int off = static_cast<int>(w.free_cols.size());
   const auto Ja = J.topRows(active);
   const auto ra = r.head(active);
   if (off == J.cols() && active <= kLazyProductRows) {
@@ -235,14 +240,14 @@ void ISAM2::form_normal_equations(Eigen::Ref<Eigen::MatrixXd> J, int active, Lin
     lf.g.noalias() = Ja.transpose() * ra;
   } else {
     Eigen::MatrixXd Jf(active, off);
-    for (int c = 0; c < off; ++c) Jf.col(c) = Ja.col(free_cols_[c]);
+    for (int c = 0; c < off; ++c) Jf.col(c) = Ja.col(w.free_cols[c]);
     lf.H.resize(off, off);
     jacobian_gram(Jf, lf.H, /*upper_only=*/false);
     lf.g.noalias() = Jf.transpose() * ra;
   }
 }
 
-bool ISAM2::linearize_factor(int f, std::string* reason) {
+bool ISAM2::linearize_factor(int f, FactorScratch& w) {
   // Reuse the linearization made when the error was evaluated at the estimate, if the factor's
   // variables have since been relinearized exactly there (θ = estimate: their δ is zero).
   if (at_estimate_ok_[f]) {
@@ -256,21 +261,51 @@ bool ISAM2::linearize_factor(int f, std::string* reason) {
     if (at_estimate) {
       std::swap(linearized_[f], at_estimate_[f]);
       at_estimate_ok_[f] = 0;
-      ++factors_reused_;
+      ++w.reused;
       return true;
     }
   }
-  return evaluate_factor(f, theta_, &linearized_[f], nullptr, reason);
+  return evaluate_factor(f, theta_, &linearized_[f], nullptr, w);
 }
 
-double ISAM2::factor_error_at_estimate(int f) {
+double ISAM2::factor_error_at_estimate(int f, FactorScratch& w) {
   double error = 0;
   if (!options_.linearize_at_evaluation) {
-    evaluate_factor(f, estimate_, nullptr, &error, nullptr);
+    evaluate_factor(f, estimate_, nullptr, &error, w);
     return error;
   }
-  at_estimate_ok_[f] = evaluate_factor(f, estimate_, &at_estimate_[f], &error, nullptr) ? 1 : 0;
+  at_estimate_ok_[f] = evaluate_factor(f, estimate_, &at_estimate_[f], &error, w) ? 1 : 0;
   return error;
+}
+
+template <class F>
+void ISAM2::for_each_factor(const std::vector<int>& factors, ShareOutChoice& choice, F&& one) {
+  any_worker_.clear();
+  caller_only_.clear();
+  if (options_.threads > 1 && factors.size() >= kMinParallelFactors) {
+    for (int f : factors) (graph_[f]->parallel_safe() ? any_worker_ : caller_only_).push_back(f);
+  }
+  if (any_worker_.size() < kMinParallelFactors) {
+    for (int f : factors) one(f, scratch_[0]);
+  } else {
+    const auto t0 = Clock::now();
+    const bool share = choice.share();
+    if (share) {
+      auto call = [&](int f, int worker) { one(f, scratch_[static_cast<size_t>(worker)]); };
+      share_out(options_.threads, caller_only_, any_worker_, call);
+    } else {
+      for (int f : factors) one(f, scratch_[0]);
+    }
+    choice.record(share, factors.size(), seconds_since(t0));
+  }
+  count_scratch();
+}
+
+void ISAM2::count_scratch() {
+  for (FactorScratch& w : scratch_) {
+    factors_reused_ += std::exchange(w.reused, 0);
+    jacobians_kept_ += std::exchange(w.jacobians_kept, 0);
+  }
 }
 
 void ISAM2::refresh_estimate(const std::vector<int>& changed_vars) {
@@ -280,13 +315,17 @@ void ISAM2::refresh_estimate(const std::vector<int>& changed_vars) {
     estimate_.at_slot(s) = theta_.at_slot(s) + delta_.segment(theta_.offset(s), theta_.dim(s));
   }
   if (!evaluate) return;
+  refreshed_.clear();
   for (int s : changed_vars) {
     for (int f : var_factors_[s]) {
       if (factor_stamp_[f] == factor_stamp_counter_) continue;
       factor_stamp_[f] = factor_stamp_counter_;
-      factor_error_[f] = factor_error_at_estimate(f);
+      refreshed_.push_back(f);
     }
   }
+  for_each_factor(refreshed_, refresh_choice_, [this](int f, FactorScratch& w) {
+    factor_error_[f] = factor_error_at_estimate(f, w);
+  });
 }
 
 double ISAM2::total_error() const {
@@ -351,6 +390,7 @@ ISAM2Result ISAM2::update(const std::vector<FactorPtr>& new_factors,
   }
   res.trust_radius = trust_radius_;
   tree_.clear_fresh();
+  count_scratch();
   res.jacobians_kept = jacobians_kept_ - kept_before;
   res.total_s = seconds_since(t_start);
   spdlog::debug(
@@ -476,7 +516,7 @@ void ISAM2::add_factors(const std::vector<FactorPtr>& new_factors, UpdateWork& w
       mark(s, work);
     }
     work.to_linearize.push_back(idx);
-    if (work.evaluate) factor_error_[idx] = factor_error_at_estimate(idx);
+    if (work.evaluate) factor_error_[idx] = factor_error_at_estimate(idx, scratch_[0]);
   }
 }
 
@@ -575,10 +615,13 @@ std::vector<int> ISAM2::active_factors() const {
 // Linearizes the queued factors at θ; false (the result says which factor) if one is not finite.
 bool ISAM2::linearize_queued(const UpdateWork& work, ISAM2Result& res) {
   const int reused_before = factors_reused_;
+  linearized_ok_.resize(graph_.size());
+  for_each_factor(work.to_linearize, linearize_choice_, [this](int f, FactorScratch& w) {
+    linearized_ok_[f] = linearize_factor(f, w);
+  });
   for (int f : work.to_linearize) {
-    std::string reason;
-    if (!linearize_factor(f, &reason)) {
-      fail(res, ISAM2Status::kNonFinite, reason);
+    if (!linearized_ok_[f]) {
+      fail(res, ISAM2Status::kNonFinite, non_finite_reason(f));
       return false;
     }
   }

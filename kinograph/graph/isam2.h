@@ -4,13 +4,16 @@
 // eliminates only the cliques touched by new, removed or relinearized factors and their
 // ancestors, reattaching the untouched subtrees through their cached marginal factors.
 #include <Eigen/Core>
+#include <array>
 #include <functional>
 #include <string>
 #include <vector>
 
 #include "kinograph/graph/bayes_tree.h"
 #include "kinograph/graph/factor_graph.h"
+#include "kinograph/graph/share_out_choice.h"
 #include "kinograph/graph/values.h"
+#include "kinograph/graph/worker_pool.h"
 
 namespace kinograph::graph {
 
@@ -56,6 +59,11 @@ struct ISAM2Options {
   /// (Factor::jacobian_version), forming only Jᵀr again. Changes the work only, never the
   /// iterates.
   bool reuse_constant_jacobians = true;
+  /// Threads that linearize and evaluate the factors of an update when there are many (the
+  /// caller's and the process's pool, as LevenbergMarquardtOptions::threads); the factors
+  /// that are not Factor::parallel_safe stay on the caller's. Changes the work only, never
+  /// the iterates.
+  int threads = 2;
 
   /// Gauss–Newton only (Dogleg always evaluates the error): evaluate the nonlinear error after
   /// each update (incrementally: only factors on variables that moved) and, if it rose,
@@ -217,17 +225,36 @@ class ISAM2 {
   Eigen::VectorXd damping_diagonal(const std::vector<int>& vars) const;
   Eigen::VectorXd cauchy_point() const;
 
-  // Linearizing one factor, and the error at the estimate.
+  // Linearizing one factor, and the error at the estimate, with one worker's scratch.
+  struct FactorScratch {
+    Eigen::VectorXd r;
+    Eigen::MatrixXd J;
+    RowSupport support;
+    std::vector<const double*> ptrs;
+    std::vector<int> free_vars, free_offsets, free_cols;
+    int reused = 0;          // linearizations taken from at_estimate_, not yet counted
+    int jacobians_kept = 0;  // kept linear factors' JᵀJ, not yet counted
+  };
   /// Error of factor f at `at` and, with `out`, its linearization there (false when the
   /// residual or Jacobian is not finite).
   bool evaluate_factor(int f, const Values& at, LinearizedFactor* out, double* error,
-                       std::string* reason);
-  void collect_free_columns(const Factor& factor, const std::vector<int>& slots, const Values& at);
-  bool relinearize_kept_jacobian(const Factor& factor, LinearizedFactor& lf, double* error);
-  bool linearize_fresh(const Factor& factor, LinearizedFactor& lf, double* error);
-  void form_normal_equations(Eigen::Ref<Eigen::MatrixXd> J, int active, LinearizedFactor& lf);
-  bool linearize_factor(int f, std::string* reason);
-  double factor_error_at_estimate(int f);
+                       FactorScratch& w);
+  std::string non_finite_reason(int f) const;
+  void collect_free_columns(const Factor& factor, const std::vector<int>& slots, const Values& at,
+                            FactorScratch& w);
+  bool relinearize_kept_jacobian(const Factor& factor, LinearizedFactor& lf, double* error,
+                                 FactorScratch& w);
+  bool linearize_fresh(const Factor& factor, LinearizedFactor& lf, double* error,
+                       FactorScratch& w);
+  void form_normal_equations(Eigen::Ref<Eigen::MatrixXd> J, int active, LinearizedFactor& lf,
+                             const FactorScratch& w);
+  bool linearize_factor(int f, FactorScratch& w);
+  double factor_error_at_estimate(int f, FactorScratch& w);
+  /// Calls one(f, scratch) for every factor index of `factors`, on options_.threads workers
+  /// when they are many, and counts what the scratches noted.
+  template <class F>
+  void for_each_factor(const std::vector<int>& factors, ShareOutChoice& choice, F&& one);
+  void count_scratch();
   void refresh_estimate(const std::vector<int>& changed_vars);
   void sync_layout();
   double total_error() const;
@@ -257,12 +284,11 @@ class ISAM2 {
   bool last_step_limited_ = false;
   bool needs_full_ = true;
   int update_count_ = 0;
-  // Workspaces for linearizing one factor.
-  Eigen::VectorXd r_;
-  Eigen::MatrixXd J_;
-  RowSupport support_;
-  std::vector<const double*> ptrs_;
-  std::vector<int> free_vars_, free_offsets_, free_cols_;
+  // Workspaces for linearizing factors: one per worker, and the lists shared out.
+  std::array<FactorScratch, kMaxWorkers> scratch_;
+  std::vector<int> any_worker_, caller_only_, refreshed_;
+  ShareOutChoice linearize_choice_, refresh_choice_;
+  std::vector<char> linearized_ok_;  // per factor: its last linearize_queued succeeded
 };
 
 }  // namespace kinograph::graph

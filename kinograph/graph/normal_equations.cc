@@ -1,7 +1,6 @@
 #include "kinograph/graph/normal_equations.h"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
@@ -15,11 +14,9 @@ namespace {
 
 // Factors linearized between two looks at the cancellation flag: a few hundred microseconds.
 constexpr size_t kFactorsPerCancellationCheck = 256;
-// Graphs with fewer factors that may run on any thread than this, or whose last evaluation
-// took less than this many seconds of one thread's time, are evaluated on the caller's alone:
-// sharing the work out would cost about as much as it saves.
+// Graphs with fewer factors that may run on any thread than this are evaluated on the caller's
+// alone: sharing the work out would cost about as much as it saves.
 constexpr size_t kMinParallelFactors = 32;
-constexpr double kMinParallelSeconds = 100e-6;
 // Factors a worker takes at a time.
 constexpr size_t kChunk = 4;
 
@@ -372,7 +369,7 @@ void NormalEquations::add(size_t fi, const Factor& f, const Outcome& o) {
 template <bool kWithJacobian>
 bool NormalEquations::evaluate_in_parallel(const FactorGraph& graph, const double* base) {
   if (threads_ <= 1 || any_worker_.size() < kMinParallelFactors ||
-      serial_seconds_ < kMinParallelSeconds) {
+      !choice_[kWithJacobian].share()) {
     return false;
   }
   if (outcomes_.size() != factors_.size()) {  // first parallel run: room for every JᵀJ and Jᵀr
@@ -386,39 +383,15 @@ bool NormalEquations::evaluate_in_parallel(const FactorGraph& graph, const doubl
     }
     buffer_.assign(size, 0.0);
   }
-  std::atomic<size_t> next{0};
-  std::atomic<bool> stop{false};
-  const auto one = [&](size_t fi, Workspace& ws) {
+  size_t done = 0;  // by worker 0, which alone looks at the cancellation flag
+  auto one = [&](int item, int worker) {
+    if (worker == 0 && ++done % kFactorsPerCancellationCheck == 0) throw_if_cancelled();
+    const size_t fi = static_cast<size_t>(item);
     const Eigen::Index nc = graph[factors_[fi].slot]->jacobian_cols();
     double* at = buffer_.data() + buffer_offset_[fi];
-    outcomes_[fi] = evaluate<kWithJacobian>(fi, graph, base, ws, at + nc, nc, at);
+    outcomes_[fi] = evaluate<kWithJacobian>(fi, graph, base, workspace(worker), at + nc, nc, at);
   };
-  auto body = [&](int worker) {
-    Workspace& ws = workspace(worker);
-    size_t done = 0;
-    try {
-      if (worker == 0) {
-        for (int fi : caller_only_) {
-          if (++done % kFactorsPerCancellationCheck == 0) throw_if_cancelled();
-          one(static_cast<size_t>(fi), ws);
-        }
-      }
-      const size_t n = any_worker_.size();
-      for (size_t i = next.fetch_add(kChunk); i < n && !stop; i = next.fetch_add(kChunk)) {
-        for (size_t j = i; j < std::min(n, i + kChunk); ++j) {
-          if (worker == 0 && ++done % kFactorsPerCancellationCheck == 0) throw_if_cancelled();
-          one(static_cast<size_t>(any_worker_[j]), ws);
-        }
-      }
-    } catch (...) {
-      stop = true;  // the other workers leave the rest
-      throw;
-    }
-  };
-  const auto t0 = std::chrono::steady_clock::now();
-  const int ran = run_on_workers(threads_, body);
-  serial_seconds_ =
-      ran * std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  share_out(threads_, caller_only_, any_worker_, one, kChunk);
   return true;
 }
 
@@ -461,8 +434,10 @@ bool NormalEquations::run(const FactorGraph& graph, const Values& values, double
     total += o.half_squared;
     if (o.jtj != nullptr) add(fi, f, o);
   }
-  if (!parallel) {
-    serial_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (threads_ > 1) {
+    choice_[kWithJacobian].record(
+        parallel, factors_.size(),
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   }
   *error = total;
   return true;

@@ -4,12 +4,12 @@
 // every factor's dense JᵀJ blocks straight into precomputed slots of H: no sparse J is formed and
 // nothing is allocated.
 #include <Eigen/Core>
-#include <limits>
 #include <string>
 #include <vector>
 
 #include "kinograph/graph/factor_graph.h"
 #include "kinograph/graph/ordering.h"
+#include "kinograph/graph/share_out_choice.h"
 #include "kinograph/graph/values.h"
 
 namespace kinograph::graph {
@@ -154,9 +154,8 @@ class NormalEquations {
   std::vector<Outcome> outcomes_;
   std::vector<size_t> buffer_offset_;
   std::vector<double> buffer_;
-  // One thread's time for the last evaluation (estimated when parallel): whether the next is
-  // worth sharing out. The first is shared out when the graph has enough factors to share.
-  double serial_seconds_ = std::numeric_limits<double>::infinity();
+  // Whether sharing out pays, for evaluations without and with Jacobians.
+  ShareOutChoice choice_[2];
 };
 
 }  // namespace kinograph::graph

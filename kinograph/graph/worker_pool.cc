@@ -54,7 +54,10 @@ constexpr std::chrono::microseconds kIdleSpin{250};
 constexpr std::chrono::microseconds kFinishSpin{200};
 
 // Threads started on first use and kept for the process's life; one job at a time. A job is
-// announced by one atomic word, its number and how many pool threads it wants.
+// one atomic word: its number, the pool threads it wants, whether it is closed, how many
+// threads joined and how many finished. The caller closes its job when its own share is done
+// and waits only for the threads that joined by then: a thread the machine has not run yet
+// (another process has the core) never holds the caller up.
 class WorkerPool {
  public:
   static WorkerPool& instance() {
@@ -84,11 +87,11 @@ class WorkerPool {
     job_ = body;
     context_ = context;
     error_ = nullptr;
-    running_.store(helpers, std::memory_order_relaxed);
     {
       std::lock_guard<std::mutex> lock(mutex_);  // a thread about to sleep sees it or is woken
-      const uint64_t next = (announced_.load(std::memory_order_relaxed) >> 8) + 1;
-      announced_.store(next << 8 | static_cast<uint64_t>(helpers), std::memory_order_release);
+      ++job_number_;
+      state_.store(job_number_ << kJobShift | static_cast<uint64_t>(helpers) << kWantedShift,
+                   std::memory_order_release);
     }
     wake_.notify_all();
     std::exception_ptr own;
@@ -97,14 +100,21 @@ class WorkerPool {
     } catch (...) {
       own = std::current_exception();
     }
-    const auto finished = [this] { return running_.load(std::memory_order_acquire) == 0; };
+    const uint64_t closed = state_.fetch_or(kClosed, std::memory_order_acq_rel) | kClosed;
+    const uint64_t joined = closed & kCountMask;
+    const auto finished = [&] {
+      return (state_.load(std::memory_order_acquire) >> kFinishedShift & kCountMask) == joined;
+    };
     if (!spin_until(finished, kFinishSpin)) {
       std::unique_lock<std::mutex> lock(mutex_);
       done_.wait(lock, finished);
     }
-    if (!own) own = error_;
+    if (!own) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      own = error_;
+    }
     if (own) std::rethrow_exception(own);
-    return helpers + 1;
+    return static_cast<int>(joined) + 1;
   }
 
   ~WorkerPool() {
@@ -119,6 +129,9 @@ class WorkerPool {
   }
 
  private:
+  static constexpr int kJobShift = 32, kWantedShift = 24, kFinishedShift = 8;
+  static constexpr uint64_t kClosed = uint64_t{1} << 16, kCountMask = 0xff;
+
   WorkerPool() : pid_(getpid()) {}
 
   void start_threads() {
@@ -129,19 +142,32 @@ class WorkerPool {
     for (int w = 1; w <= count; ++w) threads_.emplace_back([this, w] { serve(w); });
   }
 
+  // Joins the announced job `job` unless it is closed, taken over by the next or does not want
+  // thread w.
+  bool join(uint64_t job, int w) {
+    uint64_t s = state_.load(std::memory_order_acquire);
+    while (s >> kJobShift == job && !(s & kClosed) &&
+           w <= static_cast<int>(s >> kWantedShift & kCountMask)) {
+      if (state_.compare_exchange_weak(s, s + 1, std::memory_order_acq_rel)) return true;
+    }
+    return false;
+  }
+
   void serve(int w) {
     t_worker = w;
     t_in_job = true;
-    uint64_t seen = 0;  // started by the first job, which it must not miss
+    uint64_t seen = 0;  // the last job looked at; the first is 1
     for (;;) {
-      const auto announced = [&] { return announced_.load(std::memory_order_acquire) != seen; };
+      const auto announced = [&] {
+        return state_.load(std::memory_order_acquire) >> kJobShift != seen;
+      };
       if (!spin_until(announced, kIdleSpin)) {
         std::unique_lock<std::mutex> lock(mutex_);
         wake_.wait(lock, [&] { return stop_ || announced(); });
         if (stop_) return;
       }
-      seen = announced_.load(std::memory_order_acquire);
-      if (w > static_cast<int>(seen & 0xff)) continue;  // not wanted for this job
+      seen = state_.load(std::memory_order_acquire) >> kJobShift;
+      if (!join(seen, w)) continue;
       std::exception_ptr error;
       try {
         job_(context_, w);
@@ -152,7 +178,10 @@ class WorkerPool {
         std::lock_guard<std::mutex> lock(mutex_);
         if (!error_) error_ = error;
       }
-      if (running_.fetch_sub(1, std::memory_order_acq_rel) == 1) {
+      const uint64_t s =
+          state_.fetch_add(uint64_t{1} << kFinishedShift, std::memory_order_acq_rel) +
+          (uint64_t{1} << kFinishedShift);
+      if ((s & kClosed) && (s >> kFinishedShift & kCountMask) == (s & kCountMask)) {
         std::lock_guard<std::mutex> lock(mutex_);
         done_.notify_one();
       }
@@ -165,13 +194,14 @@ class WorkerPool {
   std::vector<std::thread> threads_;
   std::mutex mutex_;
   std::condition_variable wake_, done_;
-  // The job: set by its caller before it is announced, read by the threads it wants.
+  // The job: set by its caller before it is announced, read by the threads that join it.
   WorkerBody job_ = nullptr;
   void* context_ = nullptr;
   std::exception_ptr error_;  // under mutex_
-  std::atomic<uint64_t> announced_{0};  // job number << 8 | pool threads wanted
-  std::atomic<int> running_{0};         // wanted pool threads not yet done
-  bool stop_ = false;                   // under mutex_
+  uint64_t job_number_ = 0;   // under serving_
+  // job number << 32 | wanted << 24 | closed << 16 | finished << 8 | joined
+  std::atomic<uint64_t> state_{0};
+  bool stop_ = false;  // under mutex_
 };
 
 }  // namespace
