@@ -251,7 +251,7 @@ class ISAM2 {
   bool linearize_factor(int f, FactorScratch& w);
   double factor_error_at_estimate(int f, FactorScratch& w);
   /// Calls one(f, scratch) for every factor index of `factors`, on options_.threads workers
-  /// when they are many, and counts what the scratches noted.
+  /// when they are many and `choice` finds sharing pays, and counts what the scratches noted.
   template <class F>
   void for_each_factor(const std::vector<int>& factors, ShareOutChoice& choice, F&& one);
   void count_scratch();
