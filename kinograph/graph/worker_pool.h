@@ -17,10 +17,11 @@ inline constexpr int kMaxWorkers = 8;
 int current_worker();
 
 /// Runs `body(context, w)` on the calling thread (w = 0) and on up to `workers` − 1 of the
-/// pool's threads (w = 1…), and returns how many ran when every call has. Fewer run when the machine has
-/// fewer cores, the pool is serving another caller or `workers` ≤ 1: `body` must share out its
-/// work dynamically so that worker 0 alone finishes it. An exception thrown by any call is
-/// rethrown here (the caller's first, else the first caught), after all calls have returned.
+/// pool's threads (w = 1…), and returns how many ran when every call has. Fewer run when the
+/// machine has fewer cores, the pool is serving another caller, `workers` ≤ 1, or a pool thread
+/// has not started by the time the caller's call returns (it then stays out): `body` must share
+/// out its work dynamically so that worker 0 alone finishes it. An exception thrown by any call
+/// is rethrown here (the caller's first, else the first caught), after all calls have returned.
 /// Allocates nothing once the pool's threads are started.
 using WorkerBody = void (*)(void* context, int worker);
 int run_on_workers(int workers, WorkerBody body, void* context);
