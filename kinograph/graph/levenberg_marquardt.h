@@ -47,9 +47,10 @@ struct LevenbergMarquardtOptions {
   /// How H + λD is factorized (kAuto: the envelope in natural order when it adds little fill,
   /// as for a trajectory, else CHOLMOD's choice in `ordering`).
   Factorization factorization = Factorization::kAuto;
-  /// Threads that evaluate the factors (the caller's and up to threads − 1 of the process's
-  /// pool, as many as the machine has cores for). The solve is the same to the bit for any
-  /// value; 1 keeps it on the caller's thread, e.g. beside other busy processes.
+  /// Threads that may evaluate the factors (the caller's and up to threads − 1 of the
+  /// process's pool, as many as the machine has cores for); a graph is shared out only when it
+  /// has enough factors and timing shows it pays (ShareOutChoice). The solve is the same to the
+  /// bit for any value; 1 keeps it on the caller's thread, e.g. beside other busy processes.
   int threads = 2;
   /// Take Jacobians at every trial point, so an accepted step is not linearized a second time.
   bool linearize_at_evaluation = true;

@@ -20,8 +20,9 @@ class NormalEquations {
  public:
   /// Builds the pattern. Throws std::invalid_argument naming the factor and key if a factor's
   /// key is missing from `values` or has another dimension. Factors whose keys are all fixed
-  /// still contribute to the error. With `threads` > 1 the factors are evaluated on up to that
-  /// many threads (run_on_workers; those not Factor::parallel_safe on the caller's) and added
+  /// still contribute to the error. With `threads` > 1 the factors may be evaluated on up to
+  /// that many threads (share_out, when ShareOutChoice finds it pays; those not
+  /// Factor::parallel_safe on the caller's) and are added
   /// into H and g in graph order afterwards, so H, g and the cost are the same to the bit for
   /// any number of threads.
   NormalEquations(const FactorGraph& graph, const Values& values, OrderingMethod ordering,
