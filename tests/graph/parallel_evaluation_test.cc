@@ -1,6 +1,7 @@
 // Factors evaluated on several threads (LevenbergMarquardtOptions::threads): the same H, g and
 // cost to the bit as on one, the work really shared, factors that are not parallel_safe kept
-// on the caller's thread, and a factor's exception brought back to the caller.
+// on the caller's thread, a factor's exception brought back to the caller, and the choice
+// between sharing out and running alone.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -15,6 +16,7 @@
 
 #include "kinograph/graph/levenberg_marquardt.h"
 #include "kinograph/graph/normal_equations.h"
+#include "kinograph/graph/share_out_choice.h"
 #include "kinograph/graph/worker_local.h"
 
 namespace kinograph::graph {
@@ -159,6 +161,30 @@ TEST(ParallelEvaluation, AFactorsExceptionReachesTheCaller) {
   Chain sound = chain(100, seen, false);
   NormalEquations ok(sound.graph, sound.values, OrderingMethod::kColamd, 2);
   EXPECT_TRUE(ok.linearize(sound.graph, sound.values, &e, nullptr));
+}
+
+// The choice shares the first two jobs, then runs one alone, then keeps to the faster way and
+// tries the other once every kProbeEvery jobs.
+TEST(ParallelEvaluation, ShareOutChoiceKeepsToTheFasterWayAndProbesTheOther) {
+  for (const bool sharing_faster : {true, false}) {
+    ShareOutChoice choice;
+    const auto run = [&](bool shared) {
+      choice.record(shared, 100, shared == sharing_faster ? 1e-3 : 2e-3);
+    };
+    ASSERT_TRUE(choice.share());  // first: one-time costs, not timed
+    run(true);
+    ASSERT_TRUE(choice.share());
+    run(true);
+    ASSERT_FALSE(choice.share());
+    run(false);
+    int other = 0;
+    for (int job = 0; job < 4 * ShareOutChoice::kProbeEvery; ++job) {
+      const bool shared = choice.share();
+      other += shared != sharing_faster;
+      run(shared);
+    }
+    EXPECT_EQ(other, 4) << (sharing_faster ? "sharing faster" : "alone faster");
+  }
 }
 
 TEST(ParallelEvaluation, WorkerLocalGivesEachWorkerItsOwn) {
