@@ -16,4 +16,6 @@ void throw_if_cancelled() {
   if (t_flag != nullptr && t_flag->load(std::memory_order_relaxed)) throw Cancelled{};
 }
 
+const std::atomic<bool>* cancellation_flag() { return t_flag; }
+
 }  // namespace kinograph::graph

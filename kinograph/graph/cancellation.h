@@ -31,4 +31,8 @@ class CancellationScope {
 /// is consistent (between iterations), so that the object can be destroyed or reused.
 void throw_if_cancelled();
 
+/// This thread's flag, null when none is installed: the worker pool installs the caller's flag
+/// on the threads that help it, so that a cancellation stops their share of a job too.
+const std::atomic<bool>* cancellation_flag();
+
 }  // namespace kinograph::graph

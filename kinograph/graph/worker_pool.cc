@@ -12,6 +12,8 @@
 #include <thread>
 #include <vector>
 
+#include "kinograph/graph/cancellation.h"
+
 namespace kinograph::graph {
 namespace {
 
@@ -86,6 +88,7 @@ class WorkerPool {
     }
     job_ = body;
     context_ = context;
+    cancel_ = cancellation_flag();
     error_ = nullptr;
     {
       std::lock_guard<std::mutex> lock(mutex_);  // a thread about to sleep sees it or is woken
@@ -170,7 +173,12 @@ class WorkerPool {
       if (!join(seen, w)) continue;
       std::exception_ptr error;
       try {
-        job_(context_, w);
+        if (cancel_ != nullptr) {  // the caller's cancellation reaches its helpers
+          const CancellationScope scope(*cancel_);
+          job_(context_, w);
+        } else {
+          job_(context_, w);
+        }
       } catch (...) {
         error = std::current_exception();
       }
@@ -197,6 +205,7 @@ class WorkerPool {
   // The job: set by its caller before it is announced, read by the threads that join it.
   WorkerBody job_ = nullptr;
   void* context_ = nullptr;
+  const std::atomic<bool>* cancel_ = nullptr;  // the caller's cancellation flag, if any
   std::exception_ptr error_;  // under mutex_
   uint64_t job_number_ = 0;   // under serving_
   // job number << 32 | wanted << 24 | closed << 16 | finished << 8 | joined

@@ -22,6 +22,8 @@ int current_worker();
 /// has not started by the time the caller's call returns (it then stays out): `body` must share
 /// out its work dynamically so that worker 0 alone finishes it. An exception thrown by any call
 /// is rethrown here (the caller's first, else the first caught), after all calls have returned.
+/// The caller's cancellation flag (cancellation.h) is installed on the pool threads for their
+/// calls, so throw_if_cancelled() stops the helpers' share too.
 /// Allocates nothing once the pool's threads are started.
 using WorkerBody = void (*)(void* context, int worker);
 int run_on_workers(int workers, WorkerBody body, void* context);

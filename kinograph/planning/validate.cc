@@ -3,12 +3,18 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <numeric>
+#include <optional>
+#include <string>
+#include <vector>
 #include <sstream>
+#include <stdexcept>
 
 #include "kinograph/collision/collision_world.h"
 #include "kinograph/collision/segment_checker.h"
 #include "kinograph/dynamics/inverse_dynamics.h"
 #include "kinograph/dynamics/kinematics.h"
+#include "kinograph/graph/worker_pool.h"
 #include "kinograph/planning/clearance_world.h"
 #include "kinograph/planning/factors/pose_error.h"
 #include "kinograph/planning/trajectory_sampler.h"
@@ -319,65 +325,118 @@ void check_tasks(const Problem& problem, const Plan& plan, dynamics::Data& data,
   }
 }
 
+// The collision walk is cut at knots into this many pieces (fewer for short plans), each
+// walked on its own, so that the pieces and the physics check share the cores. The number is
+// fixed, never the thread count's: a plan's figures are the same on any machine.
+constexpr int kCollisionPieces = 4;
+
 // Clearance (obstacles, the floor, self pairs): every step and dense samples along the
-// validator's Hermite interpolation; a failure names the closest pair, its time and depth.
-void check_collision(const Problem& problem, const Plan& plan,
-                     const ValidationThresholds& thresholds, dynamics::Data& data, Validation& v) {
-  const dynamics::Model& model = *problem.model;
-  const int n = model.nq(), N = problem.steps, rows = N + 1;
-  const double dt = problem.dt();
-  std::unique_ptr<collision::CollisionWorld> world;
-  try {
-    world = clearance_world(problem);
-  } catch (const std::invalid_argument& e) {
-    add_failure(v, e.what());
-    return;
+// validator's Hermite interpolation, walked by conservative advancement (stretches far from
+// everything cost one query; near something the samples are as dense as the segment checker's
+// sweep step). prepare() builds the path, walk(p) checks piece p (on any thread: each piece
+// has its own world), report() turns the pieces' results into figures and failures.
+class CollisionWalk {
+ public:
+  CollisionWalk(const Problem& problem, const Plan& plan, const ValidationThresholds& thresholds)
+      : problem_(problem), clearance_(thresholds.min_clearance) {
+    const dynamics::Model& model = *problem.model;
+    const int n = model.nq(), N = problem.steps, rows = N + 1;
+    const double dt = problem.dt();
+    const int sub = std::max(1, thresholds.collision_samples);
+    path_.resize(N * sub + 1, n);
+    times_.resize(N * sub + 1);
+    const bool timed = plan.t.size() == static_cast<size_t>(rows);
+    for (int k = 0; k < N; ++k) {
+      for (int i = 0; i < sub; ++i) {
+        const double s = static_cast<double>(i) / sub;
+        path_.row(k * sub + i) =
+            i == 0 ? Eigen::VectorXd(plan.q.row(k).transpose()) : hermite(plan, k, s, dt);
+        times_[k * sub + i] = (timed ? plan.t[k] : k * dt) + s * dt;
+      }
+    }
+    path_.row(N * sub) = plan.q.row(N);
+    times_[N * sub] = timed ? plan.t[N] : N * dt;
+    const int pieces = std::clamp(N, 1, kCollisionPieces);
+    for (int p = 0; p <= pieces; ++p) first_row_.push_back(p * N / pieces * sub);
+    results_.resize(pieces);
+    errors_.resize(pieces);
   }
-  // The validator's Hermite interpolation sampled `sub` times per interval, walked by
-  // conservative advancement: stretches far from everything cost one query, and near
-  // something the samples are as dense as the segment checker's sweep step.
-  collision::SegmentChecker checker(model);
-  const int sub = std::max(1, thresholds.collision_samples);
-  Eigen::MatrixXd path(N * sub + 1, n);
-  std::vector<double> times(N * sub + 1);
-  const bool timed = plan.t.size() == static_cast<size_t>(rows);
-  for (int k = 0; k < N; ++k) {
-    for (int i = 0; i < sub; ++i) {
-      const double s = static_cast<double>(i) / sub;
-      path.row(k * sub + i) =
-          i == 0 ? Eigen::VectorXd(plan.q.row(k).transpose()) : hermite(plan, k, s, dt);
-      times[k * sub + i] = (timed ? plan.t[k] : k * dt) + s * dt;
+
+  int pieces() const { return static_cast<int>(results_.size()); }
+
+  // Walks piece p: rows first_row_[p] … first_row_[p + 1] of the path, with its share of the
+  // walk's budgets.
+  void walk(int p) {
+    std::unique_ptr<collision::CollisionWorld> world;
+    try {
+      world = clearance_world(problem_);
+    } catch (const std::invalid_argument& e) {
+      errors_[p] = e.what();
+      return;
+    }
+    collision::SegmentCheckOptions options;
+    options.max_path_samples = std::max(1, options.max_path_samples / pieces());
+    options.max_path_sweep /= pieces();
+    collision::SegmentChecker checker(*problem_.model, options);
+    dynamics::Data data(*problem_.model);
+    const int r0 = first_row_[p], count = first_row_[p + 1] - r0 + 1;
+    const std::vector<double> times(times_.begin() + r0, times_.begin() + r0 + count);
+    results_[p] = checker.check_path(*world, data, path_.middleRows(r0, count), times, clearance_);
+    results_[p].segment += r0;
+    results_[p].stopped_segment += r0;
+  }
+
+  // The smallest clearance over the pieces and the failures: a world that cannot be built,
+  // the first piece whose walk stopped, and the closest approach when it is too close.
+  void report(Validation& v) const {
+    for (const std::string& e : errors_) {
+      if (e.empty()) continue;
+      add_failure(v, e);
+      return;  // every piece builds the same world
+    }
+    const collision::PathCheckResult* closest = nullptr;
+    for (const collision::PathCheckResult& r : results_) {
+      if (closest == nullptr || r.min_distance < closest->min_distance) closest = &r;
+    }
+    v.min_clearance = std::min(v.min_clearance, closest->min_distance);
+    for (const collision::PathCheckResult& r : results_) {
+      if (r.complete) continue;
+      std::ostringstream os;
+      os << "collision: not checked after t = " << time_at(r.stopped_segment, r.stopped_s)
+         << " s: the path sweeps too far (" << r.swept << " m in " << r.samples
+         << " collision queries; q or q̇ far beyond what the robot can move)";
+      add_failure(v, os.str());
+      break;
+    }
+    if (closest->min_distance < clearance_) {
+      std::ostringstream os;
+      os << "collision: " << describe_pair(*problem_.model, closest->closest);
+      if (closest->min_distance < 0) {
+        os << " overlap by " << -closest->min_distance << " m";
+      } else {
+        os << " are " << closest->min_distance << " m apart";
+      }
+      os << " at t = " << time_at(closest->segment, closest->s) << " s (required clearance "
+         << clearance_ << " m)";
+      add_failure(v, os.str());
     }
   }
-  path.row(N * sub) = plan.q.row(N);
-  times[N * sub] = timed ? plan.t[N] : N * dt;
-  const collision::PathCheckResult r =
-      checker.check_path(*world, data, path, times, thresholds.min_clearance);
-  v.min_clearance = std::min(v.min_clearance, r.min_distance);
-  if (!r.complete) {
-    const size_t at = std::min(static_cast<size_t>(r.stopped_segment), times.size() - 1);
-    const double t =
-        at + 1 < times.size() ? times[at] + r.stopped_s * (times[at + 1] - times[at]) : times[at];
-    std::ostringstream os;
-    os << "collision: not checked after t = " << t << " s: the path sweeps too far (" << r.swept
-       << " m in " << r.samples << " collision queries; q or q̇ far beyond what the robot can move)";
-    add_failure(v, os.str());
+
+ private:
+  // The time a fraction s along path segment i.
+  double time_at(int segment, double s) const {
+    const size_t at = std::min(static_cast<size_t>(segment), times_.size() - 1);
+    return at + 1 < times_.size() ? times_[at] + s * (times_[at + 1] - times_[at]) : times_[at];
   }
-  if (r.min_distance < thresholds.min_clearance) {
-    const size_t at = std::min(static_cast<size_t>(r.segment), times.size() - 1);
-    const double t =
-        at + 1 < times.size() ? times[at] + r.s * (times[at + 1] - times[at]) : times[at];
-    std::ostringstream os;
-    os << "collision: " << describe_pair(model, r.closest);
-    if (r.min_distance < 0) {
-      os << " overlap by " << -r.min_distance << " m";
-    } else {
-      os << " are " << r.min_distance << " m apart";
-    }
-    os << " at t = " << t << " s (required clearance " << thresholds.min_clearance << " m)";
-    add_failure(v, os.str());
-  }
-}
+
+  const Problem& problem_;
+  double clearance_;
+  Eigen::MatrixXd path_;
+  std::vector<double> times_;
+  std::vector<int> first_row_;  // piece p walks rows first_row_[p] … first_row_[p + 1]
+  std::vector<collision::PathCheckResult> results_;
+  std::vector<std::string> errors_;  // a world that could not be built, per piece
+};
 
 }  // namespace
 
@@ -386,13 +445,23 @@ Validation validate(const Problem& problem, const Plan& plan,
   Validation v;
   if (!check_shape(problem, plan, v)) return v;
   dynamics::Data data(*problem.model);
-  check_physics(problem, plan, thresholds, data, v);
+  std::optional<CollisionWalk> walk;
+  if (has_clearance_checks(problem)) walk.emplace(problem, plan, thresholds);
+  // Item 0 is the physics, item p + 1 the collision walk's piece p; each writes only its own.
+  std::vector<int> items(1 + (walk ? walk->pieces() : 0));
+  std::iota(items.begin(), items.end(), 0);
+  auto one = [&](int item, int) {
+    if (item == 0) {
+      check_physics(problem, plan, thresholds, data, v);
+    } else {
+      walk->walk(item - 1);
+    }
+  };
+  graph::share_out(static_cast<int>(items.size()), {}, items, one, 1);
   check_start_and_goal(problem, plan, thresholds, data, v);
   check_tasks(problem, plan, data, v);
-  // The only costly check; a caller that only needs the verdict skips it once another failed.
-  if (has_clearance_checks(problem) && !(verdict_only && !v.failures.empty())) {
-    check_collision(problem, plan, thresholds, data, v);
-  }
+  // A caller that only needs the verdict has no use for the clearance once another check failed.
+  if (walk && !(verdict_only && !v.failures.empty())) walk->report(v);
   v.valid = v.failures.empty();
   return v;
 }

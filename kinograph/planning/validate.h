@@ -29,8 +29,10 @@ struct ValidationThresholds {
 
 /// Validates `plan` for `problem`: fills every figure of Validation, lists each failed check
 /// in failures, and sets valid. Malformed plans (wrong sizes, NaN) are invalid, never a crash.
-/// With verdict_only, the collision check (the costly one) is skipped when another check has
-/// already failed, so min_clearance may be left unset then.
+/// With verdict_only, the clearance is not reported when another check has failed, so
+/// min_clearance may be left unset then. The physics and the pieces of the collision walk run
+/// on the process's worker pool (graph/worker_pool.h) when it is free; the result is the same
+/// either way.
 Validation validate(const Problem& problem, const Plan& plan,
                     const ValidationThresholds& thresholds = {}, bool verdict_only = false);
 

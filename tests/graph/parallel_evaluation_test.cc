@@ -4,6 +4,7 @@
 // between sharing out and running alone.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -14,10 +15,12 @@
 #include <thread>
 #include <vector>
 
+#include "kinograph/graph/cancellation.h"
 #include "kinograph/graph/levenberg_marquardt.h"
 #include "kinograph/graph/normal_equations.h"
 #include "kinograph/graph/share_out_choice.h"
 #include "kinograph/graph/worker_local.h"
+#include "kinograph/graph/worker_pool.h"
 
 namespace kinograph::graph {
 namespace {
@@ -161,6 +164,31 @@ TEST(ParallelEvaluation, AFactorsExceptionReachesTheCaller) {
   Chain sound = chain(100, seen, false);
   NormalEquations ok(sound.graph, sound.values, OrderingMethod::kColamd, 2);
   EXPECT_TRUE(ok.linearize(sound.graph, sound.values, &e, nullptr));
+}
+
+// A pool thread that helps a caller sees the caller's cancellation flag: its
+// throw_if_cancelled() throws, and the caller gets the Cancelled.
+TEST(ParallelEvaluation, TheCallersCancellationReachesItsHelpers) {
+  if (!two_cores()) GTEST_SKIP() << "one core: the pool has no thread";
+  const std::atomic<bool> cancelled{true};
+  const CancellationScope scope(cancelled);
+  Seen seen;
+  bool helper_ran = false;
+  auto body = [&](int worker) {
+    {  // both workers meet first, so that the helper surely takes part in the job
+      std::unique_lock<std::mutex> lock(seen.mutex);
+      ++seen.met;
+      seen.changed.notify_all();
+      seen.waited_out = !seen.changed.wait_for(lock, std::chrono::minutes(1),
+                                               [&] { return seen.met >= 2; });
+      if (worker == 0) return;
+      helper_ran = true;
+    }
+    throw_if_cancelled();
+  };
+  EXPECT_THROW(run_on_workers(2, body), Cancelled);
+  EXPECT_FALSE(seen.waited_out);
+  EXPECT_TRUE(helper_ran);
 }
 
 // The choice shares the first two jobs, then runs one alone, then keeps to the faster way and

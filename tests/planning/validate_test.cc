@@ -5,6 +5,10 @@
 
 #include "kinograph/dynamics/inverse_dynamics.h"
 #include "kinograph/dynamics/kinematics.h"
+#include "kinograph/graph/worker_pool.h"
+#include "kinograph/planning/formulation/initialization.h"
+#include "kinograph/planning/formulation/planning_graph.h"
+#include "kinograph/planning/io/scene.h"
 #include "kinograph/planning/problem_check.h"
 #include "kinograph/planning/trajectory_sampler.h"
 
@@ -60,6 +64,44 @@ TEST(Validate, APathTooLongToWalkIsInvalidNotEndless) {
   const Validation v = validate(f.problem, f.plan);
   EXPECT_FALSE(v.valid);
   EXPECT_TRUE(mentions(v, "collision: not checked after t = ")) << all_failures(v);
+}
+
+// The physics and the pieces of the collision walk share the worker pool when it is free; run
+// alone (inside a job, where the pool never helps) they give the same figures and failures.
+TEST(Validate, TheSameVerdictWithAndWithoutThePoolsHelp) {
+  const Problem desk =
+      load_scene(std::string(KINOGRAPH_SOURCE_DIR) + "/robots/scenes/iiwa_desk.yaml").problem;
+  // The straight line runs through the desk: collision, limit and dynamics failures to report.
+  const Plan through = plan_from_trajectory(desk, straight_line(desk, desk.goal.q));
+  const Validation shared = validate(desk, through);
+  Validation alone;
+  auto body = [&](int worker) {
+    if (worker == 0) alone = validate(desk, through);
+  };
+  graph::run_on_workers(2, body);
+  EXPECT_FALSE(shared.valid);
+  EXPECT_LT(shared.min_clearance, 0);
+  EXPECT_EQ(shared.failures, alone.failures);
+  EXPECT_EQ(shared.min_clearance, alone.min_clearance);
+  EXPECT_EQ(shared.max_dynamics_residual, alone.max_dynamics_residual);
+  EXPECT_EQ(shared.max_position_consistency, alone.max_position_consistency);
+  EXPECT_EQ(shared.max_tau_violation_between, alone.max_tau_violation_between);
+  EXPECT_EQ(shared.goal_error, alone.goal_error);
+}
+
+// The collision walk is cut into pieces; a collision in a late piece is reported at its own
+// time on the plan's clock.
+TEST(Validate, ACollisionLateInThePlanIsReportedAtItsTime) {
+  Fixture f;
+  collision::Obstacle ball;  // on the upper link where the shoulder is at −0.5 rad
+  ball.shape = collision::Shape::sphere(0.1);
+  ball.pose.translation() = Eigen::Vector3d(std::sin(-0.5) * 0.5, 0, std::cos(-0.5) * 0.5);
+  f.problem.obstacles.push_back(ball);
+  ASSERT_GT(validate(f.problem, f.plan).min_clearance, 0);
+  f.plan.q(8, 0) = -0.5;  // knot 8 (t = 0.8 s) swings into the ball and back
+  const Validation v = validate(f.problem, f.plan);
+  EXPECT_LT(v.min_clearance, 0);
+  EXPECT_TRUE(mentions_all(v, {"collision: ", "at t = 0.8"})) << all_failures(v);
 }
 
 // Start, goal and task failures say which joint or frame misses, by how much, and when.

@@ -1,7 +1,11 @@
 #include "kinograph/planning/batch/interval_limits.h"
 
 #include <cmath>
+#include <memory>
+#include <numeric>
+#include <vector>
 
+#include "kinograph/graph/worker_local.h"
 #include "kinograph/planning/interpolant.h"
 #include "kinograph/planning/trajectory_sampler.h"
 
@@ -43,17 +47,26 @@ std::vector<char> intervals_near_limits(const Problem& problem, const Plan& plan
   if (checks == 0) return flags;
   std::vector<double> fractions;
   for (int i = 1; i <= checks; ++i) fractions.push_back(static_cast<double>(i) / (checks + 1));
-  TrajectorySampler sampler(model, plan);
-  std::vector<InterpolantPoint> points;
-  for (int k = 0; k < sampler.intervals(); ++k) {
-    sampler.interval(k, fractions, points);
-    for (const InterpolantPoint& p : points) {
+  // Intervals are independent: they are shared out, each worker with its own sampler.
+  struct Workspace {
+    TrajectorySampler sampler;
+    std::vector<InterpolantPoint> points;
+  };
+  graph::WorkerLocal<Workspace> workspaces(
+      [&] { return std::make_unique<Workspace>(Workspace{TrajectorySampler(model, plan), {}}); });
+  std::vector<int> intervals(static_cast<size_t>(workspaces.local().sampler.intervals()));
+  std::iota(intervals.begin(), intervals.end(), 0);
+  auto one = [&](int k, int) {
+    Workspace& w = workspaces.local();
+    w.sampler.interval(k, fractions, w.points);
+    for (const InterpolantPoint& p : w.points) {
       if (near_a_limit(model, p, problem.objectives.limit_epsilon, margin)) {
         flags[static_cast<size_t>(k)] = 1;
         break;
       }
     }
-  }
+  };
+  graph::share_out(graph::kMaxWorkers, {}, intervals, one);
   return flags;
 }
 
