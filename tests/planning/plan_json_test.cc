@@ -9,6 +9,7 @@
 #include <random>
 
 #include "tests/lib/temp_dir.h"
+#include "tests/planning/test_problems.h"
 
 namespace kinograph::planning {
 namespace {
@@ -79,22 +80,7 @@ void expect_same_plan(const Plan& a, const Plan& b) {
   EXPECT_EQ(a.stats.solve_time_s, b.stats.solve_time_s);
   EXPECT_EQ(a.stats.cost, b.stats.cost);
   EXPECT_EQ(a.stats.max_constraint_violation, b.stats.max_constraint_violation);
-  const Validation &v = a.validation, &w = b.validation;
-  EXPECT_EQ(v.valid, w.valid);
-  EXPECT_EQ(v.failures, w.failures);
-  EXPECT_EQ(v.max_dynamics_residual, w.max_dynamics_residual);
-  EXPECT_EQ(v.max_position_consistency, w.max_position_consistency);
-  EXPECT_EQ(v.max_velocity_consistency, w.max_velocity_consistency);
-  EXPECT_EQ(v.max_q_violation, w.max_q_violation);
-  EXPECT_EQ(v.max_qd_violation, w.max_qd_violation);
-  EXPECT_EQ(v.max_qdd_violation, w.max_qdd_violation);
-  EXPECT_EQ(v.max_tau_violation, w.max_tau_violation);
-  EXPECT_EQ(v.min_clearance, w.min_clearance);
-  EXPECT_EQ(v.goal_error, w.goal_error);
-  EXPECT_EQ(v.max_task_error, w.max_task_error);
-  EXPECT_EQ(v.max_unactuated_torque, w.max_unactuated_torque);
-  EXPECT_EQ(v.start_error, w.start_error);
-  EXPECT_EQ(v.final_velocity, w.final_velocity);
+  testing::expect_same_validation(a.validation, b.validation);
 }
 
 TEST(PlanJson, RoundTripsExactlyThroughAFile) {

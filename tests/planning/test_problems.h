@@ -2,6 +2,7 @@
 // Small planning problems shared by the planner's end-to-end tests: the Acrobot swing-up, the RR
 // arm reaching past a ball, and the iiwa carrying a 2 kg block past a box.
 #include <Eigen/Core>
+#include <gtest/gtest.h>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -20,6 +21,27 @@ inline std::string failures(const Plan& p) {
   std::string s = p.stats.method + " " + to_string(p.stats.status) + " " + p.stats.reason + ":";
   for (const auto& f : p.validation.failures) s += " | " + f;
   return s;
+}
+
+// Every verdict, failure and figure of two validations is the same.
+inline void expect_same_validation(const Validation& v, const Validation& w) {
+  EXPECT_EQ(v.valid, w.valid);
+  EXPECT_EQ(v.failures, w.failures);
+  EXPECT_EQ(v.max_dynamics_residual, w.max_dynamics_residual);
+  EXPECT_EQ(v.max_position_consistency, w.max_position_consistency);
+  EXPECT_EQ(v.max_velocity_consistency, w.max_velocity_consistency);
+  EXPECT_EQ(v.max_q_violation, w.max_q_violation);
+  EXPECT_EQ(v.max_qd_violation, w.max_qd_violation);
+  EXPECT_EQ(v.max_qdd_violation, w.max_qdd_violation);
+  EXPECT_EQ(v.max_tau_violation, w.max_tau_violation);
+  EXPECT_EQ(v.max_tau_violation_between, w.max_tau_violation_between);
+  EXPECT_EQ(v.max_unactuated_torque_between, w.max_unactuated_torque_between);
+  EXPECT_EQ(v.min_clearance, w.min_clearance);
+  EXPECT_EQ(v.goal_error, w.goal_error);
+  EXPECT_EQ(v.max_task_error, w.max_task_error);
+  EXPECT_EQ(v.max_unactuated_torque, w.max_unactuated_torque);
+  EXPECT_EQ(v.start_error, w.start_error);
+  EXPECT_EQ(v.final_velocity, w.final_velocity);
 }
 
 inline std::shared_ptr<const dynamics::Model> load_robot(const std::string& rel) {
