@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <numeric>
 #include <stdexcept>
 
 #include "kinograph/graph/cancellation.h"
@@ -331,14 +332,15 @@ NormalEquations::Outcome NormalEquations::evaluate(size_t fi, const FactorGraph&
   }
 }
 
-void NormalEquations::add(size_t fi, const Factor& f, const Outcome& o) {
+void NormalEquations::add(size_t fi, const Factor& f, const Outcome& o, int first_col,
+                          int end_col) {
   const FactorInfo& info = factors_[fi];
   const int nk = static_cast<int>(f.keys().size());
   const auto& offsets = f.block_offsets();
   const auto& dims = f.dims();
   for (int k = 0; k < nk; ++k) {
     const int col = key_col_[info.first_key + k];
-    if (col >= 0) {
+    if (col >= first_col && col < end_col) {
       g_.segment(col, dims[k]) += Eigen::Map<const Eigen::VectorXd>(o.jtr + offsets[k], dims[k]);
     }
   }
@@ -347,6 +349,7 @@ void NormalEquations::add(size_t fi, const Factor& f, const Outcome& o) {
   double* h = h_.data();
   for (int p = info.first_pair; p < info.first_pair + info.num_pairs; ++p) {
     const Pair& pair = pairs_[p];
+    if (pair.first_col < first_col || pair.first_col >= end_col) continue;
     const int ro = offsets[pair.row_key], co = offsets[pair.col_key];
     const int dr = dims[pair.row_key], dc = dims[pair.col_key];
     if (ro <= co) {  // the block lies in JᵀJ's upper triangle
@@ -395,19 +398,46 @@ bool NormalEquations::evaluate_in_parallel(const FactorGraph& graph, const doubl
   return true;
 }
 
+void NormalEquations::add_in_parallel(const FactorGraph& graph) {
+  if (part_cols_.empty()) {  // the column parts, once: equal shares of H's entries
+    const int parts = std::max(1, std::min(threads_, n_));
+    part_cols_.push_back(0);
+    for (int v = 0; v < static_cast<int>(var_col_.size()); ++v) {
+      const int share = static_cast<int>(part_cols_.size());
+      if (share < parts && col_ptr_[var_col_[v]] * static_cast<size_t>(parts) >=
+                               static_cast<size_t>(share) * h_.size()) {
+        if (var_col_[v] > part_cols_.back()) part_cols_.push_back(var_col_[v]);
+      }
+    }
+    part_cols_.push_back(n_);
+    parts_.resize(part_cols_.size() - 1);
+    std::iota(parts_.begin(), parts_.end(), 0);
+  }
+  auto one = [&](int part, int) {
+    const int first = part_cols_[part], end = part_cols_[part + 1];
+    std::fill(h_.begin() + col_ptr_[first], h_.begin() + col_ptr_[end], 0.0);
+    g_.segment(first, end - first).setZero();
+    for (size_t fi = 0; fi < factors_.size(); ++fi) {
+      const Outcome& o = outcomes_[fi];
+      if (o.jtj != nullptr) add(fi, *graph[factors_[fi].slot], o, first, end);
+    }
+  };
+  share_out(threads_, {}, parts_, one, 1);
+}
+
 template <bool kWithJacobian>
 bool NormalEquations::run(const FactorGraph& graph, const Values& values, double* error,
                           std::string* reason) {
   if (!matches(graph, values)) {
     throw std::logic_error("NormalEquations used with a graph or Values of another structure");
   }
-  if constexpr (kWithJacobian) {
-    std::fill(h_.begin(), h_.end(), 0.0);
-    g_.setZero();
-  }
   const double* base = values.vector().data();
   const auto t0 = std::chrono::steady_clock::now();
   const bool parallel = evaluate_in_parallel<kWithJacobian>(graph, base);
+  if (kWithJacobian && !parallel) {  // a shared evaluation's scatter zeroes its own parts
+    std::fill(h_.begin(), h_.end(), 0.0);
+    g_.setZero();
+  }
   Workspace& ws = workspace(0);
   double total = 0;
   for (size_t fi = 0; fi < factors_.size(); ++fi) {
@@ -432,8 +462,9 @@ bool NormalEquations::run(const FactorGraph& graph, const Values& values, double
       return false;
     }
     total += o.half_squared;
-    if (o.jtj != nullptr) add(fi, f, o);
+    if (!parallel && o.jtj != nullptr) add(fi, f, o, 0, n_);
   }
+  if (kWithJacobian && parallel) add_in_parallel(graph);
   if (threads_ > 1) {
     choice_[kWithJacobian].record(
         parallel, factors_.size(),

@@ -123,8 +123,11 @@ class NormalEquations {
   template <bool kWithJacobian>
   Outcome evaluate(size_t fi, const FactorGraph& graph, const double* base, Workspace& ws,
                    double* jtj, Eigen::Index stride, double* jtr);
-  // Adds factor fi's evaluation into H and g.
-  void add(size_t fi, const Factor& f, const Outcome& o);
+  // Adds factor fi's evaluation into the columns [first_col, end_col) of H and g.
+  void add(size_t fi, const Factor& f, const Outcome& o, int first_col, int end_col);
+  // Adds the shared evaluation (outcomes_) into H and g, zeroed first: each worker takes a
+  // part of the columns and adds to it in graph order, so every entry is the serial sum.
+  void add_in_parallel(const FactorGraph& graph);
   // The parallel evaluation into outcomes_ (and buffer_); false when nothing is to be run so.
   template <bool kWithJacobian>
   bool evaluate_in_parallel(const FactorGraph& graph, const double* base);
@@ -155,6 +158,9 @@ class NormalEquations {
   std::vector<Outcome> outcomes_;
   std::vector<size_t> buffer_offset_;
   std::vector<double> buffer_;
+  // The scatter's column parts: part p is columns part_cols_[p] … part_cols_[p + 1] − 1, at
+  // variable boundaries; parts_ lists 0 … P − 1 for share_out.
+  std::vector<int> part_cols_, parts_;
   // Whether sharing out pays, for evaluations without and with Jacobians.
   ShareOutChoice choice_[2];
 };
