@@ -5,10 +5,10 @@
 #include <memory>
 #include <numeric>
 #include <optional>
-#include <string>
-#include <vector>
 #include <sstream>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "kinograph/collision/collision_world.h"
 #include "kinograph/collision/segment_checker.h"
@@ -333,8 +333,8 @@ constexpr int kCollisionPieces = 4;
 // Clearance (obstacles, the floor, self pairs): every step and dense samples along the
 // validator's Hermite interpolation, walked by conservative advancement (stretches far from
 // everything cost one query; near something the samples are as dense as the segment checker's
-// sweep step). prepare() builds the path, walk(p) checks piece p (on any thread: each piece
-// has its own world), report() turns the pieces' results into figures and failures.
+// sweep step). The constructor builds the path, walk(p) checks piece p (on any thread: each
+// piece has its own world), report() turns the pieces' results into figures and failures.
 class CollisionWalk {
  public:
   CollisionWalk(const Problem& problem, const Plan& plan, const ValidationThresholds& thresholds)
