@@ -947,6 +947,9 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t
     publish(options_.drake_plan_channel, drake_plan);
   }
   publish_status();
+  // Answered: while the node waits for the next change, the incremental planner readies its
+  // tree, so that a replan re-eliminates only what its change touches.
+  if (valid) replanner_.prepare();
 }
 
 void PlannerNode::answer_at_shutdown(const Intake& taken) {

@@ -72,6 +72,7 @@ void run_replan(const ReplanArgs& args) {
                              planning::to_string(before.stats.status) + "); nothing to replan",
                          2);
   }
+  planner.prepare();  // as the daemon does while it waits for a change
   const planning::Plan after = planner.replan(change.change);
   if (!args.quiet) {
     std::cout << "\nreplan after " << args.change << "\n"

@@ -86,12 +86,14 @@ struct Row {
   Method L, W, inc;
   int problems = 0, first_failed = 0, no_change = 0;
   std::vector<double> first_cost;  // per first plan: its soft cost, NaN where it failed
+  std::vector<double> prepare;     // per first plan: Replanner::prepare's wall time [s]
 };
 
 json row_json(const Row& r) {
   return {{"problems", r.problems},
           {"first_plan_failed", r.first_failed},
           {"first_plan_objective_all", r.first_cost},
+          {"prepare_s_median", median(r.prepare)},
           {"no_nearby_change", r.no_change},
           {"DFGP-L", r.L.to_json()},
           {"DFGP-W", r.W.to_json()},
@@ -112,6 +114,8 @@ void replan_all(Row& row, const Problem& first_problem, Problem changed,
     ++row.first_failed;
     return;
   }
+  // As a daemon does while it waits for the next change.
+  row.prepare.push_back(planner.prepare());
   const Plan warm = knots > 0 ? planning::gone_on(first, knots) : first;
   if (knots > 0) {
     changed.start_q = warm.q.row(0).transpose();

@@ -74,6 +74,7 @@ struct ISAM2::UpdateWork {
   std::vector<int> changed;       // variables back-substitution changed (last trial)
   double lambda = 0;              // damping of the last trial
   bool accepted = true;           // the last trial did not raise the error
+  const ISAM2UpdateOptions* options = nullptr;  // of this update
 };
 
 std::string to_string(ISAM2Status status) {
@@ -351,6 +352,7 @@ ISAM2Result ISAM2::update(const std::vector<FactorPtr>& new_factors,
   UpdateWork work;
   work.gauss_newton = options_.step == ISAM2Step::kGaussNewton;
   work.evaluate = options_.safeguard || !work.gauss_newton;
+  work.options = &update_options;
 
   add_variables(new_values);
   ++stamp_counter_;  // a new marking: mark() stamps variables with this counter
@@ -359,23 +361,15 @@ ISAM2Result ISAM2::update(const std::vector<FactorPtr>& new_factors,
   work.touched = work.marked;
   if (work.evaluate) res.error_before = total_error();
   relinearize(update_options, work, res);
-  if (work.marked.empty() && !needs_full_) {  // nothing to re-eliminate
+  const bool reeliminate = !work.marked.empty() || needs_full_;
+  if (!reeliminate && !prepared_) {  // nothing to re-eliminate, no step left to take
     report_unchanged(work, res);
     res.total_s = seconds_since(t_start);
     return res;
   }
 
-  const auto t_lin = Clock::now();
-  find_affected_top(work);
-  res.full_reelimination = work.full;
-  if (!linearize_queued(work, res)) {
-    res.total_s = seconds_since(t_start);
-    return res;
-  }
-  work.factors = factors_to_eliminate(work, res);
-  res.linearize_s = seconds_since(t_lin);
-  build_affected_top(update_options, work, res);
-  if (!eliminate_and_solve(work, res)) {
+  // Without a change only the prepared tree's step is taken.
+  if ((reeliminate && !detach_and_linearize(work, res)) || !eliminate_and_solve(work, res)) {
     res.total_s = seconds_since(t_start);
     return res;
   }
@@ -390,6 +384,7 @@ ISAM2Result ISAM2::update(const std::vector<FactorPtr>& new_factors,
   }
   res.trust_radius = trust_radius_;
   tree_.clear_fresh();
+  prepared_ = false;
   count_scratch();
   res.jacobians_kept = jacobians_kept_ - kept_before;
   res.total_s = seconds_since(t_start);
@@ -399,6 +394,56 @@ ISAM2Result ISAM2::update(const std::vector<FactorPtr>& new_factors,
       update_count_, res.variables_reeliminated, res.cliques_reeliminated,
       work.full ? "full" : "partial", res.variables_relinearized, res.cliques_solved,
       res.error_before, res.error_after, res.lambda, 1e3 * res.total_s);
+  return res;
+}
+
+ISAM2Result ISAM2::relinearize_at_estimate(const std::vector<Key>& last) {
+  const auto t_start = Clock::now();
+  ISAM2Result res;
+  UpdateWork work;
+  work.gauss_newton = options_.step == ISAM2Step::kGaussNewton;
+  work.evaluate = false;
+  ISAM2UpdateOptions all;
+  all.force_relinearize = true;
+  all.constrained_last = last;
+  work.options = &all;
+  ++stamp_counter_;
+  relinearize(all, work, res);
+  if (work.marked.empty() && !needs_full_) {
+    report_unchanged(work, res);
+    res.total_s = seconds_since(t_start);
+    return res;
+  }
+  if (!detach_and_linearize(work, res)) {
+    res.total_s = seconds_since(t_start);
+    return res;
+  }
+  // Damped as the next update's first trial would be: that trial then re-eliminates only its
+  // own top and takes the same step as if it had re-eliminated everything.
+  Eigen::VectorXd damping;
+  if (work.gauss_newton && options_.safeguard && lambda_ > 0) {
+    damping = lambda_ * damping_diagonal(work.vars);
+    prepared_damped_ = work.vars;
+  }
+  int bad_slot = -1;
+  const auto t_factor = Clock::now();
+  const bool factored = tree_.factorize(work.new_cliques, linearized_,
+                                        damping.size() > 0 ? &damping : nullptr, &bad_slot);
+  res.eliminate_s += seconds_since(t_factor);
+  res.trials = 1;
+  if (!factored) {
+    fail_singular(res, bad_slot);
+    res.total_s = seconds_since(t_start);
+    return res;
+  }
+  // The new cliques' solution is not taken: δ stays 0 (θ is the estimate). They stay fresh, so
+  // the next update back-substitutes every one of them and takes the step it skipped here.
+  needs_full_ = false;
+  prepared_ = true;
+  count_scratch();
+  res.lambda = lambda_;
+  res.trust_radius = trust_radius_;
+  res.total_s = seconds_since(t_start);
   return res;
 }
 
@@ -637,6 +682,27 @@ void ISAM2::fail(ISAM2Result& res, ISAM2Status status, std::string reason) {
   res.reason = std::move(reason);
   tree_.clear();
   needs_full_ = true;
+  prepared_ = false;
+  prepared_damped_.clear();
+}
+
+void ISAM2::fail_singular(ISAM2Result& res, int slot) {
+  fail(res, ISAM2Status::kSingular,
+       "the information block of " + theta_.key(slot).to_string() +
+           " is not positive definite (too few factors on it?)");
+}
+
+// The affected top detached, its factors linearized and its new cliques built (symbolically);
+// false (the result says which factor) if a factor is not finite.
+bool ISAM2::detach_and_linearize(UpdateWork& work, ISAM2Result& res) {
+  const auto t_lin = Clock::now();
+  find_affected_top(work);
+  res.full_reelimination = work.full;
+  if (!linearize_queued(work, res)) return false;
+  work.factors = factors_to_eliminate(work, res);
+  res.linearize_s = seconds_since(t_lin);
+  build_affected_top(*work.options, work, res);
+  return true;
 }
 
 // Factors eliminated into the new cliques (those with a free variable): every one after a full
@@ -742,7 +808,26 @@ bool ISAM2::eliminate_and_solve(UpdateWork& work, ISAM2Result& res) {
       return true;
     }
     work.lambda = next;
+    // A prepared tree's step moved every variable: damping only this update's top would not
+    // shorten it.
+    if (prepared_ && !work.full) {
+      reeliminate_all(work, res);
+      diag_H.resize(0);
+    }
   }
+}
+
+// Widens the affected top to the whole tree (the linearizations stay).
+void ISAM2::reeliminate_all(UpdateWork& work, ISAM2Result& res) {
+  prepared_ = false;
+  prepared_damped_.clear();
+  work.full = true;
+  res.full_reelimination = true;
+  tree_.clear();
+  work.vars = free_slots(theta_);
+  work.orphans.clear();
+  work.factors = factors_to_eliminate(work, res);
+  build_affected_top(*work.options, work, res);
 }
 
 // diag(H) of the affected top's variables, floored at min_diagonal (zero elsewhere).
@@ -772,9 +857,7 @@ bool ISAM2::factorize_and_solve(UpdateWork& work, const Eigen::VectorXd* damping
   const bool factored = tree_.factorize(work.new_cliques, linearized_, damping, &bad_slot);
   res.eliminate_s += seconds_since(t_factor);
   if (!factored) {  // J is rank deficient: damping would only hide it
-    fail(res, ISAM2Status::kSingular,
-         "the information block of " + theta_.key(bad_slot).to_string() +
-             " is not positive definite (too few factors on it?)");
+    fail_singular(res, bad_slot);
     return false;
   }
   const auto t_solve = Clock::now();
@@ -801,7 +884,11 @@ void ISAM2::carry_damping(const UpdateWork& work, ISAM2Result& res) {
   } else {
     lambda_ = work.lambda;
   }
-  if (work.lambda > 0) damped_vars_ = work.vars;  // the tree holds a damped system for these
+  // The tree holds a damped system for these (a prepared tree's too, below this update's top).
+  if (work.lambda > 0) damped_vars_ = work.vars;
+  if (!work.full) damped_vars_.insert(damped_vars_.end(), prepared_damped_.begin(),
+                                      prepared_damped_.end());
+  prepared_damped_.clear();
   res.error_increased = !work.accepted;
   res.error_evaluated = work.evaluate;
 }

@@ -166,6 +166,14 @@ class ISAM2 {
                      const std::vector<size_t>& removed_factor_indices = {},
                      const Values& new_values = {}, const ISAM2UpdateOptions& options = {});
 
+  /// Moves the linearization point to the estimate (θ ← θ + δ, δ ← 0) for every variable that
+  /// moved, relinearizes their factors and re-eliminates the tree there, with `last` ordered
+  /// near the root. The estimate stays as it is. It is the work an update that relinearizes
+  /// those variables does first, done ahead (e.g. while a planner waits for the next change):
+  /// that update then re-eliminates only what its own changes touch. A failure comes back in
+  /// the result, as in update(); the next update then rebuilds everything.
+  ISAM2Result relinearize_at_estimate(const std::vector<Key>& last = {});
+
   /// Renames every variable, in θ, the estimate and every factor at once (`rename` must keep
   /// distinct keys distinct): the Bayes tree, the linearizations and the estimate stay as they
   /// are, so a graph whose variables are renamed (e.g. a trajectory's steps counted from a later
@@ -208,15 +216,18 @@ class ISAM2 {
   std::vector<int> factors_to_eliminate(const UpdateWork& work, const ISAM2Result& result) const;
   void build_affected_top(const ISAM2UpdateOptions& options, UpdateWork& work,
                           ISAM2Result& result);
+  bool detach_and_linearize(UpdateWork& work, ISAM2Result& result);
   bool eliminate_and_solve(UpdateWork& work, ISAM2Result& result);
   bool factorize_and_solve(UpdateWork& work, const Eigen::VectorXd* damping,
                            ISAM2Result& result);
   void carry_damping(const UpdateWork& work, ISAM2Result& result);
+  void reeliminate_all(UpdateWork& work, ISAM2Result& result);
   void apply_dogleg(ISAM2Result& result);
 
   // Helpers of the steps.
   void mark(int slot, UpdateWork& work);
   void fail(ISAM2Result& result, ISAM2Status status, std::string reason);
+  void fail_singular(ISAM2Result& result, int slot);
   std::vector<int> active_factors() const;
   std::vector<std::vector<int>> elimination_incidence(const UpdateWork& work,
                                                       const std::vector<int>& local) const;
@@ -275,6 +286,8 @@ class ISAM2 {
   std::vector<double> factor_error_;            // per factor: error at the estimate
   std::vector<std::vector<int>> var_factors_;   // per slot: factor indices touching it
   std::vector<int> damped_vars_;                // eliminated with damping last time
+  bool prepared_ = false;  // relinearize_at_estimate built the tree; no update since
+  std::vector<int> prepared_damped_;  // eliminated damped by relinearize_at_estimate
   std::vector<int> stamp_;                      // per slot scratch
   int stamp_counter_ = 0;
   std::vector<int> factor_stamp_;

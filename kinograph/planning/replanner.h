@@ -58,6 +58,9 @@ class Replanner {
   /// Applies `change` to the current problem and plans it (a new request when it has a goal).
   /// Needs a first plan (else status "no_plan").
   Plan replan(const ProblemChange& change);
+  /// Readies the incremental planner for the next change (IncrementalPlanner::prepare) when
+  /// the next request would replan incrementally; call while idle. Returns its wall time [s].
+  double prepare() { return ready_ && options_.use_incremental ? incremental_.prepare() : 0; }
   /// Forgets the current plan (the next request is planned from scratch), e.g. after an error.
   void reset() { ready_ = false; }
 

@@ -124,6 +124,37 @@ TEST(IncrementalPlanner, GoalChangeAroundObstacleMatchesWarmBatch) {
   EXPECT_NEAR(inc.stats.cost, batch.stats.cost, 0.01 * batch.stats.cost);
 }
 
+// Preparing the tree while idle changes no plan: the goal change and the start update after it
+// answer the plans of an unprepared planner, each re-eliminating only the root of the tree.
+TEST(IncrementalPlanner, APreparedTreeAnswersTheSameReplansReeliminatingOnlyTheRoot) {
+  const Problem p = rr_problem();
+  IncrementalPlanner prepared, plain;
+  ASSERT_TRUE(prepared.plan(p).success());
+  ASSERT_TRUE(plain.plan(p).success());
+  const Plan before = prepared.current_plan();
+  EXPECT_GT(prepared.prepare(), 0.0);
+  EXPECT_EQ(prepared.current_plan().q, before.q);
+  Goal g;
+  g.q = Eigen::Vector2d(1.0, 0.9);
+  const Plan a = prepared.set_goal(g);
+  const Plan b = plain.set_goal(g);
+  ASSERT_TRUE(a.success()) << failures(a);
+  ASSERT_TRUE(b.success()) << failures(b);
+  EXPECT_EQ(prepared.last_stats().updates, plain.last_stats().updates);
+  EXPECT_LT(prepared.last_stats().cliques_reeliminated, plain.last_stats().cliques_reeliminated);
+  EXPECT_LT(prepared.last_stats().full_reeliminations, plain.last_stats().full_reeliminations);
+  EXPECT_LT((a.q - b.q).cwiseAbs().maxCoeff(), 1e-6);
+
+  prepared.prepare();
+  const Eigen::Vector2d q0 = p.start_q + Eigen::Vector2d(0.02, -0.01);
+  const Plan c = prepared.update_start(q0, Eigen::Vector2d::Zero());
+  const Plan d = plain.update_start(q0, Eigen::Vector2d::Zero());
+  ASSERT_TRUE(c.success()) << failures(c);
+  ASSERT_TRUE(d.success()) << failures(d);
+  EXPECT_LT(prepared.last_stats().cliques_reeliminated, plain.last_stats().cliques_reeliminated);
+  EXPECT_LT((c.q - d.q).cwiseAbs().maxCoeff(), 1e-6);
+}
+
 // The ball moved onto the current path: the replan goes around it.
 TEST(IncrementalPlanner, ObstacleMovedIntoPathIsAvoided) {
   const Problem p = rr_problem();

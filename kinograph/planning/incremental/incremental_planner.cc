@@ -642,6 +642,17 @@ int IncrementalPlanner::multiplier_round(const std::vector<double>& violations, 
   return readded;
 }
 
+double IncrementalPlanner::prepare() {
+  const auto t0 = Clock::now();
+  if (!tree_) return 0;
+  const std::optional<graph::ISAM2Result> r = tree_->relinearize_at_estimate();
+  if (r && !r->ok()) {
+    spdlog::debug("iDFGP: relinearizing at the plan failed ({}); the next update rebuilds",
+                  r->reason);
+  }
+  return seconds_since(t0);
+}
+
 Plan IncrementalPlanner::set_goal(const Goal& goal) {
   ProblemChange c;
   c.goal = goal;

@@ -92,6 +92,12 @@ class IncrementalPlanner {
   /// the tree's knot m.
   std::string shift_refusal(const Problem& next, int m) const;
 
+  /// Readies the Bayes tree for the next change: relinearizes it at the current plan and
+  /// re-eliminates it there with the start and goal at its root, the work the next replan
+  /// would otherwise do first. Changes no plan, only how soon the next replan answers: call it
+  /// while waiting for a change (e.g. right after answering). Returns its wall time [s].
+  double prepare();
+
   /// Shorthands for a single change.
   Plan set_goal(const Goal& goal);
   Plan add_or_move_obstacle(const collision::Obstacle& obstacle);

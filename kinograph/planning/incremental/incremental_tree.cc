@@ -141,6 +141,23 @@ graph::ISAM2Result IncrementalTree::update(bool force_relinearize, IncrementalSt
   return r;
 }
 
+std::optional<graph::ISAM2Result> IncrementalTree::relinearize_at_estimate() {
+  if (!pending_add_.empty() || !pending_priors_.empty() || !pending_remove_.empty() ||
+      pending_values_.size() > 0) {
+    return std::nullopt;
+  }
+  // The variables a new goal or a new measured start changes: at the root, such a change
+  // re-eliminates only the root.
+  std::vector<graph::Key> last;
+  for (const FactorEntry& e : entries) {
+    if (e.key.role != FactorRole::kStart && e.key.role != FactorRole::kGoal) continue;
+    for (const graph::Key& k : e.factor->keys()) {
+      if (std::find(last.begin(), last.end(), k) == last.end()) last.push_back(k);
+    }
+  }
+  return isam->relinearize_at_estimate(last);
+}
+
 double IncrementalTree::soft_cost(double* violation) const {
   // Slot order, as the ISAM2 graph sums its error: the stopping rule compares these costs.
   std::vector<const FactorEntry*> by_slot(isam->graph().size(), nullptr);

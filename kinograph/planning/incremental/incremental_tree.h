@@ -5,6 +5,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "kinograph/graph/isam2.h"
@@ -53,6 +54,10 @@ struct IncrementalTree {
   void compact_if_sparse();
   /// One ISAM2 update with the queued changes; its counts and time add to `stats`.
   graph::ISAM2Result update(bool force_relinearize, IncrementalStats& stats);
+
+  /// Relinearizes the tree at its estimate with the start's and goal's variables ordered near
+  /// the root (ISAM2::relinearize_at_estimate); nothing (nullopt) while a change is queued.
+  std::optional<graph::ISAM2Result> relinearize_at_estimate();
 
   /// The soft cost (and the worst violation) of the ISAM2 graph at its estimate, in slot order.
   double soft_cost(double* violation = nullptr) const;
