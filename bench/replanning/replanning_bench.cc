@@ -160,8 +160,8 @@ int run(int argc, char** argv) {
            .value("--log-level", "warn|info|debug|trace",
                   [&](const std::string& v) { log_level = spdlog::level::from_str(v); })
            .toggle("--polish-objective", [&] { io.stop_at_first_valid = false; })
-           .toggle("--no-linearize-at-evaluation",
-                   [&] { io.isam2.linearize_at_evaluation = false; })
+           .toggle("--linearize-at-evaluation",
+                   [&] { io.isam2.linearize_at_evaluation = true; })
            .value("--lambda-initial", &io.isam2.lambda_initial)
            .value("--lambda-decrease", &io.isam2.lambda_decrease)
            .value("--lambda-min", &io.isam2.lambda_min)

@@ -89,6 +89,9 @@ graph::ISAM2Options default_incremental_isam2() {
   // Marquardt damping lingers less: while it lasts it stiffens the smooth modes of the
   // trajectory, and each update then bends only part of it.
   o.lambda_decrease = 100;
+  // A replan answers with the first update whose plan validates: the linearization at its
+  // estimate is left to prepare(), which runs after the answer.
+  o.linearize_at_evaluation = false;
   return o;
 }
 

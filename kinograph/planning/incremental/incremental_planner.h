@@ -31,8 +31,8 @@
 namespace kinograph::planning {
 
 /// The ISAM2 settings of the incremental planner: a relinearization threshold below ISAM2's
-/// general one (trajectory variables move by less than that in a replan) and damping that
-/// fades fast.
+/// general one (trajectory variables move by less than that in a replan), damping that fades
+/// fast, and no linearization while the error is evaluated (prepare() linearizes at the plan).
 graph::ISAM2Options default_incremental_isam2();
 
 /// Options of IncrementalPlanner.
