@@ -949,7 +949,13 @@ void PlannerNode::plan_and_publish(const GoalRequest& goal, bool replan, int64_t
   publish_status();
   // Answered: while the node waits for the next change, the incremental planner readies its
   // tree, so that a replan re-eliminates only what its change touches.
-  if (valid) replanner_.prepare();
+  if (!valid) return;
+  try {
+    replanner_.prepare();
+  } catch (const std::exception& e) {  // the next request is planned from scratch
+    spdlog::warn("goal {}: preparing the next replan failed: {}", goal.goal_id, e.what());
+    replanner_.reset();
+  }
 }
 
 void PlannerNode::answer_at_shutdown(const Intake& taken) {
