@@ -167,11 +167,12 @@ class ISAM2 {
                      const Values& new_values = {}, const ISAM2UpdateOptions& options = {});
 
   /// Moves the linearization point to the estimate (θ ← θ + δ, δ ← 0) for every variable that
-  /// moved, relinearizes their factors and re-eliminates the tree there, with `last` ordered
-  /// near the root. The estimate stays as it is. It is the work an update that relinearizes
-  /// those variables does first, done ahead (e.g. while a planner waits for the next change):
-  /// that update then re-eliminates only what its own changes touch. A failure comes back in
-  /// the result, as in update(); the next update then rebuilds everything.
+  /// moved, relinearizes their factors and re-eliminates the tree there (damped with the
+  /// carried λ), with `last` ordered near the root. The estimate stays as it is. It is the work
+  /// a forced update does first, done ahead (e.g. while a planner waits for the next change):
+  /// the next update re-eliminates only what its own changes touch and takes the forced
+  /// update's step (the whole tree is re-eliminated if that step raises the error). A failure
+  /// comes back in the result, as in update(); the next update then rebuilds everything.
   ISAM2Result relinearize_at_estimate(const std::vector<Key>& last = {});
 
   /// Renames every variable, in θ, the estimate and every factor at once (`rename` must keep
