@@ -86,6 +86,42 @@ void BayesTree::detach(const std::vector<int>& marked, std::vector<int>* vars,
   }
 }
 
+int BayesTree::holder(const std::vector<int>& vars) const {
+  const auto has = [](const std::vector<int>& list, int v) {
+    return std::find(list.begin(), list.end(), v) != list.end();
+  };
+  for (int v : vars) {
+    const int id = v < static_cast<int>(clique_of_.size()) ? clique_of_[v] : -1;
+    if (id < 0) continue;
+    const Clique& c = cliques_[id];
+    const bool all = std::all_of(vars.begin(), vars.end(), [&](int u) {
+      return has(c.frontals, u) || has(c.separator, u);
+    });
+    if (all) return id;
+  }
+  return -1;
+}
+
+bool BayesTree::hold(int factor, const std::vector<int>& vars) {
+  const int id = holder(vars);
+  if (id < 0) return false;
+  cliques_[id].factors.push_back(factor);
+  return true;
+}
+
+void BayesTree::release(int factor, const std::vector<int>& vars) {
+  for (int v : vars) {
+    const int c = v < static_cast<int>(clique_of_.size()) ? clique_of_[v] : -1;
+    if (c < 0) continue;
+    std::vector<int>& list = cliques_[c].factors;
+    const auto it = std::find(list.begin(), list.end(), factor);
+    if (it != list.end()) {
+      list.erase(it);
+      return;
+    }
+  }
+}
+
 std::vector<int> BayesTree::build(const std::vector<int>& vars, const std::vector<int>& order,
                                   const std::vector<int>& factors,
                                   const std::vector<LinearizedFactor>& linearized,

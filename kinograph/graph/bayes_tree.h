@@ -74,6 +74,16 @@ class BayesTree {
   void detach(const std::vector<int>& marked, std::vector<int>* vars, std::vector<int>* factors,
               std::vector<int>* orphans);
 
+  /// Gives factor `factor` on the free variables `vars` to a clique that already has all of
+  /// them (frontal or separator), without changing its numbers: for a factor that adds
+  /// nothing (LinearizedFactor::zero). False, and nothing held, if no clique has them all.
+  bool hold(int factor, const std::vector<int>& vars);
+  /// A clique that has all of `vars` (frontal or separator), or −1.
+  int holder(const std::vector<int>& vars) const;
+  /// Takes factor `factor` on `vars` from the clique holding it, if any, without changing its
+  /// numbers: for a removed factor that added nothing.
+  void release(int factor, const std::vector<int>& vars);
+
   /// Symbolic elimination of `vars` in the order `order` (order[k] indexes vars) with the given
   /// factors (all of whose free variables lie in vars) and orphan subtrees (whose separators lie
   /// in vars). Creates the new cliques (supernodes of the elimination tree), assigns factors and

@@ -65,6 +65,9 @@ struct ISAM2::UpdateWork {
   std::vector<int> marked;        // free variables whose cliques must be re-eliminated
   std::vector<int> touched;       // of those, the ones on removed or added factors
   std::vector<int> to_linearize;  // factors to linearize at θ
+  std::vector<int> added;         // factors added by this update
+  std::vector<int> unmarked_new;  // new factors without an active row, on variables one clique has
+  std::vector<int> parked;        // of those, the ones held without re-elimination (sorted)
   bool full = false;              // rebuild the whole tree
   std::vector<int> vars;          // variables of the affected top
   std::vector<int> held;          // factors held by the detached cliques
@@ -358,10 +361,15 @@ ISAM2Result ISAM2::update(const std::vector<FactorPtr>& new_factors,
   ++stamp_counter_;  // a new marking: mark() stamps variables with this counter
   remove_factors(removed_factor_indices, work);
   add_factors(new_factors, work, res);
+  if (!linearize_new_factors(work, res)) {
+    res.total_s = seconds_since(t_start);
+    return res;
+  }
   work.touched = work.marked;
   if (work.evaluate) res.error_before = total_error();
   relinearize(update_options, work, res);
   const bool reeliminate = !work.marked.empty() || needs_full_;
+  if (!reeliminate) park_new_factors(work);
   if (!reeliminate && !prepared_) {  // nothing to re-eliminate, no step left to take
     report_unchanged(work, res);
     res.total_s = seconds_since(t_start);
@@ -524,11 +532,15 @@ void ISAM2::mark(int slot, UpdateWork& work) {
   }
 }
 
-// Removed factors leave their slot empty; their variables are touched.
+// Removed factors leave their slot empty; their variables are touched, unless the factor added
+// nothing to its clique (no active row at θ): then it only leaves the clique's list.
 void ISAM2::remove_factors(const std::vector<size_t>& removed_factor_indices, UpdateWork& work) {
   for (size_t idx : removed_factor_indices) {
+    const LinearizedFactor& lf = linearized_[idx];
+    const bool added_nothing = lf.active && lf.zero;
+    if (added_nothing) tree_.release(static_cast<int>(idx), lf.vars);
     for (int s : factor_slots_[idx]) {
-      mark(s, work);
+      if (!added_nothing) mark(s, work);
       auto& list = var_factors_[s];
       list.erase(std::remove(list.begin(), list.end(), static_cast<int>(idx)), list.end());
     }
@@ -541,13 +553,14 @@ void ISAM2::remove_factors(const std::vector<size_t>& removed_factor_indices, Up
   }
 }
 
-// Added factors are queued for linearization (and their error at the estimate taken, to judge
-// the step); their variables are touched.
+// Added factors are registered (and their error at the estimate taken, to judge the step);
+// linearize_new_factors decides which of their variables are touched.
 void ISAM2::add_factors(const std::vector<FactorPtr>& new_factors, UpdateWork& work,
                         ISAM2Result& res) {
   for (const auto& f : new_factors) {
     const int idx = static_cast<int>(graph_.add(f));
     res.new_factor_indices.push_back(idx);
+    work.added.push_back(idx);
     linearized_.resize(graph_.size());
     at_estimate_.resize(graph_.size());
     at_estimate_ok_.resize(graph_.size(), 0);
@@ -558,11 +571,41 @@ void ISAM2::add_factors(const std::vector<FactorPtr>& new_factors, UpdateWork& w
       const int s = theta_.slot(k);
       factor_slots_[idx].push_back(s);
       var_factors_[s].push_back(idx);
-      mark(s, work);
     }
-    work.to_linearize.push_back(idx);
     if (work.evaluate) factor_error_[idx] = factor_error_at_estimate(idx, scratch_[0]);
   }
+}
+
+// New factors are linearized at θ here. One with an active row, or on variables no clique has
+// together, touches its variables; one without (most collision pairs of a planning graph are
+// clear) changes no clique's numbers and is only held by a clique (park_new_factors).
+bool ISAM2::linearize_new_factors(UpdateWork& work, ISAM2Result& res) {
+  if (needs_full_) {  // the rebuild linearizes every factor
+    for (int idx : work.added) {
+      for (int s : factor_slots_[idx]) mark(s, work);
+    }
+    return true;
+  }
+  if (!linearize_factors(work.added, res)) return false;
+  for (int idx : work.added) {
+    const LinearizedFactor& lf = linearized_[idx];
+    if (lf.zero && tree_.holder(lf.vars) >= 0) {
+      work.unmarked_new.push_back(idx);
+    } else {
+      for (int s : factor_slots_[idx]) mark(s, work);
+    }
+  }
+  return true;
+}
+
+// The unmarked new factors go to a clique that has their variables and was not detached;
+// the others (their clique was) are eliminated with the affected top, which has all their
+// variables: a detached clique's separator lies in its detached ancestors.
+void ISAM2::park_new_factors(UpdateWork& work) {
+  for (int idx : work.unmarked_new) {
+    if (tree_.hold(idx, linearized_[idx].vars)) work.parked.push_back(idx);
+  }
+  std::sort(work.parked.begin(), work.parked.end());
 }
 
 // Variables whose δ moved past the threshold (checked every relinearize_skip-th update), and
@@ -657,22 +700,22 @@ std::vector<int> ISAM2::active_factors() const {
   return factors;
 }
 
-// Linearizes the queued factors at θ; false (the result says which factor) if one is not finite.
-bool ISAM2::linearize_queued(const UpdateWork& work, ISAM2Result& res) {
+// Linearizes `factors` at θ; false (the result says which factor) if one is not finite.
+bool ISAM2::linearize_factors(const std::vector<int>& factors, ISAM2Result& res) {
   const int reused_before = factors_reused_;
   linearized_ok_.resize(graph_.size());
-  for_each_factor(work.to_linearize, linearize_choice_, [this](int f, FactorScratch& w) {
+  for_each_factor(factors, linearize_choice_, [this](int f, FactorScratch& w) {
     linearized_ok_[f] = linearize_factor(f, w);
   });
-  for (int f : work.to_linearize) {
+  for (int f : factors) {
     if (!linearized_ok_[f]) {
       fail(res, ISAM2Status::kNonFinite, non_finite_reason(f));
       return false;
     }
   }
-  res.factors_linearized = static_cast<int>(work.to_linearize.size());
-  res.factors_reused = factors_reused_ - reused_before;
-  for (int f : work.to_linearize) res.factors_zero += linearized_[f].zero ? 1 : 0;
+  res.factors_linearized += static_cast<int>(factors.size());
+  res.factors_reused += factors_reused_ - reused_before;
+  for (int f : factors) res.factors_zero += linearized_[f].zero ? 1 : 0;
   return true;
 }
 
@@ -698,16 +741,17 @@ bool ISAM2::detach_and_linearize(UpdateWork& work, ISAM2Result& res) {
   const auto t_lin = Clock::now();
   find_affected_top(work);
   res.full_reelimination = work.full;
-  if (!linearize_queued(work, res)) return false;
-  work.factors = factors_to_eliminate(work, res);
+  if (!work.full) park_new_factors(work);
+  if (!linearize_factors(work.to_linearize, res)) return false;
+  work.factors = factors_to_eliminate(work);
   res.linearize_s = seconds_since(t_lin);
   build_affected_top(*work.options, work, res);
   return true;
 }
 
 // Factors eliminated into the new cliques (those with a free variable): every one after a full
-// re-elimination, else those the detached cliques held and the new ones.
-std::vector<int> ISAM2::factors_to_eliminate(const UpdateWork& work, const ISAM2Result& res) const {
+// re-elimination, else those the detached cliques held and the new ones not parked.
+std::vector<int> ISAM2::factors_to_eliminate(const UpdateWork& work) const {
   std::vector<int> factors;
   if (work.full) {
     for (size_t f = 0; f < graph_.size(); ++f) {
@@ -718,8 +762,12 @@ std::vector<int> ISAM2::factors_to_eliminate(const UpdateWork& work, const ISAM2
   for (int f : work.held) {
     if (linearized_[f].active && !linearized_[f].vars.empty()) factors.push_back(f);
   }
-  for (int idx : res.new_factor_indices) {
-    if (!linearized_[idx].vars.empty()) factors.push_back(idx);
+  for (int idx : work.added) {
+    if (linearized_[idx].vars.empty() ||
+        std::binary_search(work.parked.begin(), work.parked.end(), idx)) {
+      continue;
+    }
+    factors.push_back(idx);
   }
   return factors;
 }
@@ -826,7 +874,7 @@ void ISAM2::reeliminate_all(UpdateWork& work, ISAM2Result& res) {
   tree_.clear();
   work.vars = free_slots(theta_);
   work.orphans.clear();
-  work.factors = factors_to_eliminate(work, res);
+  work.factors = factors_to_eliminate(work);
   build_affected_top(*work.options, work, res);
 }
 

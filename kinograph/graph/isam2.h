@@ -210,11 +210,13 @@ class ISAM2 {
   void add_factors(const std::vector<FactorPtr>& new_factors, UpdateWork& work,
                    ISAM2Result& result);
   std::vector<int> variables_to_relinearize(const ISAM2UpdateOptions& options) const;
+  bool linearize_new_factors(UpdateWork& work, ISAM2Result& result);
+  void park_new_factors(UpdateWork& work);
   void relinearize(const ISAM2UpdateOptions& options, UpdateWork& work, ISAM2Result& result);
   void report_unchanged(const UpdateWork& work, ISAM2Result& result) const;
   void find_affected_top(UpdateWork& work);
-  bool linearize_queued(const UpdateWork& work, ISAM2Result& result);
-  std::vector<int> factors_to_eliminate(const UpdateWork& work, const ISAM2Result& result) const;
+  bool linearize_factors(const std::vector<int>& factors, ISAM2Result& result);
+  std::vector<int> factors_to_eliminate(const UpdateWork& work) const;
   void build_affected_top(const ISAM2UpdateOptions& options, UpdateWork& work,
                           ISAM2Result& result);
   bool detach_and_linearize(UpdateWork& work, ISAM2Result& result);
@@ -302,7 +304,7 @@ class ISAM2 {
   std::array<FactorScratch, kMaxWorkers> scratch_;
   std::vector<int> any_worker_, caller_only_, refreshed_;
   ShareOutChoice linearize_choice_, refresh_choice_;
-  std::vector<char> linearized_ok_;  // per factor: its last linearize_queued succeeded
+  std::vector<char> linearized_ok_;  // per factor: its last linearize_factors succeeded
 };
 
 }  // namespace kinograph::graph

@@ -414,6 +414,75 @@ TEST(ISAM2, FactorsWithoutActiveRowsAddNothingUntilTheyTurnActive) {
   EXPECT_NEAR(isam.error(), reference.error(optimum), 1e-9 * reference.error(optimum));
 }
 
+TEST(ISAM2, FactorsAddedOrRemovedWithoutActiveRowsReeliminateNothing) {
+  // Limits on the middle of the chain that hold change no clique: adding and removing them
+  // re-eliminates nothing and leaves every conditional as it was. One stays, and must act once
+  // the chain is pulled past it: a limit the tree did not hold would let the point through.
+  const int n = 20, mid = n / 2;
+  Chain chain = make_chain(n, Eigen::Vector2d(3, 1));
+  ISAM2Options opt;
+  opt.wildfire_threshold = 0;
+  opt.relinearize_threshold = 1e9;  // linear chain: nothing to relinearize
+  ISAM2 isam(opt);
+  auto res = isam.update(chain.factors, {}, chain.values);
+  ASSERT_TRUE(res.ok()) << res.reason;
+  const size_t goal = res.new_factor_indices[chain.goal_index];
+  const double x_mid = isam.estimate().at(X(mid))[0];
+
+  const BayesTree& tree = isam.bayes_tree();
+  auto conditionals = [&tree] {
+    std::map<int, Eigen::MatrixXd> R;
+    for (int c = 0; c < tree.clique_capacity(); ++c) {
+      if (tree.clique(c).alive) R[c] = tree.clique(c).R;
+    }
+    return R;
+  };
+  const std::map<int, Eigen::MatrixXd> before = conditionals();
+  const Values estimate = isam.estimate();
+  std::vector<FactorPtr> limits;
+  for (int i = mid - 2; i <= mid + 2; ++i) {
+    limits.push_back(std::make_shared<UpperLimitFactor>(X(i), x_mid + 10, isotropic(1, 0.01)));
+  }
+  res = isam.update(limits, {});
+  ASSERT_TRUE(res.ok()) << res.reason;
+  EXPECT_EQ(res.factors_zero, static_cast<int>(limits.size()));
+  EXPECT_EQ(res.variables_reeliminated, 0);
+  EXPECT_EQ(res.cliques_reeliminated, 0);
+  EXPECT_EQ(conditionals(), before);
+  EXPECT_EQ(isam.estimate().vector(), estimate.vector());
+  ASSERT_EQ(isam.check_invariants(), "");  // every limit is held by exactly one clique
+  std::vector<size_t> limit_index = res.new_factor_indices;
+
+  // All but the middle one go again.
+  std::vector<size_t> removed = limit_index;
+  removed.erase(removed.begin() + 2);
+  res = isam.update({}, removed);
+  ASSERT_TRUE(res.ok()) << res.reason;
+  EXPECT_EQ(res.cliques_reeliminated, 0);
+  EXPECT_EQ(conditionals(), before);
+  ASSERT_EQ(isam.check_invariants(), "");
+
+  // A goal that pulls the chain far along x: the middle limit turns active as the updates go.
+  const double limit = x_mid + 10;
+  auto far = std::make_shared<PriorFactor>(X(n - 1), Eigen::Vector2d(60, 1), isotropic(2, 0.1));
+  ASSERT_TRUE(isam.update({far}, {goal}).ok());
+  ISAM2UpdateOptions force;
+  force.force_relinearize = true;
+  for (int it = 0; it < 40; ++it) ASSERT_TRUE(isam.update({}, {}, {}, force).ok());
+  ASSERT_EQ(isam.check_invariants(), "");
+  FactorGraph reference;
+  for (size_t i = 0; i < chain.factors.size(); ++i) {
+    if (i != chain.goal_index) reference.add(chain.factors[i]);
+  }
+  reference.add(far);
+  const Values unlimited = batch_optimum(reference, chain.values);
+  ASSERT_GT(unlimited.at(X(mid))[0], limit + 1);  // without the limit the point passes it
+  reference.add(limits[2]);
+  const Values optimum = batch_optimum(reference, chain.values);
+  EXPECT_LT(optimum.at(X(mid))[0], limit + 0.5);
+  EXPECT_LT((isam.estimate().vector() - optimum.vector()).cwiseAbs().maxCoeff(), 1e-4);
+}
+
 TEST(ISAM2, ThresholdRelinearizationReachesTheOptimumWithoutForcing) {
   // Same kind of problem, one batch insert, then plain updates with a small threshold.
   ISAM2Options opt;
