@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/common/bench_flags.h"
 #include "bench/common/bench_stats.h"
 #include "bench/common/between_knots_measure.h"
 #include "kinograph/dynamics/inverse_dynamics.h"
@@ -30,21 +31,20 @@ int run(int argc, char** argv) {
   std::vector<int> grids = {50, 100, 200, 400};
   int repeats = 3, points = 10;
   std::string json_path;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--repeats" && i + 1 < argc) {
-      repeats = std::stoi(argv[++i]);
-    } else if (a == "--points" && i + 1 < argc) {
-      points = std::stoi(argv[++i]);
-    } else if (a == "--steps" && i + 1 < argc) {
-      grids = {std::stoi(argv[++i])};
-    } else if (a == "--json" && i + 1 < argc) {
-      json_path = argv[++i];
-    } else {
-      std::cerr << "usage: between_knots_bench [--steps N] [--repeats N] [--points N] "
-                   "[--json FILE]\n";
-      return 1;
-    }
+  int steps = 0;
+  if (!bench::Flags("between_knots_bench")
+           .value("--steps", &steps)
+           .value("--repeats", &repeats)
+           .value("--points", &points)
+           .value("--json", &json_path)
+           .parse(argc, argv)) {
+    return 64;
+  }
+  if (steps > 0) grids = {steps};
+  if (repeats < 1 || points < 0 || steps < 0) {
+    std::cerr << "between_knots_bench: --repeats must be at least 1, --steps and --points "
+                 "not negative\n";
+    return 64;
   }
   spdlog::set_level(spdlog::level::warn);
   const planning::Scene scene = planning::load_scene(std::string(KINOGRAPH_SOURCE_DIR) +

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/common/bench_flags.h"
 #include "bench/common/bench_stats.h"
 #include "kinograph/collision/collision_world.h"
 #include "kinograph/collision/segment_checker.h"
@@ -19,6 +20,7 @@
 #include "kinograph/planning/validate.h"
 
 using namespace kinograph;
+using bench::Flags;
 using bench::median;
 using Clock = std::chrono::steady_clock;
 
@@ -38,7 +40,12 @@ double median_ms(int reps, F&& f) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const int reps = argc > 1 ? std::stoi(argv[1]) : 51;
+  int reps = 51;
+  if (!Flags("validate_bench").value("--reps", &reps).parse(argc, argv)) return 64;
+  if (reps < 1) {
+    std::cerr << "validate_bench: --reps must be at least 1\n";
+    return 64;
+  }
   spdlog::set_level(spdlog::level::warn);
   nlohmann::json out;
   std::cout << std::fixed << std::setprecision(2);
