@@ -11,17 +11,11 @@ namespace {
 // A pivot this small relative to the diagonal of A means H is singular to working precision
 // (the same test as SparseCholesky's).
 constexpr double kPivotTolerance = 1e-14;
-
-double dot(const double* a, const double* b, int n) {
-  return n > 0 ? Eigen::Map<const Eigen::VectorXd>(a, n).dot(Eigen::Map<const Eigen::VectorXd>(b, n))
-               : 0.0;
-}
 }  // namespace
 
 EnvelopeCholesky::EnvelopeCholesky(int n, const std::vector<int>& col_ptr,
                                    const std::vector<int>& row_idx)
-    : n_(n), col_ptr_(col_ptr), row_idx_(row_idx), first_(n), start_(n + 1) {
-  start_[0] = 0;
+    : n_(n), col_ptr_(col_ptr), row_idx_(row_idx), first_(n) {
   for (int j = 0; j < n; ++j) {
     // Column j of the upper triangle is row j of the lower one: its first row is the row's
     // first column, its last the diagonal.
@@ -30,10 +24,25 @@ EnvelopeCholesky::EnvelopeCholesky(int n, const std::vector<int>& col_ptr,
                                   " has no diagonal entry");
     }
     first_[j] = row_idx[col_ptr[j]];
-    start_[j + 1] = start_[j] + (j - first_[j] + 1);
+  }
+  const int groups = (n + kGroupRows - 1) / kGroupRows;
+  group_first_.resize(groups);
+  group_start_.resize(groups + 1);
+  group_start_[0] = 0;
+  for (int g = 0; g < groups; ++g) {
+    const int r0 = g * kGroupRows, r1 = std::min(n, r0 + kGroupRows);
+    group_first_[g] = *std::min_element(first_.begin() + r0, first_.begin() + r1);
+    group_start_[g + 1] =
+        group_start_[g] + static_cast<long>(r0 + kGroupRows - group_first_[g]) * kGroupRows;
   }
   values_.assign(row_idx.size(), 0.0);
-  env_.assign(static_cast<size_t>(start_[n]), 0.0);
+  env_.assign(static_cast<size_t>(group_start_[groups]), 0.0);
+  value_at_.resize(row_idx.size());
+  for (int j = 0; j < n; ++j) {
+    for (int p = col_ptr[j]; p < col_ptr[j + 1]; ++p) {
+      value_at_[p] = &entry(j, row_idx[p]) - env_.data();
+    }
+  }
 }
 
 double EnvelopeCholesky::flops(int n, const std::vector<int>& col_ptr,
@@ -63,45 +72,91 @@ bool EnvelopeCholesky::wins(int n, const std::vector<int>& col_ptr,
 bool EnvelopeCholesky::factorize() {
   failed_column_ = -1;
   std::fill(env_.begin(), env_.end(), 0.0);
-  for (int j = 0; j < n_; ++j) {
-    double* row = env_.data() + start_[j] - first_[j];  // row[k] = L(j, k)
-    for (int p = col_ptr_[j]; p < col_ptr_[j + 1]; ++p) row[row_idx_[p]] = values_[p];
-  }
-  for (int j = 0; j < n_; ++j) {
-    const int fj = first_[j];
-    double* Lj = env_.data() + start_[j] - fj;
-    for (int k = fj; k < j; ++k) {
-      const int fk = first_[k];
-      const double* Lk = env_.data() + start_[k] - fk;
-      const int from = std::max(fj, fk);
-      Lj[k] = (Lj[k] - dot(Lj + from, Lk + from, k - from)) / Lk[k];
+  for (size_t p = 0; p < values_.size(); ++p) env_[static_cast<size_t>(value_at_[p])] = values_[p];
+  using Column = Eigen::Matrix<double, kGroupRows, 1>;
+  const int groups = static_cast<int>(group_first_.size());
+  for (int g = 0; g < groups; ++g) {
+    const int r0 = g * kGroupRows, rows = std::min(n_, r0 + kGroupRows) - r0;
+    const int F = group_first_[g];
+    double* B = env_.data() + group_start_[g];  // B + kGroupRows·(c − F): column c of the group
+    // Left-looking, column by column: column k of the group's rows needs row k of L up to k.
+    for (int k = F; k < r0 + rows; ++k) {
+      const int h = k / kGroupRows;
+      const double* Lk = env_.data() + group_start_[h] + k % kGroupRows;  // stride kGroupRows
+      const int Fh = group_first_[h];
+      const int from = std::max(F, Fh);
+      // acc = Σ_c B(:, c) L(k, c) over c in [from, k), in two chains for throughput.
+      Column acc0 = Column::Zero(), acc1 = Column::Zero();
+      int c = from;
+      for (; c + 1 < k; c += 2) {
+        acc0.noalias() += Eigen::Map<const Column>(B + kGroupRows * (c - F)) *
+                          Lk[kGroupRows * (c - Fh)];
+        acc1.noalias() += Eigen::Map<const Column>(B + kGroupRows * (c + 1 - F)) *
+                          Lk[kGroupRows * (c + 1 - Fh)];
+      }
+      if (c < k) {
+        acc0.noalias() += Eigen::Map<const Column>(B + kGroupRows * (c - F)) *
+                          Lk[kGroupRows * (c - Fh)];
+      }
+      acc0 += acc1;
+      double* Bk = B + kGroupRows * (k - F);
+      if (k < r0) {
+        const double l_kk = Lk[kGroupRows * (k - Fh)];
+        for (int i = 0; i < rows; ++i) Bk[i] = (Bk[i] - acc0[i]) / l_kk;
+        continue;
+      }
+      // k is the group's own row i0: its diagonal, then the rows below it in the group.
+      const int i0 = k - r0;
+      const double a_kk = Bk[i0];
+      const double d = a_kk - acc0[i0];
+      if (!(d > kPivotTolerance * std::abs(a_kk))) {
+        failed_column_ = k;
+        return false;
+      }
+      const double l_kk = std::sqrt(d);
+      Bk[i0] = l_kk;
+      for (int i = i0 + 1; i < rows; ++i) Bk[i] = (Bk[i] - acc0[i]) / l_kk;
     }
-    const double a_jj = Lj[j];
-    const double d = a_jj - dot(Lj + fj, Lj + fj, j - fj);
-    if (!(d > kPivotTolerance * std::abs(a_jj))) {
-      failed_column_ = j;
-      return false;
-    }
-    Lj[j] = std::sqrt(d);
   }
   return true;
 }
 
 void EnvelopeCholesky::solve(const Eigen::Ref<const Eigen::VectorXd>& b,
                              Eigen::Ref<Eigen::VectorXd> x) {
+  using Column = Eigen::Matrix<double, kGroupRows, 1>;
   x = b;
   double* xs = x.data();
-  for (int j = 0; j < n_; ++j) {  // L y = b, row by row
-    const int fj = first_[j];
-    const double* Lj = env_.data() + start_[j] - fj;
-    xs[j] = (xs[j] - dot(Lj + fj, xs + fj, j - fj)) / Lj[j];
+  const int groups = static_cast<int>(group_first_.size());
+  // L y = b by groups: the columns left of a group at once, then its own triangle.
+  for (int g = 0; g < groups; ++g) {
+    const int r0 = g * kGroupRows, rows = std::min(n_, r0 + kGroupRows) - r0;
+    const int F = group_first_[g];
+    const double* B = env_.data() + group_start_[g];
+    Column acc = Column::Zero();
+    for (int c = F; c < r0; ++c) {
+      acc.noalias() += Eigen::Map<const Column>(B + kGroupRows * (c - F)) * xs[c];
+    }
+    for (int i = 0; i < rows; ++i) {
+      double s = xs[r0 + i] - acc[i];
+      for (int m = 0; m < i; ++m) s -= B[kGroupRows * (r0 + m - F) + i] * xs[r0 + m];
+      xs[r0 + i] = s / B[kGroupRows * (r0 + i - F) + i];
+    }
   }
-  for (int j = n_ - 1; j >= 0; --j) {  // Lᵀ x = y, row j of L is column j of Lᵀ
-    const int fj = first_[j];
-    const double* Lj = env_.data() + start_[j] - fj;
-    xs[j] /= Lj[j];
-    const double xj = xs[j];
-    Eigen::Map<Eigen::VectorXd>(xs + fj, j - fj) -= xj * Eigen::Map<const Eigen::VectorXd>(Lj + fj, j - fj);
+  // Lᵀ x = y by groups from the last: its own triangle, then the columns left of it at once.
+  for (int g = groups - 1; g >= 0; --g) {
+    const int r0 = g * kGroupRows, rows = std::min(n_, r0 + kGroupRows) - r0;
+    const int F = group_first_[g];
+    const double* B = env_.data() + group_start_[g];
+    Column xg = Column::Zero();
+    for (int i = rows - 1; i >= 0; --i) {
+      double s = xs[r0 + i];
+      for (int m = i + 1; m < rows; ++m) s -= B[kGroupRows * (r0 + i - F) + m] * xg[m];
+      xg[i] = s / B[kGroupRows * (r0 + i - F) + i];
+      xs[r0 + i] = xg[i];
+    }
+    for (int c = F; c < r0; ++c) {
+      xs[c] -= Eigen::Map<const Column>(B + kGroupRows * (c - F)).dot(xg);
+    }
   }
 }
 

@@ -2,7 +2,7 @@
 // Dense Cholesky LLᵀ inside the envelope (profile) of a symmetric matrix: row j of L is stored
 // from its first nonzero column to the diagonal, and no fill falls outside. For a trajectory
 // graph in time order the envelope is a band of about two states, so the factorization is a
-// sequence of contiguous dot products, several times cheaper than a general sparse one.
+// sequence of short dense products, several times cheaper than a general sparse one.
 #include <Eigen/Core>
 #include <vector>
 
@@ -29,16 +29,25 @@ class EnvelopeCholesky final : public CholeskyFactor {
   /// multiply-adds a factorization without any fill would (true for banded patterns).
   static bool wins(int n, const std::vector<int>& col_ptr, const std::vector<int>& row_idx);
 
-  /// Stored entries of L (the envelope's size).
-  long envelope_size() const { return static_cast<long>(env_.size()); }
+  // L is stored by groups of kGroupRows consecutive rows, each group from the first column of
+  // any of its rows to its last row, column-major: a column of a group is a short contiguous
+  // vector, so the factorization's inner loop updates every row of a group at once.
+  static constexpr int kGroupRows = 4;
+  // L(j, c) for c at or right of the first column of j's group.
+  double& entry(int j, int c) {
+    const int g = j / kGroupRows;
+    return env_[static_cast<size_t>(group_start_[g] + (c - group_first_[g]) * kGroupRows +
+                                    j % kGroupRows)];
+  }
 
- private:
   int n_;
   std::vector<int> col_ptr_, row_idx_;
-  std::vector<int> first_;   // row j of L: first stored column
-  std::vector<long> start_;  // row j of L: offset of column first_[j] in env_
-  std::vector<double> values_;  // A's upper triangle, pattern order
-  std::vector<double> env_;     // L by rows within the envelope
+  std::vector<int> first_;          // row j of L: first column within the envelope
+  std::vector<int> group_first_;    // group g: first column stored (its rows' smallest first_)
+  std::vector<long> group_start_;   // group g: offset of its first stored column in env_
+  std::vector<long> value_at_;      // A's entry p (pattern order): its place in env_
+  std::vector<double> values_;      // A's upper triangle, pattern order
+  std::vector<double> env_;         // L by groups of rows
   int failed_column_ = -1;
 };
 

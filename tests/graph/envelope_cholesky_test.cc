@@ -83,6 +83,20 @@ TEST(EnvelopeCholesky, BlockBandedMatrixSolvesLikeDenseLlt) {
   expect_solves_like_dense(A, upper_pattern(A, block_band));
 }
 
+TEST(EnvelopeCholesky, RaggedEnvelopeSolvesLikeDenseLlt) {
+  // Every row starts at its own column and the size is no multiple of the rows stored
+  // together: rows of a group padded to the group's first column, and a last partial group.
+  for (int n : {1, 2, 5, 37, 38, 39, 40}) {
+    std::mt19937 rng(11 + n);
+    std::uniform_int_distribution<int> reach(0, 12);
+    std::vector<int> first(n);
+    for (int j = 0; j < n; ++j) first[j] = std::max(0, j - reach(rng));
+    const auto ragged = [&first](int i, int j) { return i >= first[j]; };
+    const Eigen::MatrixXd A = random_spd(n, 20 + n, ragged);
+    expect_solves_like_dense(A, upper_pattern(A, ragged));
+  }
+}
+
 TEST(EnvelopeCholesky, NotPositiveDefiniteInsideAStateNamesTheColumn) {
   Eigen::MatrixXd A = random_spd(7 * 10, 6, block_band);
   A(7 * 4 + 3, 7 * 4 + 3) = -1.0;

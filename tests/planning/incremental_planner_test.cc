@@ -385,11 +385,13 @@ TEST(Replanner, MotionGoneOnAlongThePlanShiftsTheTree) {
 TEST(Replanner, AFailedReplanFallsBackToTheBatchPlannersWarmStart) {
   const Scene scene = load_scene(kScenes + "iiwa_desk.yaml");
   GoalSampler sampler(scene.problem, bench::iiwa_goal_options(1));
-  const std::vector<Eigen::VectorXd> goals = sampler.sample(12);
-  ASSERT_EQ(goals.size(), 12u);
+  // A desk move whose incremental replan does not validate and whose warm batch solve does
+  // (the 20th of the replanning benchmark's draws; most replan incrementally).
+  const std::vector<Eigen::VectorXd> goals = sampler.sample(20);
+  ASSERT_EQ(goals.size(), 20u);
   Problem first = scene.problem;
-  first.goal.q = goals[8];
-  std::mt19937_64 rng(5008);
+  first.goal.q = goals[19];
+  std::mt19937_64 rng(5019);
   std::uniform_real_distribution<double> u(-0.05, 0.05);
   collision::Obstacle top = first.obstacles[0];
   Problem moved = first;
@@ -410,7 +412,9 @@ TEST(Replanner, AFailedReplanFallsBackToTheBatchPlannersWarmStart) {
   ASSERT_TRUE(re.success()) << failures(re) << re.stats.reason;
   EXPECT_TRUE(replanner.last_report().fell_back);
   EXPECT_EQ(replanner.last_report().method, "batch after incremental");
-  const Plan warm = BatchPlanner(options.incremental.batch).plan(moved, &plan);
+  // The answer is the incremental planner's warm-started solve of the moved problem (a batch
+  // solve from the first plan, settled in the tree).
+  const Plan warm = IncrementalPlanner(options.incremental).plan(moved, &plan);
   ASSERT_TRUE(warm.success());
   EXPECT_NEAR(re.stats.cost, warm.stats.cost, 1e-6 * warm.stats.cost);
   // The tree carries the recovered plan: the goal moved a little replans incrementally.
