@@ -15,7 +15,8 @@ constexpr double kPivotTolerance = 1e-14;
 
 EnvelopeCholesky::EnvelopeCholesky(int n, const std::vector<int>& col_ptr,
                                    const std::vector<int>& row_idx)
-    : n_(n), col_ptr_(col_ptr), row_idx_(row_idx), first_(n) {
+    : n_(n) {
+  std::vector<int> first(n);  // row j of L: first column within the envelope
   for (int j = 0; j < n; ++j) {
     // Column j of the upper triangle is row j of the lower one: its first row is the row's
     // first column, its last the diagonal.
@@ -23,7 +24,7 @@ EnvelopeCholesky::EnvelopeCholesky(int n, const std::vector<int>& col_ptr,
       throw std::invalid_argument("EnvelopeCholesky: column " + std::to_string(j) +
                                   " has no diagonal entry");
     }
-    first_[j] = row_idx[col_ptr[j]];
+    first[j] = row_idx[col_ptr[j]];
   }
   const int groups = (n + kGroupRows - 1) / kGroupRows;
   group_first_.resize(groups);
@@ -31,7 +32,7 @@ EnvelopeCholesky::EnvelopeCholesky(int n, const std::vector<int>& col_ptr,
   group_start_[0] = 0;
   for (int g = 0; g < groups; ++g) {
     const int r0 = g * kGroupRows, r1 = std::min(n, r0 + kGroupRows);
-    group_first_[g] = *std::min_element(first_.begin() + r0, first_.begin() + r1);
+    group_first_[g] = *std::min_element(first.begin() + r0, first.begin() + r1);
     group_start_[g + 1] =
         group_start_[g] + static_cast<long>(r0 + kGroupRows - group_first_[g]) * kGroupRows;
   }

@@ -41,9 +41,7 @@ class EnvelopeCholesky final : public CholeskyFactor {
   }
 
   int n_;
-  std::vector<int> col_ptr_, row_idx_;
-  std::vector<int> first_;          // row j of L: first column within the envelope
-  std::vector<int> group_first_;    // group g: first column stored (its rows' smallest first_)
+  std::vector<int> group_first_;    // group g: first column stored (its rows' smallest first)
   std::vector<long> group_start_;   // group g: offset of its first stored column in env_
   std::vector<long> value_at_;      // A's entry p (pattern order): its place in env_
   std::vector<double> values_;      // A's upper triangle, pattern order
