@@ -257,7 +257,9 @@ Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init, const s
     between.limits =
         intervals_near_limits(problem, plan_from_trajectory(problem, init), kNearLimit);
   }
-  bool added_to_converged = false;  // this round only adds limit rows to a converged solve
+  // This round's rows follow a converged solve that may already hold them all: limit rows
+  // added to it, or the interpolant's rows after a converged warm-up.
+  bool after_converged = false;
   for (int round = 0;; ++round) {
     PlanningGraph next;
     std::vector<DfgConstraintStep> dfg_steps;
@@ -278,13 +280,15 @@ Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init, const s
     OuterLoopOptions loop = dfg_steps.empty() ? options_.outer_loop : outer_loop_options(options_);
     // Limit rows added to a converged solve that it already keeps change nothing: the solve was
     // the optimum of a relaxation of this graph, and it is feasible here, so it is this one's.
-    if (added_to_converged) {
+    // A converged warm-up that already holds the interpolant's rows is kept too: its objective
+    // is that of a graph differing only in the RK4 step, and every row of this one holds.
+    if (after_converged) {
       const ConstraintReport worst = worst_constraint(pg.constraints(false), pg.values);
       if (worst.scaled_violation <= loop.constraint_tolerance) {
         // The new rows' multipliers start at zero, as a solve would start them.
         for (const FactorEntry* e : pg.constraints(false)) state.bind(*e);
         r.worst = worst;
-        spdlog::debug("{}: interval round {}: the added limit points hold (worst {:.3g}); not "
+        spdlog::debug("{}: interval round {}: the last solve holds its rows (worst {:.3g}); not "
                       "re-solved", problem.name, round, worst.scaled_violation);
         break;
       }
@@ -294,7 +298,12 @@ Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init, const s
     // A re-solve starts feasible but for the rows just added: at the largest penalty it is a
     // projection onto them (the multipliers carry the objective's balance), where a smaller one
     // lets LM trade feasibility for the objective first and spend many more linearizations.
-    if (round > 0 || from_interpolant) state.set_penalty(options_.augmented_lagrangian.max_penalty);
+    // It also starts at the final inner tolerance: a looser first LM solve would be followed
+    // by one more at the final tolerance, a relinearization that moves almost nothing.
+    if (round > 0 || from_interpolant) {
+      state.set_penalty(options_.augmented_lagrangian.max_penalty);
+      loop.inner_tolerance_initial = loop.inner_tolerance_final;
+    }
     const OuterLoopResult stage = solve_outer_loop(pg.graph, pg.values, al, loop, problem.name);
     const int before = r.iterations, before_outer = r.outer_iterations,
               before_solves = r.linear_solves;
@@ -326,11 +335,12 @@ Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init, const s
     }
     if (!on_interpolant) {
       between.integration_step = kMaxIntegrationStep;
+      after_converged = r.status == PlanStatus::kConverged;
       continue;
     }
     if (!added) break;
     between.knots_only = false;
-    added_to_converged = r.status == PlanStatus::kConverged;
+    after_converged = r.status == PlanStatus::kConverged;
   }
   if (r.status == PlanStatus::kInfeasible) r.reason = infeasible_reason(problem, r);
 

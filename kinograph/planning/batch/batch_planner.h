@@ -71,7 +71,8 @@ struct BatchPlannerOptions {
   /// RK4 step (s) of a warm-up solve between the knot-only solve and the one on the
   /// interpolant, for robots with an unactuated joint: the same rows (shooting defects, limit
   /// points) integrated in steps this long, which cost a fraction of the interpolant's
-  /// kMaxIntegrationStep and leave the final solve a short projection. Used only when it takes
+  /// kMaxIntegrationStep and leave the final solve on the interpolant a short projection, or
+  /// none when the warm-up already holds the interpolant's rows. Used only when it takes
   /// fewer steps per interval than the interpolant; 0 = off.
   double warmup_integration_step = 0.05;
   /// Grid refinement (grid_refinement.h): a problem whose steps have a coarser grid with
