@@ -1,5 +1,6 @@
-// iiwa14 dynamics microbenchmarks: RNEA, RNEA with all derivatives, mass matrix, forward
-// dynamics, forward kinematics. Run with
+// Dynamics microbenchmarks: on the iiwa14 RNEA, RNEA with all derivatives, mass matrix,
+// forward dynamics, forward kinematics; on the Acrobot the passive-joint dynamics of the
+// shooting rows. Run with
 //   bench_dynamics --benchmark_repetitions=10 --benchmark_report_aggregates_only=true
 //                  --benchmark_out=dynamics.json --benchmark_out_format=json
 // The console shows Google Benchmark's usual output followed by a Markdown table of medians
@@ -93,6 +94,27 @@ void BM_ForwardKinematics(benchmark::State& state) {
 }
 BENCHMARK(BM_ForwardKinematics);
 
+// The Acrobot with its shoulder passive: one RK4 stage of the planner's shooting rows, with and
+// without the derivatives its sensitivities need.
+struct AcrobotFixture {
+  kd::Model model =
+      kd::Model::from_urdf_file(std::string(KINOGRAPH_SOURCE_DIR) + "/robots/acrobot/acrobot.urdf");
+  kd::Data data{model};
+  Eigen::Vector2d q{0.7, -1.3}, qd{1.1, 2.4}, qdd{0.0, 3.0};
+  std::vector<int> passive{0};
+};
+
+void BM_AcrobotPassiveDynamics(benchmark::State& state) {
+  static AcrobotFixture f;
+  const bool derivatives = state.range(0) != 0;
+  for (auto _ : state) {
+    kd::passive_dynamics(f.model, f.data, f.q, f.qd, f.qdd, f.passive, derivatives);
+    benchmark::DoNotOptimize(f.data.qdd.data());
+    benchmark::ClobberMemory();
+  }
+}
+BENCHMARK(BM_AcrobotPassiveDynamics)->Arg(0)->Arg(1);
+
 // Console output as usual, plus a Markdown table of the median (or single-run) times.
 class MarkdownReporter : public benchmark::ConsoleReporter {
  public:
@@ -108,7 +130,7 @@ class MarkdownReporter : public benchmark::ConsoleReporter {
   }
   void Finalize() override {
     ConsoleReporter::Finalize();
-    std::printf("\n| benchmark (iiwa14) | median real time | median CPU time |\n|---|---|---|\n");
+    std::printf("\n| benchmark (iiwa14; Acrobot: AcrobotPassiveDynamics, /1 with derivatives) | median real time | median CPU time |\n|---|---|---|\n");
     for (const Row& r : rows_) {
       std::printf("| %s | %.0f %s | %.0f %s |\n", r.name.c_str(), r.real, r.unit, r.cpu, r.unit);
     }

@@ -5,16 +5,6 @@
 namespace kinograph::dynamics {
 namespace {
 
-// B(h) with [ad_X]^T h = B(h) X, for a wrench h = [m; f]: the wrench bracket seen as a
-// function of the twist X. Note B(h)^T = −B(h).
-Matrix6 wrench_bracket(const Vector6& h) {
-  Matrix6 B;
-  const Eigen::Matrix3d m = skew(h.head<3>());
-  const Eigen::Matrix3d f = skew(h.tail<3>());
-  B << m, f, f, Eigen::Matrix3d::Zero();
-  return B;
-}
-
 // World-frame spatial inertia of body i from its mass, COM and inertia about the COM.
 void world_inertia(const Data::Scratch& s, int i, const Eigen::Isometry3d& T, Matrix6& I) {
   const double m = s.mass[i];
@@ -175,27 +165,27 @@ void world_acceleration_pass(const Model& model, Data& data, const VectorRef& qd
   for (int i = 0; i < n; ++i) data.tau[i] = s.S[i].dot(s.Fw[i]) + model.bodies[i].damping * qd[i];
 }
 
-// ∂τ/∂q, ∂τ/∂q̇ and M from the world passes at the same q, q̇; and the body-frame V, V̇, F.
-void derivative_assembly(const Model& model, Data& data) {
+// ∂τ/∂q, ∂τ/∂q̇ and M from the world passes at the same q, q̇; with `body_frame` also the
+// body-frame V, V̇, F that rnea gives.
+void derivative_assembly(const Model& model, Data& data, bool body_frame) {
   const int n = model.nq();
   auto& s = data.scratch;
-  // Per body: rows S_i^T Ic_i, S_i^T Bc_i (Bc = Ec^T), S_i^T Dc_i (Dc = B(hc) + Ec), and the
+  // Per body: rows S_i^T Ic_i, S_i^T Bc_i (Bc = Ec^T), S_i^T Dc_i (Dc = B(hc) + Ec, with
+  // B(h) X = [ad_X]^T h the wrench bracket, so B(hc) X is one cross-product pair), and the
   // derivative of its own subtree wrench with respect to its own q_i and q̇_i.
   for (int i = 0; i < n; ++i) {
     const Vector6& S = s.S[i];
-    const Matrix6 B = wrench_bracket(s.hc[i]);
+    const Vector6 BS = ad_transpose_apply(S, s.hc[i]);
+    const Vector6 EtS = s.Ec[i].transpose() * S;
     s.SIc[i].noalias() = s.Ic[i] * S;
     s.SBc[i].noalias() = s.Ec[i] * S;
-    s.SDc[i].noalias() = s.Ec[i].transpose() * S;
-    s.SDc[i].noalias() -= B * S;
-    const Matrix6 Dc = B + s.Ec[i];
-    s.dF_dq[i] = -ad_transpose_apply(S, s.Fw[i]);
+    s.SDc[i] = EtS - BS;  // Dc^T S, as B(h)^T = −B(h)
+    s.dF_dq[i] = ad_transpose_apply(s.beta[i], s.hc[i]) - ad_transpose_apply(S, s.Fw[i]);
     s.dF_dq[i].noalias() -= s.Ic[i] * s.alpha[i];
     s.dF_dq[i].noalias() -= s.Ec[i].transpose() * s.Sdot[i];
-    s.dF_dq[i].noalias() += Dc * s.beta[i];
+    s.dF_dq[i].noalias() += s.Ec[i] * s.beta[i];
     s.dF_dqd[i].noalias() = s.Ic[i] * (s.Sdot[i] - s.beta[i]);
-    s.dF_dqd[i].noalias() -= s.Ec[i].transpose() * S;
-    s.dF_dqd[i].noalias() -= Dc * S;
+    s.dF_dqd[i] -= EtS + BS + s.SBc[i];  // Ec^T S + Dc S
   }
   data.dtau_dq.setZero();
   data.dtau_dqd.setZero();
@@ -215,7 +205,7 @@ void derivative_assembly(const Model& model, Data& data) {
     }
     data.dtau_dqd(i, i) += model.bodies[i].damping;
   }
-  // Body-frame outputs, as rnea gives them.
+  if (!body_frame) return;
   for (int i = 0; i < n; ++i) {
     data.V[i] = Ad_inv_apply(data.body_pose[i], s.Vw[i]);
     data.Vdot[i] = Ad_inv_apply(data.body_pose[i], s.aw[i]);
@@ -240,7 +230,7 @@ void rnea_derivatives(const Model& model, Data& data, const VectorRef& q, const 
   world_geometry(model, data, q, ext);
   world_velocity_pass(model, data, qd, true);
   world_acceleration_pass(model, data, qd, qdd);
-  derivative_assembly(model, data);
+  derivative_assembly(model, data, true);
 }
 
 const Eigen::MatrixXd& mass_matrix(const Model& model, Data& data, const VectorRef& q) {
@@ -277,7 +267,7 @@ void passive_dynamics(const Model& model, Data& data, const VectorRef& q, const 
   }
   if (!derivatives) return;
   world_acceleration_pass(model, data, qd, data.qdd);
-  derivative_assembly(model, data);
+  derivative_assembly(model, data, false);
 }
 
 const Eigen::VectorXd& forward_dynamics(const Model& model, Data& data, const VectorRef& q,
