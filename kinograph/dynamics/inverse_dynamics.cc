@@ -128,7 +128,8 @@ void world_velocity_pass(const Model& model, Data& data, const VectorRef& qd,
     s.fv[i] = ad_transpose_apply(s.Vw[i], h) + s.fext[i];
     if (!for_derivatives) continue;
     s.hc[i] = h;
-    s.Ec[i].noalias() = ad(s.Vw[i]).transpose() * I;
+    // [ad_V]^T I column by column: three cross products a column, not a dense 6×6 product.
+    for (int c = 0; c < 6; ++c) s.Ec[i].col(c) = ad_transpose_apply(s.Vw[i], I.col(c));
   }
   if (!for_derivatives) return;
   for (int i = n - 1; i >= 0; --i) {
