@@ -103,6 +103,7 @@ Plan Replanner::batch_path(const Problem& problem, bool new_goal, const Plan* gi
     spdlog::info("warm-started replan did not validate ({}); planning from scratch",
                  plan.stats.reason);
     const double warm_time = plan.stats.solve_time_s;
+    report_.retried_from_scratch = true;
     plan = batch_.plan(problem);
     plan.stats.solve_time_s += warm_time;
     plan.stats.method += " after warm-start";
@@ -202,6 +203,7 @@ Plan Replanner::recover(const Problem& problem, Plan failed, const Plan& previou
   if (!plan.success() && options_.retry_from_scratch) {
     spdlog::info("replan did not validate ({}); planning from scratch", plan.stats.reason);
     const double spent = plan.stats.solve_time_s;
+    report_.retried_from_scratch = true;
     plan = from_scratch(problem);
     plan.stats.solve_time_s += spent;
     report_.method = "batch after incremental";

@@ -36,6 +36,9 @@ struct ReplanReport {
   std::string method;
   bool incremental = false;  ///< an incremental replan ran (validated or not, not refused)
   bool fell_back = false;    ///< its result did not validate and a batch solve answered
+  /// The warm-started solve (the fallback, or a batch replan's warm start) did not validate
+  /// either, and a plan from scratch was made (retry_from_scratch).
+  bool retried_from_scratch = false;
   std::string fallback_reason;   ///< the incremental result's first validation failure
   IncrementalStats statistics;   ///< of the incremental replan
 };

@@ -1172,6 +1172,7 @@ TEST(ReplannerOptions, Fallback) {
     ASSERT_TRUE(by_default.plan(p, true).success());
     ASSERT_TRUE(by_default.plan(with_goal(p, {1.05, 0.2}), true).success());
     ASSERT_TRUE(by_default.last_report().fell_back);
+    EXPECT_FALSE(by_default.last_report().retried_from_scratch);  // the fallback validated
   }
   ReplannerOptions o = failing_replans();
   o.fallback = false;
@@ -1183,6 +1184,7 @@ TEST(ReplannerOptions, Fallback) {
   // The retry from scratch answers instead.
   EXPECT_TRUE(re.success()) << failures(re);
   EXPECT_EQ(replanner.last_report().method, "batch after incremental");
+  EXPECT_TRUE(replanner.last_report().retried_from_scratch);
 }
 
 TEST(ReplannerOptions, RetryFromScratch) {
@@ -1195,6 +1197,7 @@ TEST(ReplannerOptions, RetryFromScratch) {
   const Plan re = replanner.plan(with_goal(p, {1.05, 0.2}), true);
   EXPECT_FALSE(re.success());
   EXPECT_EQ(replanner.last_report().method, "incremental");
+  EXPECT_FALSE(replanner.last_report().retried_from_scratch);
 }
 
 }  // namespace
