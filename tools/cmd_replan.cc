@@ -35,10 +35,9 @@ std::string describe(const planning::ReplanReport& r, const planning::Plan& plan
                 "re-eliminated, %ld variables relinearized, %d factors replaced, %d added, "
                 "%d re-added; incremental %.1f ms, total %.1f ms\n",
                 r.method.c_str(),
-                r.retried_from_scratch
-                    ? " (retried from scratch: neither the incremental plan nor the warm "
-                      "batch solve validated)"
-                    : r.fell_back ? " (fell back: the incremental plan did not validate)" : "",
+                r.retried_from_scratch ? " (planned from scratch: the replan did not validate)"
+                : r.fell_back ? " (fell back: the incremental plan did not validate)"
+                              : "",
                 s.updates,
                 s.rounds, s.cliques_reeliminated, s.variables_relinearized, s.factors_replaced,
                 s.factors_added, s.factors_readded, s.incremental_time_s * 1e3,
