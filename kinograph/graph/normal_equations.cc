@@ -194,9 +194,9 @@ void NormalEquations::index_factors(const FactorGraph& graph, const Values& valu
     if (!graph[fi]) continue;
     const auto& slots = inc.factor_slots[fi_dense++];
     FactorInfo info{static_cast<int>(fi), static_cast<int>(key_col_.size()),
-                    static_cast<int>(pairs_.size()), 0};
+                    static_cast<int>(runs_.size()), 0};
     const std::vector<int> pos = place_keys(slots, values, inc, pos_of_natural);
-    add_pairs(pos, pattern, info);
+    add_runs(*graph[fi], pos, pattern, info);
     factors_.push_back(info);
   }
 }
@@ -216,18 +216,51 @@ std::vector<int> NormalEquations::place_keys(const std::vector<int>& slots, cons
   return pos;
 }
 
-// Appends the upper blocks of H between a factor's free keys, located in the pattern.
-void NormalEquations::add_pairs(const std::vector<int>& pos, const BlockPattern& pattern,
-                                FactorInfo& info) {
+// Appends the runs of a factor: for every column of H that one of its free keys holds, the
+// upper blocks of its keys in that column in H's row order, each merged into the run before it
+// when both continue the same column (or row) of JᵀJ and the same column of H.
+void NormalEquations::add_runs(const Factor& f, const std::vector<int>& pos,
+                               const BlockPattern& pattern, FactorInfo& info) {
+  const auto& offsets = f.block_offsets();
+  const auto& dims = f.dims();
+  std::vector<int> by_position;  // the free keys in elimination order
   for (size_t i = 0; i < pos.size(); ++i) {
-    for (size_t j = 0; j < pos.size(); ++j) {
-      if (pos[i] < 0 || pos[j] < 0 || pos[i] > pos[j]) continue;
-      const int a = pos[i], b = pos[j];
-      const auto& rows = pattern.rows[b];
-      const auto it = std::lower_bound(rows.begin(), rows.end(), a);
-      pairs_.push_back(Pair{static_cast<int>(i), static_cast<int>(j), var_col_[b],
-                            pattern.within[b][it - rows.begin()], a == b});
-      ++info.num_pairs;
+    if (pos[i] >= 0) by_position.push_back(static_cast<int>(i));
+  }
+  std::sort(by_position.begin(), by_position.end(),
+            [&pos](int x, int y) { return pos[x] < pos[y]; });
+  for (size_t jj = 0; jj < by_position.size(); ++jj) {
+    const int j = by_position[jj], b = pos[j];
+    const auto& rows = pattern.rows[b];
+    for (int k = 0; k < dims[j]; ++k) {
+      const int col = var_col_[b] + k;
+      for (size_t ii = 0; ii <= jj; ++ii) {  // the keys at or above the diagonal block
+        const int i = by_position[ii], a = pos[i];
+        const auto it = std::lower_bound(rows.begin(), rows.end(), a);
+        Run run;
+        run.dst = static_cast<size_t>(col_ptr_[col] + pattern.within[b][it - rows.begin()]);
+        run.col = col;
+        run.src_col = offsets[j] + k;
+        run.src_row = offsets[i];
+        run.length = a == b ? k + 1 : dims[i];
+        run.mirrored = offsets[i] > offsets[j];
+        if (run.mirrored) std::swap(run.src_col, run.src_row);  // (row, col) of the upper entry
+        if (info.num_runs > 0) {
+          Run& last = runs_.back();
+          const bool along = last.mirrored == run.mirrored && last.col == col &&
+                             last.dst + last.length == run.dst;
+          const bool next = run.mirrored ? last.src_row == run.src_row &&
+                                               last.src_col + last.length == run.src_col
+                                         : last.src_col == run.src_col &&
+                                               last.src_row + last.length == run.src_row;
+          if (along && next) {
+            last.length += run.length;
+            continue;
+          }
+        }
+        runs_.push_back(run);
+        ++info.num_runs;
+      }
     }
   }
 }
@@ -284,23 +317,23 @@ NormalEquations::Outcome NormalEquations::evaluate(size_t fi, const FactorGraph&
     const int nc = f.jacobian_cols();
     // A linear factor whose Jacobian is unchanged keeps J and JᵀJ: only r and Jᵀr are new.
     const long version = f.jacobian_version();
-    LinearCache* cache = version >= 0 && info.num_pairs > 0 ? &linear_[fi] : nullptr;
+    LinearCache* cache = version >= 0 && info.num_runs > 0 ? &linear_[fi] : nullptr;
     const bool kept = cache != nullptr && cache->version == version;
     Eigen::Ref<Eigen::MatrixXd> J = ws.J.topLeftCorner(m, nc);
     // A kept linear factor's J must be whole; a factor on no free variable is only summed.
-    RowSupport* support = cache == nullptr && info.num_pairs > 0 ? &ws.support : nullptr;
+    RowSupport* support = cache == nullptr && info.num_runs > 0 ? &ws.support : nullptr;
     f.whitened(ws.x_ptrs.data(), r, kept ? nullptr : &J, support);
     if (!r.allFinite()) {
       o.non_finite = "residual";
       return o;
     }
     // A factor that adds to H learns whether J is finite from the row compaction below.
-    if (!kept && info.num_pairs == 0 && !all_finite(J)) {
+    if (!kept && info.num_runs == 0 && !all_finite(J)) {
       o.non_finite = "Jacobian";
       return o;
     }
     o.half_squared = 0.5 * r.squaredNorm();
-    if (info.num_pairs == 0) return o;
+    if (info.num_runs == 0) return o;
     Eigen::Map<Eigen::VectorXd> Jtr(jtr, nc);
     o.jtr = jtr;
     if (kept) {
@@ -347,24 +380,16 @@ void NormalEquations::add(size_t fi, const Factor& f, const Outcome& o, int firs
   const double* jtj = o.jtj;
   const Eigen::Index stride = o.stride;
   double* h = h_.data();
-  for (int p = info.first_pair; p < info.first_pair + info.num_pairs; ++p) {
-    const Pair& pair = pairs_[p];
-    if (pair.first_col < first_col || pair.first_col >= end_col) continue;
-    const int ro = offsets[pair.row_key], co = offsets[pair.col_key];
-    const int dr = dims[pair.row_key], dc = dims[pair.col_key];
-    if (ro <= co) {  // the block lies in JᵀJ's upper triangle
-      for (int k = 0; k < dc; ++k) {
-        double* dst = h + col_ptr_[pair.first_col + k] + pair.within;
-        const double* src = jtj + (co + k) * stride + ro;
-        const int rows = pair.diagonal ? k + 1 : dr;
-        for (int i = 0; i < rows; ++i) dst[i] += src[i];
-      }
-    } else {  // below the diagonal of JᵀJ: read the mirrored entries from the upper triangle
-      for (int k = 0; k < dc; ++k) {
-        double* dst = h + col_ptr_[pair.first_col + k] + pair.within;
-        const double* src = jtj + ro * stride + co + k;
-        for (int i = 0; i < dr; ++i) dst[i] += src[i * stride];
-      }
+  for (int p = info.first_run; p < info.first_run + info.num_runs; ++p) {
+    const Run& run = runs_[p];
+    if (run.col < first_col || run.col >= end_col) continue;
+    double* dst = h + run.dst;
+    if (!run.mirrored) {  // down a column of JᵀJ's upper triangle
+      const double* src = jtj + run.src_col * stride + run.src_row;
+      for (int i = 0; i < run.length; ++i) dst[i] += src[i];
+    } else {  // along a row of it: the mirrored entries of the lower triangle
+      const double* src = jtj + run.src_col * stride + run.src_row;
+      for (int i = 0; i < run.length; ++i) dst[i] += src[i * stride];
     }
   }
 }
@@ -382,7 +407,7 @@ bool NormalEquations::evaluate_in_parallel(const FactorGraph& graph, const doubl
     for (size_t fi = 0; fi < factors_.size(); ++fi) {
       buffer_offset_[fi] = size;
       const size_t nc = static_cast<size_t>(graph[factors_[fi].slot]->jacobian_cols());
-      if (factors_[fi].num_pairs > 0) size += nc * nc + nc;
+      if (factors_[fi].num_runs > 0) size += nc * nc + nc;
     }
     buffer_.assign(size, 0.0);
   }

@@ -64,18 +64,22 @@ class NormalEquations {
   Key key_of_column(int col, const Values& values) const;
 
  private:
-  struct Pair {     // one upper block of H touched by a factor
-    int row_key;    // factor-local key index of the block row (earlier in elimination)
-    int col_key;    // factor-local key index of the block column
-    int first_col;  // first scalar column of the block in H
-    int within;     // offset of the block's first row inside each of its columns
-    bool diagonal;  // row_key == col_key: only the upper triangle is stored
+  // A stretch of one column of H that a factor's JᵀJ adds to: consecutive entries of H and of
+  // a column of JᵀJ's upper triangle (or, mirrored, of a row of it), merged across the blocks
+  // of the factor's keys so that small blocks (2×2 for a planar arm) add in one loop.
+  struct Run {
+    size_t dst;     // index in h_ of the first entry
+    int col;        // the column of H
+    int src_col;    // JᵀJ's entry (src_row, src_col) is the first added; the next ones go
+    int src_row;    // down its column, or along its row when mirrored
+    int length;
+    bool mirrored;  // below JᵀJ's diagonal: only the upper triangle is written
   };
   struct FactorInfo {
-    int slot;        // graph slot
-    int first_key;   // into key_value_offset_ / key_col_ (one entry per key)
-    int first_pair;  // into pairs_
-    int num_pairs;
+    int slot;       // graph slot
+    int first_key;  // into key_value_offset_ / key_col_ (one entry per key)
+    int first_run;  // into runs_
+    int num_runs;   // 0: the factor has no free key and adds nothing to H
   };
   // A linear factor's whitened J and JᵀJ (upper triangle), kept under its
   // Factor::jacobian_version (−1: none yet).
@@ -112,7 +116,8 @@ class NormalEquations {
                      const std::vector<int>& pos_of_natural, const BlockPattern& pattern);
   std::vector<int> place_keys(const std::vector<int>& slots, const Values& values,
                               const Incidence& inc, const std::vector<int>& pos_of_natural);
-  void add_pairs(const std::vector<int>& pos, const BlockPattern& pattern, FactorInfo& info);
+  void add_runs(const Factor& f, const std::vector<int>& pos, const BlockPattern& pattern,
+                FactorInfo& info);
   void size_workspaces(const FactorGraph& graph, const Incidence& inc);
 
   // Evaluation of every factor, on one thread or on several (this is the solvers' hot path).
@@ -146,7 +151,7 @@ class NormalEquations {
   std::vector<FactorInfo> factors_;
   std::vector<int> key_value_offset_;  // per factor key: offset into Values::vector()
   std::vector<int> key_col_;           // per factor key: first column of H, −1 if fixed
-  std::vector<Pair> pairs_;
+  std::vector<Run> runs_;
   std::vector<LinearCache> linear_;  // one per entry of factors_
   // Threads: each worker's workspace (made by the worker on first use), the factors that may
   // run on any worker and those that run on the caller's, and per factor its last evaluation
