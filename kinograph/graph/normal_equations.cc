@@ -394,29 +394,40 @@ void NormalEquations::add(size_t fi, const Factor& f, const Outcome& o, int firs
   }
 }
 
+namespace {
+// Room for every factor's JᵀJ and Jᵀr of a shared evaluation, from evaluating to adding them
+// within one run on the caller's thread: that thread's scratch, which only grows. Solves that
+// follow one another reuse it instead of faulting in fresh pages each time.
+double* outcome_scratch(size_t size) {
+  thread_local std::vector<double> scratch;
+  if (scratch.size() < size) scratch.resize(size);
+  return scratch.data();
+}
+}  // namespace
+
 template <bool kWithJacobian>
 bool NormalEquations::evaluate_in_parallel(const FactorGraph& graph, const double* base) {
   if (threads_ <= 1 || any_worker_.size() < kMinParallelFactors ||
       !choice_[kWithJacobian].share()) {
     return false;
   }
-  if (outcomes_.size() != factors_.size()) {  // first parallel run: room for every JᵀJ and Jᵀr
+  if (outcomes_.size() != factors_.size()) {  // first parallel run: where each factor's goes
     outcomes_.resize(factors_.size());
     buffer_offset_.resize(factors_.size());
-    size_t size = 0;
+    buffer_size_ = 0;
     for (size_t fi = 0; fi < factors_.size(); ++fi) {
-      buffer_offset_[fi] = size;
+      buffer_offset_[fi] = buffer_size_;
       const size_t nc = static_cast<size_t>(graph[factors_[fi].slot]->jacobian_cols());
-      if (factors_[fi].num_runs > 0) size += nc * nc + nc;
+      if (factors_[fi].num_runs > 0) buffer_size_ += nc * nc + nc;
     }
-    buffer_.assign(size, 0.0);
   }
+  double* const buffer = outcome_scratch(buffer_size_);
   size_t done = 0;  // by worker 0, which alone looks at the cancellation flag
   auto one = [&](int item, int worker) {
     if (worker == 0 && ++done % kFactorsPerCancellationCheck == 0) throw_if_cancelled();
     const size_t fi = static_cast<size_t>(item);
     const Eigen::Index nc = graph[factors_[fi].slot]->jacobian_cols();
-    double* at = buffer_.data() + buffer_offset_[fi];
+    double* at = buffer + buffer_offset_[fi];
     outcomes_[fi] = evaluate<kWithJacobian>(fi, graph, base, workspace(worker), at + nc, nc, at);
   };
   share_out(threads_, caller_only_, any_worker_, one, kChunk);

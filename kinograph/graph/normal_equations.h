@@ -133,7 +133,7 @@ class NormalEquations {
   // Adds the shared evaluation (outcomes_) into H and g, zeroed first: each worker takes a
   // part of the columns and adds to it in graph order, so every entry is the serial sum.
   void add_in_parallel(const FactorGraph& graph);
-  // The parallel evaluation into outcomes_ (and buffer_); false when nothing is to be run so.
+  // The parallel evaluation into outcomes_ (and the scratch); false when nothing is run so.
   template <bool kWithJacobian>
   bool evaluate_in_parallel(const FactorGraph& graph, const double* base);
   Workspace& workspace(int worker);
@@ -155,14 +155,14 @@ class NormalEquations {
   std::vector<LinearCache> linear_;  // one per entry of factors_
   // Threads: each worker's workspace (made by the worker on first use), the factors that may
   // run on any worker and those that run on the caller's, and per factor its last evaluation
-  // and the place of its JᵀJ and Jᵀr in buffer_.
+  // and the place of its JᵀJ and Jᵀr in the caller's scratch (buffer_size_ doubles in all).
   int threads_ = 1;
   int max_rows_ = 0, max_cols_ = 0, max_keys_ = 0;
   std::vector<Workspace> workspaces_;
   std::vector<int> any_worker_, caller_only_;
   std::vector<Outcome> outcomes_;
   std::vector<size_t> buffer_offset_;
-  std::vector<double> buffer_;
+  size_t buffer_size_ = 0;
   // The scatter's column parts: part p is columns part_cols_[p] … part_cols_[p + 1] − 1, at
   // variable boundaries; parts_ lists 0 … P − 1 for share_out.
   std::vector<int> part_cols_, parts_;
