@@ -592,7 +592,7 @@ TEST(DetourOptions, SeedDrawsOtherViaPoints) {
   EXPECT_GT(other_seed, 0.1);
 }
 
-// Each detour's clearance is that of its two segments sampled `samples` times.
+// Each detour's clearance is that of its two segments sampled `samples` times, capped at ε.
 TEST(DetourOptions, SamplesPerSegment) {
   const Problem p = testing::rr_reach();
   DetourOptions o;
@@ -600,8 +600,9 @@ TEST(DetourOptions, SamplesPerSegment) {
   int differs = 0;
   for (const Detour& d : detour_candidates(p, p.goal.q, o)) {
     auto along = [&](int samples) {
-      return std::min(segment_clearance(p, p.start_q, d.via, samples),
-                      segment_clearance(p, d.via, p.goal.q, samples));
+      return std::min({segment_clearance(p, p.start_q, d.via, samples),
+                       segment_clearance(p, d.via, p.goal.q, samples),
+                       p.objectives.collision_epsilon});
     };
     EXPECT_DOUBLE_EQ(d.clearance, along(2));
     differs += along(2) != along(DetourOptions().samples);

@@ -195,19 +195,21 @@ Trajectory via_point(const Problem& problem, const Eigen::VectorXd& q_via,
 
 namespace {
 // Smallest clearance along a → b, travelled from time t0 to t1 (for moving obstacles), with a
-// prepared world and workspace.
+// prepared world and workspace; a clearance above `cap` counts as `cap`, which saves finding
+// the closest pair wherever none is within it.
 double clearance_along(const dynamics::Model& model, collision::CollisionWorld& world,
                        dynamics::Data& data, const Eigen::VectorXd& a, const Eigen::VectorXd& b,
-                       double t0, double t1, int samples, double stop_below) {
+                       double t0, double t1, int samples, double cap) {
   double worst = std::numeric_limits<double>::infinity();
   for (int i = 0; i <= samples; ++i) {
     graph::throw_if_cancelled();  // the detour ranking walks many segments before any solve
-    const double s = static_cast<double>(i) / samples;
+    const double s = static_cast<double>(i) / samples, t = (1 - s) * t0 + s * t1;
     dynamics::forward_kinematics(model, data, (1 - s) * a + s * b);
-    worst = std::min(worst, world.closest(data, (1 - s) * t0 + s * t1).distance);
-    if (worst < stop_below) break;
+    worst = std::min(worst, std::isfinite(cap) && !world.any_within(data, t, cap)
+                                ? cap
+                                : world.closest(data, t).distance);
   }
-  return worst;
+  return std::min(worst, cap);
 }
 }  // namespace
 
@@ -218,7 +220,7 @@ double segment_clearance(const Problem& problem, const Eigen::VectorXd& a, const
   for (const auto& o : problem.obstacles) world.add_obstacle(o);
   dynamics::Data data(*problem.model);
   return clearance_along(*problem.model, world, data, a, b, 0, problem.horizon,
-                         std::max(1, samples), -std::numeric_limits<double>::infinity());
+                         std::max(1, samples), std::numeric_limits<double>::infinity());
 }
 
 std::vector<Detour> detour_candidates(const Problem& problem, const Eigen::VectorXd& q_goal,
@@ -248,11 +250,10 @@ std::vector<Detour> detour_candidates(const Problem& problem, const Eigen::Vecto
     // Clearance capped at ε (anything clearer is as good), then a small preference for short
     // detours, so the ranking is: collision-free first, then by joint-space length.
     const double T = problem.horizon, half = problem.dt() * (problem.steps / 2);
-    const double c1 =
-        clearance_along(model, world, data, problem.start_q, q, 0, half, samples, -1e9);
-    const double c2 = clearance_along(model, world, data, q, q_goal, half, T, samples, -1e9);
+    const double c1 = clearance_along(model, world, data, problem.start_q, q, 0, half, samples, eps);
+    const double c2 = clearance_along(model, world, data, q, q_goal, half, T, samples, eps);
     const double length = (q - problem.start_q).norm() + (q_goal - q).norm();
-    ranked.push_back({std::min({c1, c2, eps}) - 1e-3 * length, Detour{q, std::min(c1, c2)}});
+    ranked.push_back({std::min(c1, c2) - 1e-3 * length, Detour{q, std::min(c1, c2)}});
   }
   std::stable_sort(ranked.begin(), ranked.end(),
                    [](const Candidate& a, const Candidate& b) { return a.score > b.score; });

@@ -51,7 +51,8 @@ struct DetourOptions {
   std::uint64_t seed = 1;
 };
 
-/// A via point for via_point() and the clearance (m) of its two-segment path.
+/// A via point for via_point() and the clearance (m) of its two-segment path, capped at the
+/// problem's collision ε (a path clearer than that reads ε).
 struct Detour {
   Eigen::VectorXd via;
   double clearance = 0;
