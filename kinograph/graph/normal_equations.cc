@@ -384,11 +384,10 @@ void NormalEquations::add(size_t fi, const Factor& f, const Outcome& o, int firs
     const Run& run = runs_[p];
     if (run.col < first_col || run.col >= end_col) continue;
     double* dst = h + run.dst;
+    const double* src = jtj + run.src_col * stride + run.src_row;
     if (!run.mirrored) {  // down a column of JᵀJ's upper triangle
-      const double* src = jtj + run.src_col * stride + run.src_row;
       for (int i = 0; i < run.length; ++i) dst[i] += src[i];
     } else {  // along a row of it: the mirrored entries of the lower triangle
-      const double* src = jtj + run.src_col * stride + run.src_row;
       for (int i = 0; i < run.length; ++i) dst[i] += src[i * stride];
     }
   }
