@@ -8,6 +8,7 @@
 #include "kinograph/dynamics/kinematics.h"
 #include "kinograph/planning/batch/batch_planner.h"
 #include "kinograph/planning/factors/pose_error.h"
+#include "kinograph/planning/validate.h"
 #include "tests/planning/test_problems.h"
 
 namespace kinograph::planning {
@@ -147,7 +148,10 @@ TEST(EndToEnd, MovingObstacleIsAvoidedWhenItArrives) {
   const Plan straight = BatchPlanner().plan(parked);
   expect_valid(straight);
   EXPECT_LT(straight.q.col(1).cwiseAbs().maxCoeff(), 1e-3);
-  EXPECT_GT(plan.q.col(1).cwiseAbs().maxCoeff(), 0.05);
+  // That motion would meet the arriving ball; the plan gets out of its way (by bending or by
+  // timing: either is a valid answer).
+  EXPECT_LT(validate(p, straight).min_clearance, 0.0);
+  EXPECT_GT((plan.q - straight.q).cwiseAbs().maxCoeff(), 0.05);
 }
 
 TEST(EndToEnd, MinimumTorqueLowersTheTorque) {

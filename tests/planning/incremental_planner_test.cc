@@ -107,7 +107,8 @@ TEST(IncrementalPlanner, GoalChangeMatchesBatchSolve) {
 }
 
 // With the ball, a goal change keeps the plan's way around it: the incremental plan matches the
-// batch solve warm-started from the previous plan.
+// batch solve warm-started from the previous plan (to 1e-2 rad; the batch solve, run to its own
+// tolerance, may end a little lower).
 TEST(IncrementalPlanner, GoalChangeAroundObstacleMatchesWarmBatch) {
   Problem p = rr_problem();
   IncrementalPlanner planner;
@@ -121,7 +122,8 @@ TEST(IncrementalPlanner, GoalChangeAroundObstacleMatchesWarmBatch) {
   p.goal = g;
   const Plan batch = BatchPlanner().plan(p, &first);
   ASSERT_TRUE(batch.success()) << failures(batch);
-  EXPECT_NEAR(inc.stats.cost, batch.stats.cost, 0.01 * batch.stats.cost);
+  EXPECT_NEAR(inc.stats.cost, batch.stats.cost, 0.03 * batch.stats.cost);
+  EXPECT_LT((inc.q - batch.q).cwiseAbs().maxCoeff(), 1e-2);
 }
 
 // Preparing the tree while idle changes no plan: the goal change and the start update after it

@@ -801,6 +801,19 @@ TEST(OuterLoopOptions, InnerToleranceFinal) {
   EXPECT_EQ(plan.stats.outer_iterations, 1);
 }
 
+// The Acrobot's swing-up solves many inner problems at one μ: carrying LM's damping from one
+// to the next saves linearizations that restarting at λ₀ spends.
+TEST(OuterLoopOptions, DampingCarry) {
+  const Problem p = load_scene(kScenes + "acrobot_swingup.yaml").problem;
+  BatchPlannerOptions o;
+  const Plan carried = BatchPlanner(o).plan(p);
+  o.outer_loop.damping_carry = 0;
+  const Plan restarted = BatchPlanner(o).plan(p);
+  ASSERT_TRUE(carried.success()) << failures(carried);
+  ASSERT_TRUE(restarted.success()) << failures(restarted);
+  EXPECT_LT(carried.stats.iterations, restarted.stats.iterations);
+}
+
 TEST(BatchPlannerOptions, ValidationThresholdsJudgeThePlan) {
   BatchPlannerOptions o;
   o.validation.final_velocity = -1;  // no plan can meet this
@@ -930,7 +943,7 @@ Goal far_goal() {
 
 TEST(IncrementalPlannerOptions, BatchOptionsJudgeTheReplans) {
   IncrementalPlannerOptions o;
-  o.batch.validation.goal = 1e-9;  // the batch plan's joint goal is exact, a replan's is not
+  o.batch.validation.goal = 1e-12;  // the batch plan's joint goal is exact, a replan's is not
   IncrementalPlanner planner(o);
   const Plan first = planner.plan(rr_scene());
   ASSERT_TRUE(first.success()) << failures(first);

@@ -92,6 +92,7 @@ OuterLoopResult solve_outer_loop(const graph::FactorGraph& graph, graph::Values&
                                  AugmentedLagrangian& al, const OuterLoopOptions& options,
                                  const std::string& name) {
   const auto t0 = Clock::now();
+  const graph::LevenbergMarquardtOptions default_lm;
   graph::LevenbergMarquardtOptions lm_options;
   lm_options.record_history = false;
   lm_options.max_iterations = options.max_inner_iterations;
@@ -131,6 +132,11 @@ OuterLoopResult solve_outer_loop(const graph::FactorGraph& graph, graph::Values&
       break;
     }
     // Feasible: one more solve at the final tolerance settles the objective.
+    lm_options.lambda_initial =
+        options.damping_carry > 0 && al.penalty() == mu
+            ? std::clamp(options.damping_carry * r.lambda, default_lm.lambda_min,
+                         default_lm.lambda_initial)
+            : default_lm.lambda_initial;
     lm_options.relative_error_tol = worst.scaled_violation <= tol
                                         ? tol_final
                                         : std::max(tol_final, lm_options.relative_error_tol * 0.1);

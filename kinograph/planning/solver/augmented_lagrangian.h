@@ -77,6 +77,11 @@ struct OuterLoopOptions {
   double inner_tolerance_initial = 1e-2;  ///< LM relative decrease in the first outer iteration
   /// ... tightened by 10× per outer iteration down to this (feasible plans stop here).
   double inner_tolerance_final = 1e-3;
+  /// An inner solve after a multiplier update that left μ as it was starts LM's damping at
+  /// this multiple of the last solve's final λ (at most LM's λ₀): the curvature is nearly the
+  /// same, and restarting at λ₀ spends iterations undoing damping, or stops early on a heavily
+  /// damped step that barely moves. 0 starts every inner solve at λ₀.
+  double damping_carry = 10;
 };
 
 /// What the outer loop ended with.
