@@ -814,6 +814,28 @@ TEST(OuterLoopOptions, DampingCarry) {
   EXPECT_LT(carried.stats.iterations, restarted.stats.iterations);
 }
 
+// An elbow far too weak to swing the Acrobot up: at the largest penalty the violation stops
+// shrinking, and the loop gives up after max_stalled_updates such updates instead of running
+// to max_outer_iterations.
+TEST(OuterLoopOptions, MaxStalledUpdates) {
+  Problem p = load_scene(kScenes + "acrobot_swingup.yaml").problem;
+  auto weak = std::make_shared<dynamics::Model>(*p.model);
+  weak->bodies[1].limits.effort = 0.2;
+  p.model = weak;
+  BatchPlannerOptions o;
+  o.max_restarts = 0;
+  o.effort_continuation.clear();
+  const Plan stalled = BatchPlanner(o).plan(p);
+  o.outer_loop.max_stalled_updates = 0;
+  const Plan ran_on = BatchPlanner(o).plan(p);
+  for (const Plan* plan : {&stalled, &ran_on}) {
+    EXPECT_FALSE(plan->success());
+    EXPECT_EQ(plan->stats.status, PlanStatus::kInfeasible);
+  }
+  EXPECT_LT(stalled.stats.outer_iterations, ran_on.stats.outer_iterations);
+  EXPECT_LT(stalled.stats.iterations, ran_on.stats.iterations);
+}
+
 TEST(BatchPlannerOptions, ValidationThresholdsJudgeThePlan) {
   BatchPlannerOptions o;
   o.validation.final_velocity = -1;  // no plan can meet this

@@ -77,7 +77,10 @@ ConstraintReport AugmentedLagrangian::update_unless_within(const graph::Values& 
     return r;
   }
   if (last_violation_ >= 0 && r.scaled_violation > options_.required_decrease * last_violation_) {
+    stalled_updates_ = state_.penalty() >= options_.max_penalty ? stalled_updates_ + 1 : 0;
     state_.set_penalty(std::min(options_.max_penalty, state_.penalty() * options_.penalty_growth));
+  } else {
+    stalled_updates_ = 0;
   }
   last_violation_ = r.scaled_violation;
   return r;
@@ -129,6 +132,10 @@ OuterLoopResult solve_outer_loop(const graph::FactorGraph& graph, graph::Values&
     if (final_tolerance && worst.scaled_violation <= tol) {
       out.status = PlanStatus::kConverged;
       out.worst = worst;
+      break;
+    }
+    if (options.max_stalled_updates > 0 && al.stalled_updates() >= options.max_stalled_updates) {
+      spdlog::debug("{}: the violation stalled at the largest penalty", name);
       break;
     }
     // Feasible: one more solve at the final tolerance settles the objective.

@@ -48,6 +48,9 @@ class AugmentedLagrangian {
                       AugmentedLagrangianOptions options = {});
 
   double penalty() const { return state_.penalty(); }
+  /// Multiplier updates in a row, at the largest penalty, that did not shrink the worst
+  /// violation below required_decrease × the last one.
+  int stalled_updates() const { return stalled_updates_; }
   /// The worst scaled violation at `values` and where it is.
   ConstraintReport report(const graph::Values& values) const;
   /// After an inner solve: λ ← λ + μc on every factor, then μ grows unless the worst scaled
@@ -64,6 +67,7 @@ class AugmentedLagrangian {
   ConstraintState& state_;
   AugmentedLagrangianOptions options_;
   double last_violation_ = -1;
+  int stalled_updates_ = 0;
   std::vector<Multipliers> saved_;  // update_unless_within's copy, reused
 };
 
@@ -82,6 +86,10 @@ struct OuterLoopOptions {
   /// same, and restarting at λ₀ spends iterations undoing damping, or stops early on a heavily
   /// damped step that barely moves. 0 starts every inner solve at λ₀.
   double damping_carry = 10;
+  /// Gives up after this many stalled multiplier updates (AugmentedLagrangian::
+  /// stalled_updates): at the largest penalty a violation that no longer shrinks is a local
+  /// infeasibility the growing multipliers do not cure. 0 runs to max_outer_iterations.
+  int max_stalled_updates = 2;
 };
 
 /// What the outer loop ended with.
