@@ -801,8 +801,8 @@ TEST(OuterLoopOptions, InnerToleranceFinal) {
   EXPECT_EQ(plan.stats.outer_iterations, 1);
 }
 
-// The Acrobot's swing-up solves many inner problems at one μ: carrying LM's damping from one
-// to the next saves linearizations that restarting at λ₀ spends.
+// The Acrobot's warm-up re-solve runs its inner solves at the largest μ: carrying LM's damping
+// from one to the next saves linearizations that restarting at λ₀ spends.
 TEST(OuterLoopOptions, DampingCarry) {
   const Problem p = load_scene(kScenes + "acrobot_swingup.yaml").problem;
   BatchPlannerOptions o;

@@ -77,7 +77,7 @@ ConstraintReport AugmentedLagrangian::update_unless_within(const graph::Values& 
     return r;
   }
   if (last_violation_ >= 0 && r.scaled_violation > options_.required_decrease * last_violation_) {
-    stalled_updates_ = state_.penalty() >= options_.max_penalty ? stalled_updates_ + 1 : 0;
+    stalled_updates_ = at_max_penalty() ? stalled_updates_ + 1 : 0;
     state_.set_penalty(std::min(options_.max_penalty, state_.penalty() * options_.penalty_growth));
   } else {
     stalled_updates_ = 0;
@@ -96,6 +96,9 @@ OuterLoopResult solve_outer_loop(const graph::FactorGraph& graph, graph::Values&
                                  const std::string& name) {
   const auto t0 = Clock::now();
   const graph::LevenbergMarquardtOptions default_lm;
+  // A solve that starts at the largest μ (a re-solve projecting onto rows just added) keeps
+  // that μ: its inner problems differ only in their multipliers.
+  const bool carry_damping = options.damping_carry > 0 && al.at_max_penalty();
   graph::LevenbergMarquardtOptions lm_options;
   lm_options.record_history = false;
   lm_options.max_iterations = options.max_inner_iterations;
@@ -139,11 +142,10 @@ OuterLoopResult solve_outer_loop(const graph::FactorGraph& graph, graph::Values&
       break;
     }
     // Feasible: one more solve at the final tolerance settles the objective.
-    lm_options.lambda_initial =
-        options.damping_carry > 0 && al.penalty() == mu
-            ? std::clamp(options.damping_carry * r.lambda, default_lm.lambda_min,
-                         default_lm.lambda_initial)
-            : default_lm.lambda_initial;
+    if (carry_damping) {
+      lm_options.lambda_initial = std::clamp(options.damping_carry * r.lambda,
+                                             default_lm.lambda_min, default_lm.lambda_initial);
+    }
     lm_options.relative_error_tol = worst.scaled_violation <= tol
                                         ? tol_final
                                         : std::max(tol_final, lm_options.relative_error_tol * 0.1);

@@ -48,6 +48,8 @@ class AugmentedLagrangian {
                       AugmentedLagrangianOptions options = {});
 
   double penalty() const { return state_.penalty(); }
+  /// Whether μ has reached AugmentedLagrangianOptions::max_penalty.
+  bool at_max_penalty() const { return state_.penalty() >= options_.max_penalty; }
   /// Multiplier updates in a row, at the largest penalty, that did not shrink the worst
   /// violation below required_decrease × the last one.
   int stalled_updates() const { return stalled_updates_; }
@@ -81,15 +83,17 @@ struct OuterLoopOptions {
   double inner_tolerance_initial = 1e-2;  ///< LM relative decrease in the first outer iteration
   /// ... tightened by 10× per outer iteration down to this (feasible plans stop here).
   double inner_tolerance_final = 1e-3;
-  /// An inner solve after a multiplier update that left μ as it was starts LM's damping at
-  /// this multiple of the last solve's final λ (at most LM's λ₀): the curvature is nearly the
-  /// same, and restarting at λ₀ spends iterations undoing damping, or stops early on a heavily
-  /// damped step that barely moves. 0 starts every inner solve at λ₀.
+  /// In a solve that starts at the largest μ (the batch planner's re-solves after it adds
+  /// between-knot rows), each inner solve after the first starts LM's damping at this multiple
+  /// of the last one's final λ (at most LM's λ₀): the curvature is nearly the same, and
+  /// restarting at λ₀ spends iterations undoing damping, or stops early on a heavily damped
+  /// step that barely moves. Not at smaller μ, where LM would run on along the objective: lower
+  /// objectives, but slower first plans and slower replans from them. 0 always starts at λ₀.
   double damping_carry = 10;
   /// Gives up after this many stalled multiplier updates (AugmentedLagrangian::
   /// stalled_updates): at the largest penalty a violation that no longer shrinks is a local
   /// infeasibility the growing multipliers do not cure. 0 runs to max_outer_iterations.
-  int max_stalled_updates = 2;
+  int max_stalled_updates = 3;
 };
 
 /// What the outer loop ended with.
