@@ -833,7 +833,6 @@ TEST(OuterLoopOptions, MaxStalledUpdates) {
     EXPECT_EQ(plan->stats.status, PlanStatus::kInfeasible);
   }
   EXPECT_LT(stalled.stats.outer_iterations, ran_on.stats.outer_iterations);
-  EXPECT_LT(stalled.stats.iterations, ran_on.stats.iterations);
 }
 
 TEST(BatchPlannerOptions, ValidationThresholdsJudgeThePlan) {

@@ -76,11 +76,19 @@ ConstraintReport AugmentedLagrangian::update_unless_within(const graph::Values& 
     for (size_t i = 0; i < multipliers_.size(); ++i) *multipliers_[i] = saved_[i];
     return r;
   }
+  // At the largest μ, progress is a violation a tenth below the smallest seen there: slow but
+  // steady progress (tight tolerances) is not a stall, a violation that wanders is.
+  if (at_max_penalty()) {
+    if (best_at_max_ >= 0 && r.scaled_violation > 0.9 * best_at_max_) {
+      ++stalled_updates_;
+    } else {
+      stalled_updates_ = 0;
+    }
+    best_at_max_ = best_at_max_ < 0 ? r.scaled_violation
+                                    : std::min(best_at_max_, r.scaled_violation);
+  }
   if (last_violation_ >= 0 && r.scaled_violation > options_.required_decrease * last_violation_) {
-    stalled_updates_ = at_max_penalty() ? stalled_updates_ + 1 : 0;
     state_.set_penalty(std::min(options_.max_penalty, state_.penalty() * options_.penalty_growth));
-  } else {
-    stalled_updates_ = 0;
   }
   last_violation_ = r.scaled_violation;
   return r;

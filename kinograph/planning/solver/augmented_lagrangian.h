@@ -50,8 +50,8 @@ class AugmentedLagrangian {
   double penalty() const { return state_.penalty(); }
   /// Whether μ has reached AugmentedLagrangianOptions::max_penalty.
   bool at_max_penalty() const { return state_.penalty() >= options_.max_penalty; }
-  /// Multiplier updates in a row, at the largest penalty, that did not shrink the worst
-  /// violation below required_decrease × the last one.
+  /// Multiplier updates in a row, at the largest penalty, whose worst violation did not fall
+  /// a tenth below the smallest one seen at that penalty.
   int stalled_updates() const { return stalled_updates_; }
   /// The worst scaled violation at `values` and where it is.
   ConstraintReport report(const graph::Values& values) const;
@@ -70,6 +70,7 @@ class AugmentedLagrangian {
   AugmentedLagrangianOptions options_;
   double last_violation_ = -1;
   int stalled_updates_ = 0;
+  double best_at_max_ = -1;  // smallest worst violation after an update at the largest μ
   std::vector<Multipliers> saved_;  // update_unless_within's copy, reused
 };
 
