@@ -149,11 +149,11 @@ OuterLoopResult solve_outer_loop(const graph::FactorGraph& graph, graph::Values&
       spdlog::debug("{}: the violation stalled at the largest penalty", name);
       break;
     }
-    // Feasible: one more solve at the final tolerance settles the objective.
     if (carry_damping) {
       lm_options.lambda_initial = std::clamp(options.damping_carry * r.lambda,
                                              default_lm.lambda_min, default_lm.lambda_initial);
     }
+    // Feasible: one more solve at the final tolerance settles the objective.
     lm_options.relative_error_tol = worst.scaled_violation <= tol
                                         ? tol_final
                                         : std::max(tol_final, lm_options.relative_error_tol * 0.1);
