@@ -191,10 +191,12 @@ graph::Values off_defect_interval(int n, double dt, std::mt19937& rng) {
 }
 
 void expect_raw_jacobians(std::shared_ptr<const dynamics::Model> model, int checks,
-                          unsigned seed, double integration_step = kMaxIntegrationStep) {
+                          unsigned seed, double integration_step = kMaxIntegrationStep,
+                          int limit_rows = kAllLimitRows) {
   IntervalDynamicsOptions o;
   o.checks = checks;
   o.integration_step = integration_step;
+  o.limit_rows = limit_rows;
   const double dt = 0.1;
   IntervalDynamicsFactor f(0, dt, model, o);
   std::mt19937 rng(seed);
@@ -217,6 +219,61 @@ TEST(IntervalDynamicsFactor, JacobiansWithTheWarmUpStep) {
 }
 TEST(IntervalDynamicsFactor, JacobiansFullyActuated) {
   expect_raw_jacobians(load_robot("robots/rr/rr.urdf"), 2, 22);
+}
+// One kind of limit rows only (IntervalLimitRows): without the torque rows a fully actuated
+// arm's points skip the dynamics altogether.
+TEST(IntervalDynamicsFactor, JacobiansWithOneKindOfLimitRows) {
+  for (int bits : {kMotionLimitRows, kEffortLimitRows}) {
+    expect_raw_jacobians(testing::acrobot_model(), 3, 24, kMaxIntegrationStep, bits);
+    expect_raw_jacobians(load_robot("robots/rr/rr.urdf"), 2, 25, kMaxIntegrationStep, bits);
+  }
+}
+
+// Each kind's rows alone read what the same rows read beside all the others, and are the ones
+// its bit names: the torque rows for kEffortLimitRows, the q and q̇ rows for kMotionLimitRows.
+TEST(IntervalDynamicsFactor, LimitRowsByKindReadTheSameValues) {
+  using Kind = IntervalDynamicsFactor::Row::Kind;
+  for (const auto& model : {testing::acrobot_model(), load_robot("robots/rr/rr.urdf")}) {
+    IntervalDynamicsOptions all;
+    all.checks = 3;
+    std::mt19937 rng(41);
+    const graph::Values x = off_defect_interval(model->nq(), 0.1, rng);
+    Eigen::VectorXd z_all;
+    IntervalDynamicsFactor(0, 0.1, model, all).values_at(x, z_all);
+    const auto all_rows = IntervalDynamicsFactor::layout(*model, all);
+    for (int bits : {kNoLimitRows, kMotionLimitRows, kEffortLimitRows}) {
+      IntervalDynamicsOptions o = all;
+      o.limit_rows = bits;
+      const auto rows = IntervalDynamicsFactor::layout(*model, o);
+      if (rows.empty()) {  // a fully actuated arm without limit rows has no rows at all
+        EXPECT_EQ(bits, kNoLimitRows) << model->name;
+        EXPECT_THROW(IntervalDynamicsFactor(0, 0.1, model, o), std::invalid_argument);
+        continue;
+      }
+      Eigen::VectorXd z;
+      IntervalDynamicsFactor(0, 0.1, model, o).values_at(x, z);
+      ASSERT_EQ(z.size(), static_cast<Eigen::Index>(rows.size()));
+      size_t j = 0;  // the same row among all of them (both layouts in the same order)
+      for (size_t i = 0; i < rows.size(); ++i) {
+        const auto& r = rows[i];
+        while (j < all_rows.size() && (all_rows[j].kind != r.kind ||
+                                       all_rows[j].joint != r.joint ||
+                                       all_rows[j].point != r.point)) {
+          ++j;
+        }
+        ASSERT_LT(j, all_rows.size()) << model->name << " bits " << bits << " row " << i;
+        EXPECT_EQ(z[i], z_all[j]) << model->name << " bits " << bits << " row " << i;
+        const bool defect = r.kind == Kind::kDefectQ || r.kind == Kind::kDefectQd;
+        if (!defect) {
+          EXPECT_EQ(r.kind == Kind::kTau, bits == kEffortLimitRows) << model->name << " " << i;
+        }
+      }
+      const auto limit_rows = std::count_if(rows.begin(), rows.end(), [](const auto& r) {
+        return r.point >= 0;
+      });
+      EXPECT_EQ(limit_rows == 0, bits == kNoLimitRows) << model->name << " bits " << bits;
+    }
+  }
 }
 
 // The factor's hinged residual Jacobian at x against central differences.

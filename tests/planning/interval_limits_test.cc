@@ -29,8 +29,16 @@ TEST(IntervalLimits, FlagsTheIntervalsNearALimitBetweenTheKnots) {
   EXPECT_EQ(intervals_near_limits(f.problem, f.plan, 0.1), (std::vector<char>{1, 1, 1}));
   f.limit_velocity(0.5);
   EXPECT_EQ(intervals_near_limits(f.problem, f.plan, 0.1), (std::vector<char>{0, 0, 0}));
-  // The margin is a fraction of the limit: 0.162 is within 70 % of 0.5 rad/s.
-  EXPECT_EQ(intervals_near_limits(f.problem, f.plan, 0.7), (std::vector<char>{1, 1, 1}));
+  // The margin is a fraction of the limit: 0.162 is within 70 % of 0.5 rad/s, and joint 0's
+  // torque in intervals 1 and 2 (at most 25.4 and 27.0 N·m) within 70 % of its 60 N·m.
+  EXPECT_EQ(intervals_near_limits(f.problem, f.plan, 0.7), (std::vector<char>{1, 3, 3}));
+  // The effort alone: within 10 % of 27.5 N·m, intervals 1 and 2 need their torque rows (those
+  // that cost inverse dynamics at every point), none its q and q̇ rows.
+  auto m = std::make_shared<dynamics::Model>(*f.problem.model);
+  m->bodies[0].limits.effort = 27.5;
+  f.problem.model = m;
+  EXPECT_EQ(intervals_near_limits(f.problem, f.plan, 0.1),
+            (std::vector<char>{0, kEffortLimitRows, kEffortLimitRows}));
   // No interior limit points, nothing to flag.
   f.limit_velocity(0.25);
   f.problem.objectives.limit_substeps = 0;
@@ -61,18 +69,20 @@ TEST(IntervalLimits, RowsOfTheGraph) {
       EXPECT_EQ(e.factor->residual_dim(), 2 * n);
     }
   }
-  // Limit points on interval 2 only: the shoulder's two defect rows everywhere, and there the
-  // elbow's τ, q, q̇ bounds and the shoulder's q, q̇ bounds at each point (as far as finite).
+  // The shoulder's two defect rows everywhere; at each limit point of interval 2 the elbow's τ,
+  // q, q̇ bounds and the shoulder's q, q̇ bounds (as far as finite), of interval 3 the elbow's τ
+  // alone, of interval 1 the q and q̇ bounds alone.
   IntervalRows some;
-  some.limits = {0, 0, 1, 0};
+  some.limits = {kNoLimitRows, kMotionLimitRows, kAllLimitRows, kEffortLimitRows};
   const auto rows = interval_factors(build_graph(p, init, {}, GraphForm::kBatch, some));
   const auto all = interval_factors(build_graph(p, init));
   ASSERT_EQ(rows.size(), 4u);
   ASSERT_EQ(all.size(), 4u);
-  for (int k = 0; k < 4; ++k) {
-    EXPECT_EQ(rows[k].second, k == 2 ? all[k].second : 2) << "interval " << k;
-  }
-  EXPECT_GT(all[2].second, 2);
+  EXPECT_EQ(rows[0].second, 2);
+  EXPECT_EQ(rows[2].second, all[2].second);
+  EXPECT_EQ(rows[3].second, 2 + limit_points(p.objectives.limit_substeps, p.dt()));
+  EXPECT_GT(rows[1].second, 2);
+  EXPECT_EQ(rows[1].second + rows[3].second - 2, all[1].second);
   some.limits = {1};
   EXPECT_THROW(build_graph(p, init, {}, GraphForm::kBatch, some), std::invalid_argument);
 }
@@ -96,9 +106,12 @@ TEST(IntervalLimits, AcrobotKnotOnlyPlanNeedsTheRowsThePlannerAdds) {
   // The shoulder's dynamics from each knot do not arrive at the next one.
   EXPECT_GT(v.max_velocity_consistency, ValidationThresholds{}.velocity_consistency);
   const std::vector<char> near = intervals_near_limits(p, plan, 0.1);
-  const long flagged = std::count(near.begin(), near.end(), 1);
+  const long flagged = std::count_if(near.begin(), near.end(), [](char c) { return c != 0; });
   EXPECT_GT(flagged, 0);
   EXPECT_LT(flagged, p.steps);
+  // The elbow's torque among them, where it is over its limit.
+  EXPECT_TRUE(std::any_of(near.begin(), near.end(),
+                          [](char c) { return (c & kEffortLimitRows) != 0; }));
 }
 
 }  // namespace

@@ -201,12 +201,14 @@ int unactuated_count(const Problem& problem) {
                                         [](const dynamics::Body& b) { return !b.actuated; }));
 }
 
-// Intervals whose interior limit points gain rows: the union of `flags` and `near`; returns
-// whether any was added.
+// The interior limit rows of every interval (IntervalLimitRows bits): the union of `flags` and
+// `near`; returns whether any was added.
 bool add_flags(std::vector<char>& flags, const std::vector<char>& near) {
   bool added = false;
   for (size_t k = 0; k < flags.size(); ++k) {
-    if (near[k] && !flags[k]) flags[k] = added = true;
+    if ((near[k] & ~flags[k]) == 0) continue;
+    flags[k] = static_cast<char>(flags[k] | near[k]);
+    added = true;
   }
   return added;
 }
@@ -315,7 +317,8 @@ Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init, const s
         "{}: interval round {}{}: {} LM iterations, {}; {} of {} intervals with limit points",
         problem.name, round, between.integration_step != kMaxIntegrationStep ? " (warm-up)" : "",
         stage.iterations, to_string(stage.status),
-        std::count(between.limits.begin(), between.limits.end(), 1), problem.steps);
+        std::count_if(between.limits.begin(), between.limits.end(), [](char c) { return c != 0; }),
+        problem.steps);
     // A warm-up's graph is never the answer: the rows on the interpolant follow it, even with
     // no iterations left.
     const bool on_interpolant = between.integration_step == kMaxIntegrationStep;

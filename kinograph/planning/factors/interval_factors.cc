@@ -47,10 +47,15 @@ std::vector<IntervalDynamicsFactor::Row> IntervalDynamicsFactor::layout(
   for (int j = 0; j < model.nq(); ++j) {
     if (!model.bodies[j].actuated) rows.push_back({Row::Kind::kDefectQd, j, -1});
   }
+  const bool effort = (o.limit_rows & kEffortLimitRows) != 0;
+  const bool motion = (o.limit_rows & kMotionLimitRows) != 0;
   for (int i = 0; i < o.checks; ++i) {
     for (int j = 0; j < model.nq(); ++j) {
       const dynamics::Body& b = model.bodies[j];
-      if (b.actuated && std::isfinite(b.limits.effort)) rows.push_back({Row::Kind::kTau, j, i});
+      if (effort && b.actuated && std::isfinite(b.limits.effort)) {
+        rows.push_back({Row::Kind::kTau, j, i});
+      }
+      if (!motion) continue;
       if (std::isfinite(b.limits.lower) || std::isfinite(b.limits.upper))
         rows.push_back({Row::Kind::kQ, j, i});
       if (std::isfinite(b.limits.velocity)) rows.push_back({Row::Kind::kQd, j, i});
@@ -70,18 +75,21 @@ IntervalDynamicsFactor::IntervalDynamicsFactor(int k, double dt,
       dt_(dt),
       layout_(layout(*model_, options)),
       interpolant_(*model_, options.integration_step) {
-  for (int i = 1; i <= options.checks; ++i) times_.push_back(dt * i / (options.checks + 1));
-  times_.push_back(dt);
-  points_.resize(times_.size());
   while (defect_rows_ < static_cast<int>(layout_.size()) && layout_[defect_rows_].point < 0) {
     ++defect_rows_;
   }
+  // Check points only where they have rows (limit_rows may leave a robot's points none).
+  const int checks = defect_rows_ < static_cast<int>(layout_.size()) ? options.checks : 0;
+  for (int i = 1; i <= checks; ++i) times_.push_back(dt * i / (checks + 1));
+  times_.push_back(dt);
+  points_.resize(times_.size());
   int row = defect_rows_;
-  for (int i = 0; i < options.checks; ++i) {
+  for (int i = 0; i < checks; ++i) {
     point_begin_.push_back(row);
     while (row < static_cast<int>(layout_.size()) && layout_[row].point == i) ++row;
   }
   point_begin_.push_back(row);
+  for (const Row& r : layout_) effort_rows_ = effort_rows_ || r.kind == Row::Kind::kTau;
   cache_evaluations();
 }
 
@@ -100,7 +108,7 @@ void IntervalDynamicsFactor::compute(const graph::FactorValues& x, Eigen::Ref<Ei
   // The defect needs the sensitivities to the end; check points only if a row of theirs is on.
   const bool derivatives = J != nullptr;
   interpolant_.start(x[0], x[1], x[2], x[5], dt_, derivatives);
-  for (int i = 0; i < checks; ++i) interpolant_.at(times_[i], false, points_[i]);
+  for (int i = 0; i < checks; ++i) interpolant_.at(times_[i], false, points_[i], effort_rows_);
   // The value of a row at a point.
   const auto value = [&](const Row& r, const InterpolantPoint& p) {
     switch (r.kind) {

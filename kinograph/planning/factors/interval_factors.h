@@ -12,9 +12,21 @@
 
 namespace kinograph::planning {
 
+/// Which limit rows an interval's interior points hold (bits; IntervalDynamicsOptions and the
+/// batch planner's constraint generation).
+enum IntervalLimitRows : char {
+  kNoLimitRows = 0,
+  kMotionLimitRows = 1,  ///< q and q̇: the interpolant alone
+  kEffortLimitRows = 2,  ///< τ of the actuated joints: inverse dynamics at every point
+  kAllLimitRows = kMotionLimitRows | kEffortLimitRows,
+};
+
 /// Options of IntervalDynamicsFactor.
 struct IntervalDynamicsOptions {
   int checks = 0;              ///< interior points i/(checks+1)·Δt where limits are enforced
+  /// Which limits the interior points enforce (IntervalLimitRows bits). Without the effort
+  /// rows a fully actuated robot's points need no dynamics: the cubic alone.
+  int limit_rows = kAllLimitRows;
   double limit_epsilon = 0;    ///< limits tightened by this (as at the knots)
   double defect_scale = 1;     ///< × Δt² (position rows) and × Δt (velocity rows), as collocation
   double torque_scale = 1;     ///< scale (N·m) of the effort rows
@@ -28,7 +40,7 @@ struct IntervalDynamicsOptions {
 /// unactuated joint u an equality q_{k+1,u} − q_u(Δt) = 0, then one q̇_{k+1,u} − q̇_u(Δt) = 0
 /// (the shooting defect); then at each interior check point, bounds on τ of every actuated
 /// joint with a finite effort limit, on q with finite position limits and on q̇ with a finite
-/// velocity limit. Jacobians exact through the RK4 sensitivities (dynamics::rnea_derivatives);
+/// velocity limit (those of options.limit_rows). Jacobians exact through the RK4 sensitivities (dynamics::rnea_derivatives);
 /// while linearizing, a check point's derivatives are computed only when one of its rows is on
 /// (an inactive bound contributes nothing to the step), the rest from inverse dynamics alone.
 class IntervalDynamicsFactor final : public ConstrainedFactor {
@@ -63,6 +75,7 @@ class IntervalDynamicsFactor final : public ConstrainedFactor {
   std::vector<double> times_;      // interior check points, then Δt
   std::vector<int> point_begin_;   // first row of each check point (and the row count last)
   int defect_rows_ = 0;
+  bool effort_rows_ = false;  // τ at the check points: inverse dynamics at every evaluation
   mutable IntervalInterpolant interpolant_;
   mutable std::vector<InterpolantPoint> points_;  // values at the check points, then Δt
   mutable InterpolantPoint with_derivatives_;     // one point's derivatives at a time

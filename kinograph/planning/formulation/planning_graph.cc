@@ -1,6 +1,7 @@
 #include "kinograph/planning/formulation/planning_graph.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <set>
 #include <stdexcept>
@@ -161,10 +162,16 @@ std::vector<FactorEntry> timing_entries(const Problem& problem, const GraphOptio
   between.torque_scale = options.torque_scale;
   between.limit_scale = options.limit_scale;
   between.integration_step = rows.integration_step;
-  IntervalDynamicsOptions without_limits = between;
   between.checks = limit_points(problem.objectives.limit_substeps, dt);
-  const bool has_between = !IntervalDynamicsFactor::layout(model, between).empty();
-  const bool has_defect = !IntervalDynamicsFactor::layout(model, without_limits).empty();
+  // The options of an interval by its IntervalLimitRows bits, and whether it has any row.
+  std::array<IntervalDynamicsOptions, 4> with_rows;
+  std::array<bool, 4> has_rows{};
+  for (int bits = 0; bits < 4; ++bits) {
+    with_rows[bits] = between;
+    with_rows[bits].limit_rows = bits;
+    if (bits == kNoLimitRows) with_rows[bits].checks = 0;
+    has_rows[bits] = !IntervalDynamicsFactor::layout(model, with_rows[bits]).empty();
+  }
   for (int k = 0; k < problem.steps; ++k) {
     out.push_back(make_soft_entry(std::make_shared<GpPriorFactor>(k, n, dt, problem.objectives.qc),
                                   {FactorRole::kGpPrior, k}));
@@ -174,11 +181,11 @@ std::vector<FactorEntry> timing_entries(const Problem& problem, const GraphOptio
                      {FactorRole::kCollocation, k}));
     }
     if (rows.knots_only) continue;
-    const bool limits = rows.limits.empty() || rows.limits[k] != 0;
-    if (limits ? has_between : has_defect) {
-      out.push_back(make_entry(std::make_shared<IntervalDynamicsFactor>(
-                                   k, dt, problem.model, limits ? between : without_limits),
-                               {FactorRole::kInterval, k}));
+    const int bits = rows.limits.empty() ? kAllLimitRows : rows.limits[k] & kAllLimitRows;
+    if (has_rows[bits]) {
+      out.push_back(make_entry(
+          std::make_shared<IntervalDynamicsFactor>(k, dt, problem.model, with_rows[bits]),
+          {FactorRole::kInterval, k}));
     }
   }
   return out;

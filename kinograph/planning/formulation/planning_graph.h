@@ -12,6 +12,7 @@
 #include "kinograph/planning/factors/collision_factors.h"
 #include "kinograph/planning/factors/constrained_factor.h"
 #include "kinograph/planning/factors/dynamics_workspace.h"
+#include "kinograph/planning/factors/interval_factors.h"
 #include "kinograph/planning/formulation/initialization.h"
 #include "kinograph/planning/interpolant.h"
 #include "kinograph/planning/plan.h"
@@ -99,8 +100,8 @@ struct IntervalRows {
   /// No interval factors: every joint on the collocation cubic and limits at the knots only
   /// (unactuated joints then follow the cubic too, so the plan holds only at its knots).
   bool knots_only = false;
-  /// Per interval, whether its interior limit points are enforced; empty = on every interval.
-  /// Intervals without them keep the unactuated joints' shooting defect.
+  /// Per interval, which interior limit rows it holds (IntervalLimitRows bits); empty = all of
+  /// them on every interval. Intervals without any keep the unactuated joints' shooting defect.
   std::vector<char> limits;
   /// Longest RK4 step (s) of the interval factors: the interpolant's, or longer for the batch
   /// planner's coarse warm-up solve before the rows on the interpolant itself.
