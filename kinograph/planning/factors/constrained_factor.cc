@@ -53,26 +53,21 @@ struct Evaluating {
   Evaluating& operator=(const Evaluating&) = delete;
 };
 
-// The hinge terms of a bound row: a = √μ c_l + λ_l/√μ, b = √μ c_u + λ_u/√μ (on when positive),
-// and w = √μ/s. `inv_sq` is 1/√μ: one division per row, not five, in the hottest loop of a
-// linearization. evaluate() and jacobian_row_needed() both call this, so they agree on which
-// rows are on to the bit.
+// The hinge terms of a bound row: a = √μ c_l + λ_l/√μ, b = √μ c_u + λ_u/√μ (on when positive).
 struct Hinge {
-  double a, b, w;
+  double a, b;
 };
-Hinge hinge(const RowSpec& row, double z, double sq, double inv_sq, double lambda,
-            double lambda_upper) {
-  const double w = sq / row.scale;
-  return {w * (row.lower - z) + lambda * inv_sq, w * (z - row.upper) + lambda_upper * inv_sq, w};
+Hinge hinge(const RowSpec& row, double z, double sq, double lambda, double lambda_upper) {
+  return {sq * (row.lower - z) / row.scale + lambda / sq,
+          sq * (z - row.upper) / row.scale + lambda_upper / sq};
 }
 }  // namespace
 
 bool ConstrainedFactor::jacobian_row_needed(int row, double z) const {
   const RowSpec& spec = rows_[static_cast<size_t>(row)];
   if (evaluating != this || spec.kind != RowKind::kBounds) return true;
-  const double sq = m_ ? std::sqrt(m_->penalty) : 1.0;
-  const Hinge h = m_ ? hinge(spec, z, sq, 1.0 / sq, m_->lower[row], m_->upper[row])
-                     : hinge(spec, z, 1.0, 1.0, 0.0, 0.0);
+  const Hinge h = m_ ? hinge(spec, z, std::sqrt(m_->penalty), m_->lower[row], m_->upper[row])
+                     : hinge(spec, z, 1.0, 0.0, 0.0);
   return h.a > 0 || h.b > 0;
 }
 
@@ -87,7 +82,7 @@ void ConstrainedFactor::evaluate(const graph::FactorValues& x, Eigen::Ref<Eigen:
   if (!m_ && zeros.size() < residual_dim()) zeros.setZero(residual_dim());
   const double* lambda = m_ ? m_->lower.data() : zeros.data();
   const double* lambda_upper = m_ ? m_->upper.data() : zeros.data();
-  const double sq = m_ ? std::sqrt(m_->penalty) : 1.0, inv_sq = 1.0 / sq;
+  const double sq = m_ ? std::sqrt(m_->penalty) : 1.0;
   // dr/dz of every row, applied to the Jacobian blocks column by column afterwards (blocks are
   // column-major: scaling row by row would stride through memory). Per-thread scratch that only
   // grows, so linearizing allocates nothing after the first factor of the largest size.
@@ -104,12 +99,12 @@ void ConstrainedFactor::evaluate(const graph::FactorValues& x, Eigen::Ref<Eigen:
         break;
       case RowKind::kEquality:
         f[i] = sq / row.scale;
-        e[i] = f[i] * (z - row.lower) + lambda[i] * inv_sq;
+        e[i] = f[i] * (z - row.lower) + lambda[i] / sq;
         break;
       case RowKind::kBounds: {
-        const Hinge h = hinge(row, z, sq, inv_sq, lambda[i], lambda_upper[i]);
+        const Hinge h = hinge(row, z, sq, lambda[i], lambda_upper[i]);
         e[i] = std::max(0.0, h.a) - std::max(0.0, h.b);
-        f[i] = -h.w * ((h.a > 0 ? 1.0 : 0.0) + (h.b > 0 ? 1.0 : 0.0));
+        f[i] = -(sq / row.scale) * ((h.a > 0 ? 1.0 : 0.0) + (h.b > 0 ? 1.0 : 0.0));
         break;
       }
     }
