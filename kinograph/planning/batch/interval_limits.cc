@@ -73,9 +73,8 @@ std::vector<char> intervals_near_limits(const Problem& problem, const Plan& plan
       bits |= limits_near(model, p, problem.objectives.limit_epsilon, margin);
       if (bits == kAllLimitRows) break;
     }
-    flags[static_cast<size_t>(k)] = static_cast<char>(bits != kNoLimitRows && underactuated
-                                                          ? kAllLimitRows
-                                                          : bits);
+    flags[static_cast<size_t>(k)] =
+        static_cast<char>(bits != kNoLimitRows && underactuated ? kAllLimitRows : bits);
   };
   graph::share_out(graph::kMaxWorkers, {}, intervals, one);
   return flags;

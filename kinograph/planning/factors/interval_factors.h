@@ -40,9 +40,10 @@ struct IntervalDynamicsOptions {
 /// unactuated joint u an equality q_{k+1,u} − q_u(Δt) = 0, then one q̇_{k+1,u} − q̇_u(Δt) = 0
 /// (the shooting defect); then at each interior check point, bounds on τ of every actuated
 /// joint with a finite effort limit, on q with finite position limits and on q̇ with a finite
-/// velocity limit (those of options.limit_rows). Jacobians exact through the RK4 sensitivities (dynamics::rnea_derivatives);
-/// while linearizing, a check point's derivatives are computed only when one of its rows is on
-/// (an inactive bound contributes nothing to the step), the rest from inverse dynamics alone.
+/// velocity limit (those of options.limit_rows). Jacobians exact through the RK4 sensitivities
+/// (dynamics::rnea_derivatives); while linearizing, a check point's derivatives are computed
+/// only when one of its rows is on (an inactive bound contributes nothing to the step), the
+/// rest from inverse dynamics alone.
 class IntervalDynamicsFactor final : public ConstrainedFactor {
  public:
   /// Throws std::invalid_argument if the interval would have no rows or dt ≤ 0.
