@@ -185,6 +185,28 @@ TEST(ConstrainedFactor, MultiplierUpdateClipsInequalities) {
   EXPECT_EQ(m.lower[0], 0);
 }
 
+// A bound row inside its bounds is off (zero residual and Jacobian) until a multiplier moves
+// its hinge past the bound: r = −(√μ (z − u) + λ_u/√μ) when that is positive.
+TEST(ConstrainedFactor, BoundRowInsideItsBoundsIsOnOnlyWhenAMultiplierPushes) {
+  std::mt19937 rng(3);
+  graph::Values v = random_states(1, 0, rng);
+  v.update(q_key(0), Eigen::VectorXd::Constant(1, 0.9));
+  StateLimitFactor lim(0, 1, {{0, 0, -1, 1}});
+  Eigen::VectorXd r;
+  Eigen::MatrixXd J;
+  for (const double lambda_upper : {0.0, 5.0, 20.0}) {
+    bind(lim, 100, Eigen::VectorXd::Zero(1), Eigen::VectorXd::Constant(1, lambda_upper));
+    lim.linearize(v, r, J);
+    const double b = 10 * (0.9 - 1) + lambda_upper / 10;  // -1, -0.5, 1
+    EXPECT_DOUBLE_EQ(r[0], -std::max(0.0, b)) << "λ_u = " << lambda_upper;
+    EXPECT_DOUBLE_EQ(J(0, 0), b > 0 ? -10.0 : 0.0) << "λ_u = " << lambda_upper;
+  }
+  bind(lim, 100, Eigen::VectorXd::Constant(1, 200.0), Eigen::VectorXd::Zero(1));
+  lim.linearize(v, r, J);  // the lower multiplier pushes from the other side: a = −19 + 20
+  EXPECT_NEAR(r[0], 1.0, 1e-12);
+  EXPECT_DOUBLE_EQ(J(0, 0), -10.0);
+}
+
 // z = q², counting its evaluations, with the evaluations kept (as the dynamics rows keep them)
 // or only the values (as the collision rows).
 class CountingFactor : public ConstrainedFactor {

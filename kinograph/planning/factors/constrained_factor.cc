@@ -61,11 +61,17 @@ Hinge hinge(const RowSpec& row, double z, double sq, double lambda, double lambd
   return {sq * (row.lower - z) / row.scale + lambda / sq,
           sq * (z - row.upper) / row.scale + lambda_upper / sq};
 }
+// Whether a bound row lies within its bounds without multipliers, so both hinges are off
+// (the test that saves hinge()'s divisions on most collision pairs; false also on NaN).
+bool hinges_off(const RowSpec& row, double z, double lambda, double lambda_upper) {
+  return lambda == 0 && lambda_upper == 0 && row.lower - z <= 0 && z - row.upper <= 0;
+}
 }  // namespace
 
 bool ConstrainedFactor::jacobian_row_needed(int row, double z) const {
   const RowSpec& spec = rows_[static_cast<size_t>(row)];
   if (evaluating != this || spec.kind != RowKind::kBounds) return true;
+  if (hinges_off(spec, z, m_ ? m_->lower[row] : 0.0, m_ ? m_->upper[row] : 0.0)) return false;
   const Hinge h = m_ ? hinge(spec, z, std::sqrt(m_->penalty), m_->lower[row], m_->upper[row])
                      : hinge(spec, z, 1.0, 0.0, 0.0);
   return h.a > 0 || h.b > 0;
@@ -102,6 +108,11 @@ void ConstrainedFactor::evaluate(const graph::FactorValues& x, Eigen::Ref<Eigen:
         e[i] = f[i] * (z - row.lower) + lambda[i] / sq;
         break;
       case RowKind::kBounds: {
+        if (hinges_off(row, z, lambda[i], lambda_upper[i])) {  // what hinge() would give
+          e[i] = 0.0;
+          f[i] = -0.0;
+          break;
+        }
         const Hinge h = hinge(row, z, sq, lambda[i], lambda_upper[i]);
         e[i] = std::max(0.0, h.a) - std::max(0.0, h.b);
         f[i] = -(sq / row.scale) * ((h.a > 0 ? 1.0 : 0.0) + (h.b > 0 ? 1.0 : 0.0));
