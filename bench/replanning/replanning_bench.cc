@@ -3,8 +3,8 @@
 // seeded goal sampler, as bench/planning), plan once, change the goal to a nearby seeded random
 // goal and replan with DFGP-L (batch, straight line), DFGP-W (batch, warm start from the first
 // plan) and iDFGP (IncrementalPlanner::set_goal). Also an obstacle-move row: the desk top
-// shifted by a seeded random offset. Prints one JSON document, then a Markdown table; see
-// bench/replanning/README.md.
+// shifted by a seeded random offset, and a row of goal changes in a row, each from the answer
+// to the last. Prints one JSON document, then a Markdown table; see bench/replanning/README.md.
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -141,8 +141,54 @@ void replan_all(Row& row, const Problem& first_problem, Problem changed,
   if (inc.success() && report.incremental && !report.fell_back) ++row.inc.incremental_ok;
 }
 
+// Plans `first_problem`, then changes its goal `length` times in a row, each a nearby goal of
+// the last, as a daemon is asked while the robot waits: DFGP-W warm-starts from its own last
+// answer, iDFGP replans on one Replanner (prepared before each change). DFGP-L is not run.
+void replan_sequence(Row& row, const Problem& first_problem, planning::GoalSampler& sampler,
+                     double radius, int length, uint64_t seed,
+                     const planning::ReplannerOptions& ro) {
+  ++row.problems;
+  planning::Replanner planner(ro);
+  const Plan first = planner.plan(first_problem, /*new_goal=*/true);
+  row.first_cost.push_back(first.success() ? first.stats.cost : std::nan(""));
+  if (!first.success()) {
+    ++row.first_failed;
+    return;
+  }
+  const planning::BatchPlanner batch(ro.incremental.batch);
+  Plan last_w = first;
+  Eigen::VectorXd goal = first_problem.goal.q;
+  for (int k = 0; k < length; ++k) {
+    const auto next = nearby_goal(sampler, goal, radius, seed + k);
+    if (!next) {
+      ++row.no_change;
+      continue;
+    }
+    goal = *next;
+    planning::ProblemChange change;
+    change.goal = first_problem.goal;
+    change.goal->q = goal;
+    Problem changed = first_problem;
+    changed.goal = *change.goal;
+    row.prepare.push_back(planner.prepare());
+    auto t0 = Clock::now();
+    const Plan w = batch.plan(changed, &last_w);
+    row.W.add(w, seconds_since(t0));
+    if (w.success()) last_w = w;
+    t0 = Clock::now();
+    const Plan inc = planner.replan(change);
+    row.inc.add(inc, seconds_since(t0));
+    const planning::ReplanReport& report = planner.last_report();
+    row.inc.updates.push_back(report.statistics.updates);
+    if (report.fell_back) ++row.inc.fell_back;
+    if (report.retried_from_scratch) ++row.inc.retried;
+    if (inc.success() && report.incremental && !report.fell_back) ++row.inc.incremental_ok;
+  }
+}
+
 int run(int argc, char** argv) {
   int problems = 50, obstacle_problems = -1, knots = 5;
+  int sequence_problems = -1, sequence_length = 5;
   double radius = 0.2, shift = 0.05;
   double limit_epsilon = -1;  // < 0: the scenes' own
   int only = -1;              // >= 0: replan only this problem of each row (debugging)
@@ -159,6 +205,8 @@ int run(int argc, char** argv) {
            .value("--radius", &radius)
            .value("--shift", &shift)
            .value("--gone-on", &knots)
+           .value("--sequence-problems", &sequence_problems)
+           .value("--sequence-length", &sequence_length)
            .value("--json", &json_path)
            .value("--log-level", "warn|info|debug|trace",
                   [&](const std::string& v) { log_level = spdlog::level::from_str(v); })
@@ -175,6 +223,7 @@ int run(int argc, char** argv) {
     return 1;
   }
   if (obstacle_problems < 0) obstacle_problems = problems;
+  if (sequence_problems < 0) sequence_problems = obstacle_problems;
   spdlog::set_level(log_level);
   json result;
 
@@ -244,12 +293,33 @@ int run(int argc, char** argv) {
     result["obstacle_move"] = row_json(moved);
     result["gone_on_obstacle_move"] = row_json(gone);
   }
+
+  // Goal changes in a row (task 1's scene and first goals).
+  Row sequence;
+  {
+    const planning::Scene scene = planning::load_scene(kScenes + "iiwa_desk.yaml");
+    Problem base = scene.problem;
+    if (limit_epsilon >= 0) base.objectives.limit_epsilon = limit_epsilon;
+    planning::GoalSampler sampler(base, iiwa_goal_options(1));
+    const std::vector<Eigen::VectorXd> goals = sampler.sample(sequence_problems);
+    for (size_t i = 0; i < goals.size(); ++i) {
+      if (only >= 0 && static_cast<int>(i) != only) continue;
+      Problem first = base;
+      first.goal.q = goals[i];
+      replan_sequence(sequence, first, sampler, radius, sequence_length, 3000 + 100 * i, ro);
+      std::cerr << "goal sequence " << i << ": W " << sequence.W.ok << " iDFGP " << sequence.inc.ok
+                << " / " << sequence.W.runs << "\n";
+    }
+    result["goal_sequence"] = row_json(sequence);
+  }
   result["settings"] = {
       {"problems", problems},
       {"obstacle_problems", obstacle_problems},
       {"goal_change_radius_rad", radius},
       {"desk_shift_m", shift},
       {"gone_on_knots", knots},
+      {"sequence_problems", sequence_problems},
+      {"sequence_length", sequence_length},
       {"retry_from_scratch", ro.retry_from_scratch},
       {"time", "wall time of the replanning call (build, solve, validate, fallback, retry)"},
       {"success", "the plan validates (planning::validate)"},
@@ -260,22 +330,30 @@ int run(int argc, char** argv) {
   std::cout << "| test | method | success | mean time (ms) | median (ms) | max (ms) | mean total "
                "torque (N·m) | paper success | paper mean / max time |\n";
   std::cout << "|---|---|---|---|---|---|---|---|---|\n";
-  const char* paper[4][3] = {
-      {"86 %", "92 %", "80 %"}, {"90 %", "98 %", "96 %"}, {"–", "–", "–"}, {"–", "–", "–"}};
-  const char* paper_t[4][3] = {{"1.98 / 3.33 s", "1.12 / 3.09 s", "0.119 / 0.200 s"},
-                               {"1.68 / 2.98 s", "0.63 / 1.76 s", "0.074 / 0.078 s"},
-                               {"–", "–", "–"},
-                               {"–", "–", "–"}};
+  constexpr int kRows = 5;
+  const char* paper[kRows][3] = {{"86 %", "92 %", "80 %"},
+                                 {"90 %", "98 %", "96 %"},
+                                 {"–", "–", "–"},
+                                 {"–", "–", "–"},
+                                 {"–", "–", "–"}};
+  const char* paper_t[kRows][3] = {{"1.98 / 3.33 s", "1.12 / 3.09 s", "0.119 / 0.200 s"},
+                                   {"1.68 / 2.98 s", "0.63 / 1.76 s", "0.074 / 0.078 s"},
+                                   {"–", "–", "–"},
+                                   {"–", "–", "–"},
+                                   {"–", "–", "–"}};
   const std::string gone_name =
       "task 1 desk moved, " + std::to_string(knots) + " knots on";
-  const char* names[4] = {"task 1 goal change", "task 2 goal change", "task 1 desk moved",
-                          gone_name.c_str()};
-  const Row* all[4] = {&rows[0], &rows[1], &moved, &gone};
-  for (int r = 0; r < 4; ++r) {
+  const std::string sequence_name =
+      "task 1 goal changes in a row (" + std::to_string(sequence_length) + " each)";
+  const char* names[kRows] = {"task 1 goal change", "task 2 goal change", "task 1 desk moved",
+                              gone_name.c_str(), sequence_name.c_str()};
+  const Row* all[kRows] = {&rows[0], &rows[1], &moved, &gone, &sequence};
+  for (int r = 0; r < kRows; ++r) {
     const Method* ms[3] = {&all[r]->L, &all[r]->W, &all[r]->inc};
     const char* mn[3] = {"DFGP-L", "DFGP-W", "iDFGP"};
     for (int m = 0; m < 3; ++m) {
       const Method& x = *ms[m];
+      if (x.runs == 0) continue;  // not run in this row (DFGP-L in the goal sequence)
       std::cout << "| " << names[r] << " | " << mn[m] << " | " << x.ok << "/" << x.runs << " ("
                 << cell(x.runs ? double(x.ok) / x.runs : std::nan(""), 100) << " %) | "
                 << cell(mean(x.ok_times), 1e3, 1) << " | " << cell(median(x.ok_times), 1e3, 1)
@@ -283,7 +361,7 @@ int run(int argc, char** argv) {
                 << " | " << paper[r][m] << " | " << paper_t[r][m] << " |\n";
     }
   }
-  for (int r = 0; r < 4; ++r) {
+  for (int r = 0; r < kRows; ++r) {
     const Method& x = all[r]->inc;
     std::cout << "\n"
               << names[r] << ": " << all[r]->problems << " problems, " << all[r]->first_failed
