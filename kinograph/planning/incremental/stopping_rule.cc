@@ -21,11 +21,25 @@ StoppingRule::StoppingRule(double constraint_tolerance, double previous_cost,
       stop_at_first_valid_(stop_at_first_valid),
       round_tolerance_(kInitialRelativeDecrease) {}
 
+namespace {
+// Whether `cost` is within the band of `ref`.
+bool within_band(double cost, double ref) {
+  ref = std::max(ref, 1e-12);
+  return cost >= (1 - kObjectiveFall) * ref && cost <= (1 + kObjectiveRise) * ref;
+}
+}  // namespace
+
 bool StoppingRule::accept(double cost) {
   if (!stop_at_first_valid_) return false;
-  const double ref = std::max(last_cost_, 1e-12);
+  const bool settled =
+      within_band(cost, last_cost_) || (before_jump_ >= 0 && within_band(cost, before_jump_));
+  if (cost > (1 + kObjectiveRise) * std::max(last_cost_, 1e-12)) {
+    if (before_jump_ < 0) before_jump_ = last_cost_;
+  } else {
+    before_jump_ = -1;
+  }
   last_cost_ = cost;
-  return cost >= (1 - kObjectiveFall) * ref && cost <= (1 + kObjectiveRise) * ref;
+  return settled;
 }
 
 bool StoppingRule::settled(double error_before, double error_after) const {

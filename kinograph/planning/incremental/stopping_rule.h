@@ -15,7 +15,9 @@ class StoppingRule {
   /// Whether an update's objective (soft cost) is settled enough that its plan, if it
   /// validates, is the answer: it fell by less than 5 % (a plan whose objective still falls is
   /// not yet the optimum, e.g. after an obstacle was removed) and rose by less than 50 % (a
-  /// jump is a poor first iterate after a large goal change) since the previous update. Always
+  /// jump is a poor first iterate after a large goal change) since the previous update. After
+  /// a jump the objective is also settled within the same band of the last one before the
+  /// jump: a jump is a poor iterate, no measure of whether the objective still falls. Always
   /// false unless stop_at_first_valid. Remembers `cost` for the next update.
   bool accept(double cost);
   /// Whether the updates settled at this multiplier estimate (relative decrease below the
@@ -37,6 +39,7 @@ class StoppingRule {
  private:
   double tolerance_;
   double last_cost_;
+  double before_jump_ = -1;  // the objective before the jumps that led to last_cost_, if any
   bool stop_at_first_valid_;
   double round_tolerance_;
 };
