@@ -5,12 +5,15 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <numeric>
 #include <random>
 #include <stdexcept>
 
 #include "kinograph/collision/collision_world.h"
 #include "kinograph/dynamics/kinematics.h"
 #include "kinograph/graph/cancellation.h"
+#include "kinograph/graph/worker_local.h"
 
 namespace kinograph::planning {
 
@@ -228,33 +231,52 @@ std::vector<Detour> detour_candidates(const Problem& problem, const Eigen::Vecto
   if (problem.obstacles.empty() || options.candidates <= 0) return {};
   const dynamics::Model& model = *problem.model;
   const int n = model.nq();
-  collision::CollisionWorld world(model);
-  for (const auto& o : problem.obstacles) world.add_obstacle(o);
-  dynamics::Data data(model);
+  // Every via point is drawn first, in the seed's order; their paths are then checked on the
+  // process's workers (graph/worker_pool.h), each with its own world and workspace, so the
+  // ranking does not depend on which worker checked which.
   std::mt19937_64 rng(options.seed);
   std::uniform_real_distribution<double> u(-options.spread, options.spread);
   const Eigen::VectorXd mid = 0.5 * (problem.start_q + q_goal);
-  const double eps = problem.objectives.collision_epsilon;
-  const int samples = std::max(1, options.samples);
-  struct Candidate {
-    double score;
-    Detour detour;
-  };
-  std::vector<Candidate> ranked;
-  for (int c = 0; c < options.candidates; ++c) {
-    Eigen::VectorXd q = mid;
+  std::vector<Eigen::VectorXd> vias(static_cast<size_t>(options.candidates), mid);
+  for (Eigen::VectorXd& q : vias) {
     for (int j = 0; j < n; ++j) {
       const auto& l = model.bodies[j].limits;
       q[j] = std::clamp(q[j] + u(rng), l.lower, l.upper);
     }
+  }
+  struct Probe {
+    collision::CollisionWorld world;
+    dynamics::Data data;
+  };
+  graph::WorkerLocal<Probe> probes([&problem] {
+    auto p = std::make_unique<Probe>(Probe{collision::CollisionWorld(*problem.model),
+                                           dynamics::Data(*problem.model)});
+    for (const auto& o : problem.obstacles) p->world.add_obstacle(o);
+    return p;
+  });
+  const double eps = problem.objectives.collision_epsilon;
+  const int samples = std::max(1, options.samples);
+  const double T = problem.horizon, half = problem.dt() * (problem.steps / 2);
+  struct Candidate {
+    double score;
+    Detour detour;
+  };
+  std::vector<Candidate> ranked(vias.size());
+  auto check = [&](int c, int) {
+    Probe& p = probes.local();
+    const Eigen::VectorXd& q = vias[static_cast<size_t>(c)];
     // Clearance capped at ε (anything clearer is as good), then a small preference for short
     // detours, so the ranking is: collision-free first, then by joint-space length.
-    const double T = problem.horizon, half = problem.dt() * (problem.steps / 2);
-    const double c1 = clearance_along(model, world, data, problem.start_q, q, 0, half, samples, eps);
-    const double c2 = clearance_along(model, world, data, q, q_goal, half, T, samples, eps);
+    const double c1 =
+        clearance_along(model, p.world, p.data, problem.start_q, q, 0, half, samples, eps);
+    const double c2 = clearance_along(model, p.world, p.data, q, q_goal, half, T, samples, eps);
     const double length = (q - problem.start_q).norm() + (q_goal - q).norm();
-    ranked.push_back({std::min(c1, c2) - 1e-3 * length, Detour{q, std::min(c1, c2)}});
-  }
+    ranked[static_cast<size_t>(c)] = {std::min(c1, c2) - 1e-3 * length,
+                                      Detour{q, std::min(c1, c2)}};
+  };
+  std::vector<int> items(vias.size());
+  std::iota(items.begin(), items.end(), 0);
+  graph::share_out(graph::kMaxWorkers, {}, items, check, 1);
   std::stable_sort(ranked.begin(), ranked.end(),
                    [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
   std::vector<Detour> out;
