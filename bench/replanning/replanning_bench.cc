@@ -15,6 +15,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <numeric>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -102,20 +103,37 @@ json row_json(const Row& r) {
           {"iDFGP", r.inc.to_json()}};
 }
 
+// Plans `problem` as the first plan of a row's problem; empty (and counted) when it fails.
+std::optional<Plan> first_plan(Row& row, planning::Replanner& planner, const Problem& problem) {
+  ++row.problems;
+  Plan first = planner.plan(problem, /*new_goal=*/true);
+  row.first_cost.push_back(first.success() ? first.stats.cost : std::nan(""));
+  if (!first.success()) {
+    ++row.first_failed;
+    return std::nullopt;
+  }
+  return first;
+}
+
+// Adds an iDFGP replan and what the replanner reports of it to `inc`.
+void add_replan(Method& inc, const Plan& plan, double wall_s, const planning::ReplanReport& r) {
+  inc.add(plan, wall_s);
+  inc.updates.push_back(r.statistics.updates);
+  if (r.fell_back) ++inc.fell_back;
+  if (r.retried_from_scratch) ++inc.retried;
+  if (plan.success() && r.incremental && !r.fell_back) ++inc.incremental_ok;
+}
+
 // Plans `first`, and replans `changed` with all three methods: at the first plan's start
 // (iDFGP applies `change`), or, with `knots` > 0, after the robot went on that many knots along
 // it (DFGP-W from the motion gone on, iDFGP on the tree shifted there).
 void replan_all(Row& row, const Problem& first_problem, Problem changed,
                 const planning::ProblemChange& change, const planning::ReplannerOptions& ro,
                 int knots = 0) {
-  ++row.problems;
   planning::Replanner planner(ro);
-  const Plan first = planner.plan(first_problem, /*new_goal=*/true);
-  row.first_cost.push_back(first.success() ? first.stats.cost : std::nan(""));
-  if (!first.success()) {
-    ++row.first_failed;
-    return;
-  }
+  const std::optional<Plan> planned = first_plan(row, planner, first_problem);
+  if (!planned) return;
+  const Plan& first = *planned;
   // As a daemon does while it waits for the next change.
   row.prepare.push_back(planner.prepare());
   const Plan warm = knots > 0 ? planning::gone_on(first, knots) : first;
@@ -133,12 +151,7 @@ void replan_all(Row& row, const Problem& first_problem, Problem changed,
   t0 = Clock::now();
   const Plan inc = knots > 0 ? planner.plan(changed, /*new_goal=*/false, &warm, knots)
                              : planner.replan(change);
-  row.inc.add(inc, seconds_since(t0));
-  const planning::ReplanReport& report = planner.last_report();
-  row.inc.updates.push_back(report.statistics.updates);
-  if (report.fell_back) ++row.inc.fell_back;
-  if (report.retried_from_scratch) ++row.inc.retried;
-  if (inc.success() && report.incremental && !report.fell_back) ++row.inc.incremental_ok;
+  add_replan(row.inc, inc, seconds_since(t0), planner.last_report());
 }
 
 // Plans `first_problem`, then changes its goal `length` times in a row, each a nearby goal of
@@ -147,16 +160,11 @@ void replan_all(Row& row, const Problem& first_problem, Problem changed,
 void replan_sequence(Row& row, const Problem& first_problem, planning::GoalSampler& sampler,
                      double radius, int length, uint64_t seed,
                      const planning::ReplannerOptions& ro) {
-  ++row.problems;
   planning::Replanner planner(ro);
-  const Plan first = planner.plan(first_problem, /*new_goal=*/true);
-  row.first_cost.push_back(first.success() ? first.stats.cost : std::nan(""));
-  if (!first.success()) {
-    ++row.first_failed;
-    return;
-  }
+  const std::optional<Plan> first = first_plan(row, planner, first_problem);
+  if (!first) return;
   const planning::BatchPlanner batch(ro.incremental.batch);
-  Plan last_w = first;
+  Plan last_w = *first;
   Eigen::VectorXd goal = first_problem.goal.q;
   for (int k = 0; k < length; ++k) {
     const auto next = nearby_goal(sampler, goal, radius, seed + k);
@@ -177,12 +185,7 @@ void replan_sequence(Row& row, const Problem& first_problem, planning::GoalSampl
     if (w.success()) last_w = w;
     t0 = Clock::now();
     const Plan inc = planner.replan(change);
-    row.inc.add(inc, seconds_since(t0));
-    const planning::ReplanReport& report = planner.last_report();
-    row.inc.updates.push_back(report.statistics.updates);
-    if (report.fell_back) ++row.inc.fell_back;
-    if (report.retried_from_scratch) ++row.inc.retried;
-    if (inc.success() && report.incremental && !report.fell_back) ++row.inc.incremental_ok;
+    add_replan(row.inc, inc, seconds_since(t0), planner.last_report());
   }
 }
 
