@@ -16,6 +16,7 @@
 #include "kinograph/dynamics/kinematics.h"
 #include "kinograph/graph/factor_graph.h"
 #include "kinograph/graph/values.h"
+#include "kinograph/graph/worker_pool.h"
 #include "kinograph/planning/batch/batch_planner.h"
 #include "kinograph/planning/factors/dynamics_factors.h"
 #include "kinograph/planning/factors/state_target_factor.h"
@@ -590,6 +591,23 @@ TEST(DetourOptions, SeedDrawsOtherViaPoints) {
   }
   EXPECT_EQ(same_seed, 0.0) << "repeatable";
   EXPECT_GT(other_seed, 0.1);
+}
+
+// The paths are checked on the process's workers; the ranking is the one a single worker makes
+// (a job inside a job runs on its caller alone).
+TEST(DetourOptions, RankingIsTheSameOnOneWorker) {
+  const Problem p = testing::rr_reach();
+  const std::vector<Detour> shared = detour_candidates(p, p.goal.q);
+  std::vector<Detour> alone;
+  auto body = [&](int worker) {
+    if (worker == 0) alone = detour_candidates(p, p.goal.q);
+  };
+  graph::run_on_workers(2, body);
+  ASSERT_EQ(alone.size(), shared.size());
+  for (size_t i = 0; i < shared.size(); ++i) {
+    EXPECT_EQ(alone[i].via, shared[i].via) << i;
+    EXPECT_EQ(alone[i].clearance, shared[i].clearance) << i;
+  }
 }
 
 // Each detour's clearance is that of its two segments sampled `samples` times, capped at ε.
