@@ -133,12 +133,12 @@ std::string check_goal_tolerance(const Problem& p) {
 }
 
 // Why configuration q (the start or the goal) is in collision, naming the pair and the depth;
-// empty when it is clear of obstacles, the floor and its own links.
-std::string collision_at(const Problem& problem, const Eigen::VectorXd& q, const char* what) {
-  const std::unique_ptr<collision::CollisionWorld> world = clearance_world(problem);
-  dynamics::Data data(*problem.model);
+// empty when it is clear of obstacles, the floor and its own links (`world`: the problem's
+// clearance world, `data` a workspace of its model).
+std::string collision_at(const Problem& problem, collision::CollisionWorld& world,
+                         dynamics::Data& data, const Eigen::VectorXd& q, const char* what) {
   dynamics::forward_kinematics(*problem.model, data, q);
-  const collision::Proximity p = world->closest(data, 0);
+  const collision::Proximity p = world.closest(data, 0);
   if (!(p.distance < 0)) return "";
   std::ostringstream os;
   os << "the " << what << " configuration is in collision: " << describe_pair(*problem.model, p)
@@ -197,8 +197,13 @@ std::string check_problem(const Problem& p) {
   }
   if (has_clearance_checks(p)) {
     try {
-      r = collision_at(p, p.start_q, "start");
-      if (r.empty() && p.goal.kind == Goal::Kind::kJoint) r = collision_at(p, p.goal.q, "goal");
+      // One world for both: a replan checks its problem on the way to every answer.
+      const std::unique_ptr<collision::CollisionWorld> world = clearance_world(p);
+      dynamics::Data data(model);
+      r = collision_at(p, *world, data, p.start_q, "start");
+      if (r.empty() && p.goal.kind == Goal::Kind::kJoint) {
+        r = collision_at(p, *world, data, p.goal.q, "goal");
+      }
       if (!r.empty()) return r;
     } catch (const std::exception& e) {
       return std::string("bad obstacle: ") + e.what();
