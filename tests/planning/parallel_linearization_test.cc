@@ -1,7 +1,7 @@
 // The planner's real graphs linearized on two threads give the same H, g and cost to the bit as
 // on one: the factors marked Factor::parallel_safe (dynamics through the per-worker
-// DynamicsWorkspace, pose, interval, DFG rows) really touch only their own state, and the
-// collision hinges, which share one Bullet world, stay on the caller's thread.
+// DynamicsWorkspace, pose, interval, DFG rows, and the collision hinges through a Bullet world
+// per worker) really touch only their own state.
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
