@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
+#include <map>
 #include <random>
 #include <string>
 
@@ -13,6 +14,7 @@
 #include "kinograph/planning/formulation/dfg_builder.h"
 #include "kinograph/planning/formulation/initialization.h"
 #include "kinograph/planning/formulation/planning_graph.h"
+#include "kinograph/planning/solver/augmented_lagrangian.h"
 #include "test_problems.h"
 
 namespace kinograph::planning {
@@ -91,6 +93,52 @@ TEST(ParallelLinearization, IiwaAtTheDeskWithCollisionAndSelfCollisionHinges) {
 
 TEST(ParallelLinearization, RrWithCollisionHinges) {
   expect_same_with_collision_rows(rr_reach(), "rr with a ball");
+}
+
+// worst_constraint evaluates the factors on the process's workers: the row it reports is the
+// first of the worst in the factors' order, as a scan on one thread finds it, and the multiplier
+// update (on the caller's thread) reports the same row and updates every factor's multipliers.
+TEST(ParallelLinearization, ConstraintScansAreTheSerialOnes) {
+  const Problem p =
+      load_scene(std::string(KINOGRAPH_SOURCE_DIR) + "/robots/scenes/iiwa_desk.yaml").problem;
+  PlanningGraph pg = build_graph(p, straight_line(p, p.goal.q));
+  const std::vector<const FactorEntry*> constraints = pg.constraints(false);
+  ASSERT_GE(constraints.size(), 64u);  // enough to be shared out by worst_constraint
+  ConstraintState shared;
+  AugmentedLagrangian al(constraints, shared);
+  std::map<FactorKey, Multipliers> serial;  // copies, updated on this thread
+  for (const FactorEntry* e : constraints) serial.emplace(e->key, shared.at(e->key));
+  std::mt19937 rng(11);
+  std::normal_distribution<double> noise(0.0, 0.05);
+  const Eigen::VectorXd start = pg.values.vector();
+  for (int round = 0; round < 4; ++round) {
+    for (Eigen::Index i = 0; i < start.size(); ++i) pg.values.vector()[i] = start[i] + noise(rng);
+    ConstrainedFactor::Violation first;
+    const FactorEntry* worst = nullptr;
+    for (const FactorEntry* e : constraints) {
+      const ConstrainedFactor::Violation v = e->constrained->check(pg.values);
+      if (v.scaled > first.scaled) {
+        first = v;
+        worst = e;
+      }
+    }
+    ASSERT_NE(worst, nullptr) << "round " << round;  // the noise breaks the collocation rows
+    const ConstraintReport report = worst_constraint(constraints, pg.values);
+    EXPECT_EQ(report.entry, worst) << "round " << round;
+    EXPECT_EQ(report.row, first.row) << "round " << round;
+    EXPECT_EQ(report.scaled_violation, first.scaled) << "round " << round;
+    // The multipliers: λ ← λ + μc, factor by factor on this thread, against the shared update.
+    for (const FactorEntry* e : constraints) {
+      e->constrained->update_multipliers(pg.values, serial.at(e->key));
+    }
+    const ConstraintReport updated = al.update_unless_within(pg.values, -1);
+    EXPECT_EQ(updated.entry, worst) << "round " << round;
+    for (const FactorEntry* e : constraints) {
+      ASSERT_EQ(shared.at(e->key).lower, serial.at(e->key).lower) << "round " << round;
+      ASSERT_EQ(shared.at(e->key).upper, serial.at(e->key).upper) << "round " << round;
+    }
+    for (auto& [key, m] : serial) m.penalty = shared.penalty();  // μ as the update left it
+  }
 }
 
 }  // namespace

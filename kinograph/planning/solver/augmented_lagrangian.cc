@@ -8,8 +8,37 @@
 
 #include "kinograph/graph/levenberg_marquardt.h"
 #include "kinograph/graph/stopwatch.h"
+#include "kinograph/graph/worker_pool.h"
 
 namespace kinograph::planning {
+namespace {
+
+// Below this many constraint factors a scan stays on the caller's thread (waking the workers
+// costs more than it saves).
+constexpr size_t kMinSharedConstraints = 64;
+
+// The first worst of the factors' violations, in their order (as a scan in order picks it).
+ConstraintReport first_worst(const std::vector<const FactorEntry*>& constraints,
+                             const std::vector<ConstrainedFactor::Violation>& violations) {
+  ConstraintReport r;
+  for (size_t i = 0; i < constraints.size(); ++i) {
+    const ConstrainedFactor::Violation& v = violations[i];
+    if (v.scaled > r.scaled_violation) {
+      r.scaled_violation = v.scaled;
+      r.violation = v.own_units;
+      r.entry = constraints[i];
+      r.row = v.row;
+      r.value = v.value;
+    }
+  }
+  if (r.entry != nullptr) {
+    const ConstrainedFactor& worst = *r.entry->constrained;
+    r.where = worst.name() + " " + worst.keys().front().to_string();
+  }
+  return r;
+}
+
+}  // namespace
 
 AugmentedLagrangian::AugmentedLagrangian(std::vector<const FactorEntry*> constraints,
                                          ConstraintState& state,
@@ -24,21 +53,22 @@ AugmentedLagrangian::AugmentedLagrangian(std::vector<const FactorEntry*> constra
 
 ConstraintReport worst_constraint(const std::vector<const FactorEntry*>& constraints,
                                   const graph::Values& values) {
-  ConstraintReport r;
-  const ConstrainedFactor* worst = nullptr;
-  for (const FactorEntry* e : constraints) {
-    const ConstrainedFactor::Violation v = e->constrained->check(values);
-    if (v.scaled > r.scaled_violation) {
-      r.scaled_violation = v.scaled;
-      r.violation = v.own_units;
-      r.entry = e;
-      r.row = v.row;
-      r.value = v.value;
-      worst = e->constrained.get();
-    }
+  // On the process's workers when there are many: after a solve the rows just added (the
+  // interpolant's, integrated finely) are evaluated here for the first time. The multiplier
+  // update below mostly reads kept values, too little work to share.
+  std::vector<ConstrainedFactor::Violation> violations(constraints.size());
+  auto check = [&](int i, int /*worker*/) {
+    violations[static_cast<size_t>(i)] =
+        constraints[static_cast<size_t>(i)]->constrained->check(values);
+  };
+  std::vector<int> caller_only, any;
+  for (size_t i = 0; i < constraints.size(); ++i) {
+    const bool shared =
+        constraints.size() >= kMinSharedConstraints && constraints[i]->factor->parallel_safe();
+    (shared ? any : caller_only).push_back(static_cast<int>(i));
   }
-  if (worst != nullptr) r.where = worst->name() + " " + worst->keys().front().to_string();
-  return r;
+  graph::share_out(any.empty() ? 1 : graph::kMaxWorkers, caller_only, any, check);
+  return first_worst(constraints, violations);
 }
 
 ConstraintReport AugmentedLagrangian::report(const graph::Values& values) const {
@@ -56,22 +86,11 @@ ConstraintReport AugmentedLagrangian::update_unless_within(const graph::Values& 
     saved_.resize(multipliers_.size());
     for (size_t i = 0; i < multipliers_.size(); ++i) saved_[i] = *multipliers_[i];
   }
-  ConstraintReport r;
+  violations_.resize(constraints_.size());
   for (size_t i = 0; i < constraints_.size(); ++i) {
-    const ConstrainedFactor::Violation v =
-        constraints_[i]->constrained->update_multipliers(values, *multipliers_[i]);
-    if (v.scaled > r.scaled_violation) {  // the same choice as worst_constraint
-      r.scaled_violation = v.scaled;
-      r.violation = v.own_units;
-      r.entry = constraints_[i];
-      r.row = v.row;
-      r.value = v.value;
-    }
+    violations_[i] = constraints_[i]->constrained->update_multipliers(values, *multipliers_[i]);
   }
-  if (r.entry != nullptr) {
-    const ConstrainedFactor& worst = *r.entry->constrained;
-    r.where = worst.name() + " " + worst.keys().front().to_string();
-  }
+  ConstraintReport r = first_worst(constraints_, violations_);  // worst_constraint's choice
   if (may_keep && r.scaled_violation <= tolerance) {
     for (size_t i = 0; i < multipliers_.size(); ++i) *multipliers_[i] = saved_[i];
     return r;

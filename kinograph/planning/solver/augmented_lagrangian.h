@@ -36,7 +36,8 @@ struct ConstraintReport {
   double value = 0;
 };
 
-/// The worst constraint row over `constraints` at `values` (one evaluation of each).
+/// The worst constraint row over `constraints` at `values` (one evaluation of each, on the
+/// process's workers when they are many): the first of the worst in their order.
 ConstraintReport worst_constraint(const std::vector<const FactorEntry*>& constraints,
                                   const graph::Values& values);
 
@@ -72,6 +73,7 @@ class AugmentedLagrangian {
   int stalled_updates_ = 0;
   double best_at_max_ = -1;  // smallest worst violation after an update at the largest μ
   std::vector<Multipliers> saved_;  // update_unless_within's copy, reused
+  std::vector<ConstrainedFactor::Violation> violations_;  // per constraint, reused
 };
 
 /// Limits and tolerances of the outer loop.
