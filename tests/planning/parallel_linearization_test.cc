@@ -104,10 +104,10 @@ TEST(ParallelLinearization, ConstraintScansAreTheSerialOnes) {
   PlanningGraph pg = build_graph(p, straight_line(p, p.goal.q));
   const std::vector<const FactorEntry*> constraints = pg.constraints(false);
   ASSERT_GE(constraints.size(), 64u);  // enough to be shared out by worst_constraint
-  ConstraintState shared;
-  AugmentedLagrangian al(constraints, shared);
+  ConstraintState state;
+  AugmentedLagrangian al(constraints, state);
   std::map<FactorKey, Multipliers> serial;  // copies, updated on this thread
-  for (const FactorEntry* e : constraints) serial.emplace(e->key, shared.at(e->key));
+  for (const FactorEntry* e : constraints) serial.emplace(e->key, state.at(e->key));
   std::mt19937 rng(11);
   std::normal_distribution<double> noise(0.0, 0.05);
   const Eigen::VectorXd start = pg.values.vector();
@@ -127,17 +127,17 @@ TEST(ParallelLinearization, ConstraintScansAreTheSerialOnes) {
     EXPECT_EQ(report.entry, worst) << "round " << round;
     EXPECT_EQ(report.row, first.row) << "round " << round;
     EXPECT_EQ(report.scaled_violation, first.scaled) << "round " << round;
-    // The multipliers: λ ← λ + μc, factor by factor on this thread, against the shared update.
+    // The multipliers: λ ← λ + μc, factor by factor, against AugmentedLagrangian's update.
     for (const FactorEntry* e : constraints) {
       e->constrained->update_multipliers(pg.values, serial.at(e->key));
     }
     const ConstraintReport updated = al.update_unless_within(pg.values, -1);
     EXPECT_EQ(updated.entry, worst) << "round " << round;
     for (const FactorEntry* e : constraints) {
-      ASSERT_EQ(shared.at(e->key).lower, serial.at(e->key).lower) << "round " << round;
-      ASSERT_EQ(shared.at(e->key).upper, serial.at(e->key).upper) << "round " << round;
+      ASSERT_EQ(state.at(e->key).lower, serial.at(e->key).lower) << "round " << round;
+      ASSERT_EQ(state.at(e->key).upper, serial.at(e->key).upper) << "round " << round;
     }
-    for (auto& [key, m] : serial) m.penalty = shared.penalty();  // μ as the update left it
+    for (auto& [key, m] : serial) m.penalty = state.penalty();  // μ as the update left it
   }
 }
 
