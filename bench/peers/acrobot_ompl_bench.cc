@@ -22,7 +22,6 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
-#include <malloc.h>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -381,9 +380,6 @@ int main(int argc, char** argv) {
     for (int i = 0; i < seeds; ++i) {  // interleaved: every method once per seed
       for (std::size_t m = 0; m < methods.size(); ++m) {
         runs[m].push_back(m == 0 ? run_kinograph(model, s) : run_ompl(methods[m], model, s, cap_s));
-        // A search frees millions of small blocks; glibc merges them on the next large malloc,
-        // which would bill the next method for them. Every method starts from a merged heap.
-        malloc_trim(0);
       }
       std::cerr << s.name << " seed " << i + 1 << "/" << seeds << "\n";
     }
