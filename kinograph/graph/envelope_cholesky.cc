@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 
@@ -11,6 +12,85 @@ namespace {
 // A pivot this small relative to the diagonal of A means H is singular to working precision
 // (the same test as SparseCholesky's).
 constexpr double kPivotTolerance = 1e-14;
+
+constexpr int G = EnvelopeCholesky::kGroupRows;
+static_assert(G == 4, "a column of a group is one vector of four doubles");
+
+// A column of a group: one AVX register, or two SSE2 ones.
+typedef double Column __attribute__((vector_size(4 * sizeof(double))));
+
+// Loads and stores a column (by pointer: a vector by value would change the calling convention
+// between the clones).
+void load(Column* v, const double* p) { std::memcpy(v, p, sizeof *v); }
+void store(double* p, const Column* v) { std::memcpy(p, v, sizeof *v); }
+
+// The factorization proper on L's storage by groups (see EnvelopeCholesky's members), A in
+// place; returns the failed column or −1. A free function so that it can be cloned for AVX2
+// (the clone chosen when the library loads); both clones round alike (no fused multiply-add).
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+__attribute__((target_clones("avx2", "default")))
+#endif
+int factorize_groups(int n, int groups, const int* group_first, const long* group_start,
+                     double* env, double* inv_diagonal) {
+  for (int g = 0; g < groups; ++g) {
+    const int r0 = g * G, rows = std::min(n, r0 + G) - r0;
+    const int F = group_first[g];
+    double* B = env + group_start[g];  // B + G·(c − F): column c of the group
+    // Left-looking: the group's columns left of its own rows come four at a time, those of an
+    // earlier group h's rows, each needing L's rows of group h up to it.
+    for (int h = F / G; h < g; ++h) {
+      const int rh = h * G, Fh = group_first[h];
+      const double* Lh = env + group_start[h];  // Lh + G·(c − Fh): column c of h
+      // acc[j](i) = Σ_c L(r0 + i, c) L(rh + j, c) over the columns both have left of rh.
+      Column acc[G] = {};
+      for (int c = std::max(F, Fh); c < rh; ++c) {
+        Column b;
+        load(&b, B + G * (c - F));
+        const double* l = Lh + G * (c - Fh);
+        for (int j = 0; j < G; ++j) acc[j] += b * l[j];
+      }
+      // Group h's own columns in turn (columns left of F are zero), each kept in a register
+      // for the next; a reciprocal keeps the division off that chain.
+      Column x[G];
+      for (int j = 0; j < G; ++j) {
+        const int k = rh + j;
+        x[j] = Column{};
+        if (k < F) continue;
+        Column a = acc[j];
+        for (int m = 0; m < j; ++m) a += x[m] * Lh[G * (rh + m - Fh) + j];
+        load(&x[j], B + G * (k - F));
+        x[j] = (x[j] - a) * inv_diagonal[k];
+        store(B + G * (k - F), &x[j]);
+      }
+    }
+    // The group's own rows: its diagonal, then the rows below it in the group (a last group's
+    // missing rows hold zeros throughout).
+    Column acc[G] = {};
+    for (int c = F; c < r0; ++c) {
+      Column b;
+      load(&b, B + G * (c - F));
+      for (int j = 0; j < G; ++j) acc[j] += b * b[j];
+    }
+    Column x[G];
+    for (int j = 0; j < rows; ++j) {
+      const int k = r0 + j;
+      Column a = acc[j];
+      for (int m = 0; m < j; ++m) a += x[m] * x[m][j];
+      const double a_kk = B[G * (k - F) + j];
+      load(&x[j], B + G * (k - F));
+      x[j] -= a;
+      const double d = x[j][j];
+      if (!(d > kPivotTolerance * std::abs(a_kk))) return k;
+      const double l_kk = std::sqrt(d);
+      inv_diagonal[k] = 1 / l_kk;
+      x[j] *= inv_diagonal[k];
+      for (int i = 0; i < j; ++i) x[j][i] = 0;  // above the diagonal
+      x[j][j] = l_kk;
+      store(B + G * (k - F), &x[j]);
+    }
+  }
+  return -1;
+}
 }  // namespace
 
 EnvelopeCholesky::EnvelopeCholesky(int n, const std::vector<int>& col_ptr,
@@ -38,6 +118,7 @@ EnvelopeCholesky::EnvelopeCholesky(int n, const std::vector<int>& col_ptr,
   }
   values_.assign(row_idx.size(), 0.0);
   env_.assign(static_cast<size_t>(group_start_[groups]), 0.0);
+  inv_diagonal_.assign(n, 0.0);
   value_at_.resize(row_idx.size());
   for (int j = 0; j < n; ++j) {
     for (int p = col_ptr[j]; p < col_ptr[j + 1]; ++p) {
@@ -71,55 +152,11 @@ bool EnvelopeCholesky::wins(int n, const std::vector<int>& col_ptr,
 }
 
 bool EnvelopeCholesky::factorize() {
-  failed_column_ = -1;
   std::fill(env_.begin(), env_.end(), 0.0);
   for (size_t p = 0; p < values_.size(); ++p) env_[static_cast<size_t>(value_at_[p])] = values_[p];
-  using Column = Eigen::Matrix<double, kGroupRows, 1>;
-  const int groups = static_cast<int>(group_first_.size());
-  for (int g = 0; g < groups; ++g) {
-    const int r0 = g * kGroupRows, rows = std::min(n_, r0 + kGroupRows) - r0;
-    const int F = group_first_[g];
-    double* B = env_.data() + group_start_[g];  // B + kGroupRows·(c − F): column c of the group
-    // Left-looking, column by column: column k of the group's rows needs row k of L up to k.
-    for (int k = F; k < r0 + rows; ++k) {
-      const int h = k / kGroupRows;
-      const double* Lk = env_.data() + group_start_[h] + k % kGroupRows;  // stride kGroupRows
-      const int Fh = group_first_[h];
-      const int from = std::max(F, Fh);
-      // acc = Σ_c B(:, c) L(k, c) over c in [from, k), in two chains for throughput.
-      Column acc0 = Column::Zero(), acc1 = Column::Zero();
-      int c = from;
-      for (; c + 1 < k; c += 2) {
-        acc0.noalias() += Eigen::Map<const Column>(B + kGroupRows * (c - F)) *
-                          Lk[kGroupRows * (c - Fh)];
-        acc1.noalias() += Eigen::Map<const Column>(B + kGroupRows * (c + 1 - F)) *
-                          Lk[kGroupRows * (c + 1 - Fh)];
-      }
-      if (c < k) {
-        acc0.noalias() += Eigen::Map<const Column>(B + kGroupRows * (c - F)) *
-                          Lk[kGroupRows * (c - Fh)];
-      }
-      acc0 += acc1;
-      double* Bk = B + kGroupRows * (k - F);
-      if (k < r0) {
-        const double l_kk = Lk[kGroupRows * (k - Fh)];
-        for (int i = 0; i < rows; ++i) Bk[i] = (Bk[i] - acc0[i]) / l_kk;
-        continue;
-      }
-      // k is the group's own row i0: its diagonal, then the rows below it in the group.
-      const int i0 = k - r0;
-      const double a_kk = Bk[i0];
-      const double d = a_kk - acc0[i0];
-      if (!(d > kPivotTolerance * std::abs(a_kk))) {
-        failed_column_ = k;
-        return false;
-      }
-      const double l_kk = std::sqrt(d);
-      Bk[i0] = l_kk;
-      for (int i = i0 + 1; i < rows; ++i) Bk[i] = (Bk[i] - acc0[i]) / l_kk;
-    }
-  }
-  return true;
+  failed_column_ = factorize_groups(n_, static_cast<int>(group_first_.size()), group_first_.data(),
+                                    group_start_.data(), env_.data(), inv_diagonal_.data());
+  return failed_column_ < 0;
 }
 
 void EnvelopeCholesky::solve(const Eigen::Ref<const Eigen::VectorXd>& b,
@@ -140,7 +177,7 @@ void EnvelopeCholesky::solve(const Eigen::Ref<const Eigen::VectorXd>& b,
     for (int i = 0; i < rows; ++i) {
       double s = xs[r0 + i] - acc[i];
       for (int m = 0; m < i; ++m) s -= B[kGroupRows * (r0 + m - F) + i] * xs[r0 + m];
-      xs[r0 + i] = s / B[kGroupRows * (r0 + i - F) + i];
+      xs[r0 + i] = s * inv_diagonal_[r0 + i];
     }
   }
   // Lᵀ x = y by groups from the last: its own triangle, then the columns left of it at once.
@@ -152,7 +189,7 @@ void EnvelopeCholesky::solve(const Eigen::Ref<const Eigen::VectorXd>& b,
     for (int i = rows - 1; i >= 0; --i) {
       double s = xs[r0 + i];
       for (int m = i + 1; m < rows; ++m) s -= B[kGroupRows * (r0 + i - F) + m] * xg[m];
-      xg[i] = s / B[kGroupRows * (r0 + i - F) + i];
+      xg[i] = s * inv_diagonal_[r0 + i];
       xs[r0 + i] = xg[i];
     }
     for (int c = F; c < r0; ++c) {

@@ -46,6 +46,7 @@ class EnvelopeCholesky final : public CholeskyFactor {
   std::vector<long> value_at_;      // A's entry p (pattern order): its place in env_
   std::vector<double> values_;      // A's upper triangle, pattern order
   std::vector<double> env_;         // L by groups of rows
+  std::vector<double> inv_diagonal_;  // 1 / L(j, j)
   int failed_column_ = -1;
 };
 
