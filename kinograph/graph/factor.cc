@@ -81,7 +81,7 @@ void Factor::whitened(const double* const* x, Eigen::Ref<Eigen::VectorXd> r,
     if (noise_) noise_->whiten_residual(r);
     return;
   }
-  J->setZero();
+  if (support == nullptr || noise_ || !writes_listed_rows_only()) J->setZero();
   if (support != nullptr) support->all = true;
   // A noise model may mix rows, so only an unwhitened factor may leave rows out.
   const Jacobians jac(J->data(), J->rows(), J->outerStride(), offsets_.data(), dims_.data(),

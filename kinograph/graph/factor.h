@@ -32,7 +32,8 @@ struct RowSupport {
 };
 
 /// Writable view of a factor's Jacobian, one dense block per key, stacked side by side in key
-/// order (residual_dim rows). Blocks arrive zeroed, so authors fill only non-zero entries.
+/// order (residual_dim rows). Blocks arrive zeroed, so authors fill only non-zero entries
+/// (except with a row list for a factor that writes_listed_rows_only()).
 class Jacobians {
  public:
   using Block = Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>>;
@@ -120,6 +121,12 @@ class Factor {
   /// workspaces. A factor that shares a plain workspace with others keeps the default (false)
   /// and is evaluated on the caller's thread.
   virtual bool parallel_safe() const { return false; }
+
+  /// Whether, when given a row list (Jacobians::row_support()), evaluate() writes every row it
+  /// lists in full (the rows it leaves out hold anything): J then arrives unzeroed (whitened()
+  /// skips zeroing it), which spares a factor whose rows are mostly zero (clear collision
+  /// pairs) clearing them all on every linearization. Without a row list J arrives zeroed.
+  virtual bool writes_listed_rows_only() const { return false; }
 
   /// For a factor linear in its variables (its whitened Jacobian then does not depend on them),
   /// a number that changes whenever that Jacobian may change (noise model, penalty); −1 for

@@ -123,6 +123,7 @@ CollisionFactor::CollisionFactor(int k, double s, double dt, double epsilon, dou
   const double s2 = s * s, s3 = s2 * s;
   h_ << 2 * s3 - 3 * s2 + 1, s3 - 2 * s2 + s, -2 * s3 + 3 * s2, s3 - s2;
   cache_values();
+  list_written_rows();  // only near pairs have a gradient: most rows stay zero
 }
 
 void CollisionFactor::compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
@@ -144,6 +145,7 @@ void CollisionFactor::compute(const graph::FactorValues& x, Eigen::Ref<Eigen::Ve
     z[row] = p.distance;
     if (J == nullptr) continue;
     collision::distance_gradient(model, c.data, p, c.gradient_workspace, c.gradient);
+    if (graph::RowSupport* written = J->row_support()) written->rows.push_back(row);
     if (s_ == 0) {
       J->block(0).row(row) = c.gradient.transpose();
     } else {

@@ -79,9 +79,19 @@ bool ConstrainedFactor::jacobian_row_needed(int row, double z) const {
 
 void ConstrainedFactor::evaluate(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> e,
                                  const graph::Jacobians* J) const {
+  // With a row list, a factor that lists the rows it writes gets J unzeroed: the rows listed
+  // below that compute() did not write are zeroed here.
+  graph::RowSupport* support = J != nullptr ? J->row_support() : nullptr;
+  const bool unzeroed = support != nullptr && lists_written_rows_;
+  if (unzeroed) support->rows.clear();
   {
     const Evaluating guard(this);
     cached_compute(x, e, J);
+  }
+  thread_local std::vector<char> written;
+  if (unzeroed) {
+    written.assign(static_cast<size_t>(residual_dim()), 0);
+    for (int i : support->rows) written[static_cast<size_t>(i)] = 1;
   }
   // An unbound factor reads μ = 1 and λ = 0 (per-thread zeros that only grow).
   thread_local Eigen::VectorXd zeros;
@@ -123,11 +133,14 @@ void ConstrainedFactor::evaluate(const graph::FactorValues& x, Eigen::Ref<Eigen:
   if (J == nullptr) return;
   // Rows whose dr/dz is zero (a bound whose hinge is off) are left out instead of zeroed when
   // the caller takes a row list: most of a collision factor's pairs are clear.
-  graph::RowSupport* support = J->row_support();
   if (support != nullptr) {
     support->rows.clear();
     for (int i = 0; i < residual_dim(); ++i) {
-      if (f[i] != 0) support->rows.push_back(i);
+      if (f[i] == 0) continue;
+      support->rows.push_back(i);
+      if (unzeroed && !written[static_cast<size_t>(i)]) {
+        for (size_t k = 0; k < keys().size(); ++k) J->block(static_cast<int>(k)).row(i).setZero();
+      }
     }
     support->all = static_cast<int>(support->rows.size()) == residual_dim();
   }
@@ -162,6 +175,9 @@ void ConstrainedFactor::compute_at(const graph::Values& values,
 }
 
 void ConstrainedFactor::cache_evaluations() {
+  if (lists_written_rows_) {
+    throw std::logic_error(name() + ": a kept Jacobian needs every row written");
+  }
   kept_.resize(2);
   for (Evaluation& k : kept_) {
     k.x.resize(jacobian_cols());
@@ -169,6 +185,13 @@ void ConstrainedFactor::cache_evaluations() {
   }
   kept_[1].J.resize(residual_dim(), jacobian_cols());
   kept_[1].filled.assign(static_cast<size_t>(residual_dim()), 0);
+}
+
+void ConstrainedFactor::list_written_rows() {
+  if (kept_.size() == 2) {
+    throw std::logic_error(name() + ": a kept Jacobian needs every row written");
+  }
+  lists_written_rows_ = true;
 }
 
 void ConstrainedFactor::cache_values() {

@@ -61,6 +61,7 @@ class ConstrainedFactor : public graph::Factor {
 
   void evaluate(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> e,
                 const graph::Jacobians* J) const final;
+  bool writes_listed_rows_only() const override { return lists_written_rows_; }
 
   const std::vector<RowSpec>& rows() const { return rows_; }
 
@@ -140,6 +141,12 @@ class ConstrainedFactor : public graph::Factor {
   /// again while the variables are bitwise the same (cost, violation and multiplier updates at
   /// the point just linearized). Not with cache_evaluations().
   void cache_values();
+  /// For a subclass whose Jacobian is mostly rows of clear pairs (the collision rows): given a
+  /// row list (graph::Jacobians::row_support()), compute() appends to it every row whose
+  /// Jacobian it writes, and writes those rows in full (every block). J then arrives unzeroed
+  /// (Factor::writes_listed_rows_only); evaluate() zeroes the rows it lists that compute() did
+  /// not write. Not with cache_evaluations().
+  void list_written_rows();
 
  private:
   // A kept raw evaluation: inputs (keys concatenated), z and, in the one with Jacobians,
@@ -167,6 +174,7 @@ class ConstrainedFactor : public graph::Factor {
 
   std::vector<RowSpec> rows_;
   int num_constraints_ = 0;
+  bool lists_written_rows_ = false;
   std::shared_ptr<const Multipliers> m_;  // null until bound
   double penalty_read_ = 1;               // μ of the last bind or penalty_changed
   // Empty unless cached: cache_values() keeps the last values; cache_evaluations() the last
