@@ -18,13 +18,7 @@
 namespace kinograph::planning {
 namespace {
 
-collision::Obstacle box(int id, const Eigen::Vector3d& size, const Eigen::Vector3d& at) {
-  collision::Obstacle o;
-  o.id = id;
-  o.shape = collision::Shape::box(size.x(), size.y(), size.z());
-  o.pose.translation() = at;
-  return o;
-}
+using testing::box_obstacle;
 
 struct Evaluation {
   Eigen::VectorXd z;
@@ -48,9 +42,9 @@ class CollisionCull : public ::testing::Test {
  protected:
   CollisionCull() : model(testing::iiwa_with_block()) {
     // The desk of robots/scenes/iiwa_desk.yaml and the floor; the wrist pair allowed.
-    obstacles = {box(0, {0.5, 1.0, 0.04}, {0.75, 0, 0.64}),
-                 box(1, {0.04, 0.04, 0.62}, {0.52, 0.48, 0.31}),
-                 box(2, {0.04, 0.04, 0.62}, {0.98, -0.48, 0.31})};
+    obstacles = {box_obstacle(0, {0.5, 1.0, 0.04}, {0.75, 0, 0.64}),
+                 box_obstacle(1, {0.04, 0.04, 0.62}, {0.52, 0.48, 0.31}),
+                 box_obstacle(2, {0.04, 0.04, 0.62}, {0.98, -0.48, 0.31})};
     SelfPairs self{{{4, 6}}, 0.01};
     std::vector<collision::Obstacle> floor = {floor_obstacle(0.0)};
     // The planner's query distances: ε + 0.03 m.

@@ -18,13 +18,7 @@
 namespace kinograph::planning {
 namespace {
 
-collision::Obstacle box(int id, const Eigen::Vector3d& size, const Eigen::Vector3d& at) {
-  collision::Obstacle o;
-  o.id = id;
-  o.shape = collision::Shape::box(size.x(), size.y(), size.z());
-  o.pose.translation() = at;
-  return o;
-}
+using testing::box_obstacle;
 
 struct Linearization {
   Eigen::VectorXd r;
@@ -47,8 +41,8 @@ Linearization linearize(const CollisionFactor& f, const graph::Values& v, double
 TEST(CollisionRowsListed, ListedRowsEqualAZeroedEvaluation) {
   const auto model = testing::iiwa_with_block();
   const std::vector<collision::Obstacle> obstacles = {
-      box(0, {0.5, 1.0, 0.04}, {0.75, 0, 0.64}), box(1, {0.04, 0.04, 0.62}, {0.52, 0.48, 0.31}),
-      floor_obstacle(0.0)};
+      box_obstacle(0, {0.5, 1.0, 0.04}, {0.75, 0, 0.64}),
+      box_obstacle(1, {0.04, 0.04, 0.62}, {0.52, 0.48, 0.31}), floor_obstacle(0.0)};
   SelfPairs self{{{4, 6}}, 0.01};
   const auto context = std::make_shared<CollisionContext>(model, obstacles, 0.08, &self, true);
   std::mt19937 rng(7);

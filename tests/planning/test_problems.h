@@ -16,6 +16,16 @@
 
 namespace kinograph::planning::testing {
 
+/// An axis-aligned box obstacle of the given size centred at `at`.
+inline collision::Obstacle box_obstacle(int id, const Eigen::Vector3d& size,
+                                        const Eigen::Vector3d& at) {
+  collision::Obstacle o;
+  o.id = id;
+  o.shape = collision::Shape::box(size.x(), size.y(), size.z());
+  o.pose.translation() = at;
+  return o;
+}
+
 /// A plan's method, status, reason and validation failures on one line, for test messages.
 inline std::string failures(const Plan& p) {
   std::string s = p.stats.method + " " + to_string(p.stats.status) + " " + p.stats.reason + ":";
