@@ -63,6 +63,12 @@ struct CollisionContext {
   int num_pairs = 0;          ///< all rows, self pairs last
   double self_epsilon = 0.0;  ///< ε of the self rows
   double query_distance;
+  /// Per joint, a bound on how fast any point of the robot's geometry moves with it (m/rad).
+  Eigen::VectorXd lever;
+  /// Whether an obstacle moves along a trajectory: no factor then stands in a past query.
+  bool moving = false;
+  /// Counts move_obstacle() calls: a past query stands only under the obstacles it saw.
+  int version = 0;
 
   /// The row of a reported pair, −1 when it has none.
   int row(const collision::Proximity& p) const;
@@ -89,6 +95,13 @@ class CollisionFactor final : public ConstrainedFactor {
   double s_, dt_, t_;
   Eigen::Vector4d h_;  // Hermite weights of q_k, Δt·q̇_k, q_{k+1}, Δt·q̇_{k+1}
   std::shared_ptr<CollisionContext> ctx_;
+  // The last query of the world (at q, giving z), with the smallest z − ε over the rows.
+  struct LastQuery {
+    Eigen::VectorXd q, z;
+    double gap = 0;
+    int version = -1;
+  };
+  mutable LastQuery last_;  // a factor is evaluated by one thread at a time
 };
 
 }  // namespace kinograph::planning

@@ -77,6 +77,10 @@ bool ConstrainedFactor::jacobian_row_needed(int row, double z) const {
   return h.a > 0 || h.b > 0;
 }
 
+bool ConstrainedFactor::bound_multipliers_zero() const {
+  return !m_ || ((m_->lower.array() == 0).all() && (m_->upper.array() == 0).all());
+}
+
 void ConstrainedFactor::evaluate(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> e,
                                  const graph::Jacobians* J) const {
   // With a row list, a factor that lists the rows it writes gets J unzeroed: the rows listed

@@ -125,6 +125,9 @@ class ConstrainedFactor : public graph::Factor {
   /// evaluate() runs and the row is a bound whose hinge is off under the bound multipliers
   /// (its residual and Jacobian row are then zero whatever compute() writes).
   bool jacobian_row_needed(int row, double z) const;
+  /// Whether every multiplier is zero (so is an unbound factor's): a bound row's hinge is then
+  /// off exactly where its value lies within its bounds.
+  bool bound_multipliers_zero() const;
   /// For a subclass whose compute() is linear in the variables: with soft and equality rows only
   /// the whitened Jacobian is then constant between penalty changes (Factor::jacobian_version).
   /// Throws std::logic_error if a row is a bound.

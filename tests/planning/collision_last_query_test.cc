@@ -1,0 +1,117 @@
+// A collision factor close to its last query (every distance provably still beyond its ε, no
+// multiplier positive) answers from that query instead of asking the world again: its residual
+// and Jacobian must be exactly a fresh factor's, and it must ask again when a multiplier is
+// positive or an obstacle moved. On the iiwa with the desk, a leg, the floor and its self pairs.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <random>
+#include <vector>
+
+#include "kinograph/planning/clearance_world.h"
+#include "kinograph/planning/factors/collision_factors.h"
+#include "kinograph/planning/factors/trajectory_factors.h"
+#include "test_problems.h"
+
+namespace kinograph::planning {
+namespace {
+
+using testing::box_obstacle;
+
+struct Evaluation {
+  Eigen::VectorXd z, r;
+  Eigen::MatrixXd J;
+};
+
+// The raw distances, and the whitened residual and Jacobian, of `f` at q.
+Evaluation evaluate(const CollisionFactor& f, const Eigen::VectorXd& q) {
+  const double* ptrs[1] = {q.data()};
+  const graph::FactorValues x(ptrs, f.dims().data());
+  Evaluation e{Eigen::VectorXd::Zero(f.residual_dim()), Eigen::VectorXd::Zero(f.residual_dim()),
+               Eigen::MatrixXd::Zero(f.residual_dim(), f.jacobian_cols())};
+  f.compute(x, e.z, nullptr);
+  Eigen::Ref<Eigen::MatrixXd> J(e.J);
+  f.whitened(ptrs, e.r, &J);
+  return e;
+}
+
+class CollisionLastQuery : public ::testing::Test {
+ protected:
+  CollisionLastQuery() : model(testing::iiwa_with_block()) {
+    const std::vector<collision::Obstacle> obstacles = {
+        box_obstacle(0, {0.5, 1.0, 0.04}, {0.75, 0, 0.64}),
+        box_obstacle(1, {0.04, 0.04, 0.62}, {0.52, 0.48, 0.31}), floor_obstacle(0.0)};
+    SelfPairs self{{{4, 6}}, 0.01};
+    context = std::make_shared<CollisionContext>(model, obstacles, 0.08, &self, true);
+  }
+
+  Eigen::VectorXd random_q() {
+    Eigen::VectorXd q(model->nq());
+    for (int j = 0; j < model->nq(); ++j) {
+      const auto& lim = model->bodies[j].limits;
+      q[j] = std::uniform_real_distribution<double>(lim.lower, lim.upper)(rng);
+    }
+    return q;
+  }
+
+  std::shared_ptr<const dynamics::Model> model;
+  std::shared_ptr<CollisionContext> context;
+  std::mt19937 rng{11};
+};
+
+TEST_F(CollisionLastQuery, NearTheLastQueryTheRowsAreAFreshFactors) {
+  int answered_from_last = 0, asked_again = 0, moved_into_contact = 0;
+  for (int trial = 0; trial < 250; ++trial) {
+    const Eigen::VectorXd q0 = random_q();
+    // Steps from far below to far above what the gap allows, and every fifth a configuration
+    // anywhere (often with pairs inside their ε that were clear at q0).
+    const double step = 1e-4 * std::pow(10.0, trial % 5);
+    Eigen::VectorXd q1 = q0;
+    for (int j = 0; j < q1.size(); ++j) {
+      q1[j] += std::uniform_real_distribution<double>(-step, step)(rng);
+    }
+    if (trial % 5 == 4) q1 = random_q();
+    const CollisionFactor kept(0, 0.0, 0.1, 0.05, 0.01, context);
+    evaluate(kept, q0);
+    const Evaluation a = evaluate(kept, q1);
+    const Evaluation b = evaluate(CollisionFactor(0, 0.0, 0.1, 0.05, 0.01, context), q1);
+    EXPECT_EQ(a.r, b.r) << "trial " << trial;
+    EXPECT_EQ(a.J, b.J) << "trial " << trial;
+    (a.z == b.z ? asked_again : answered_from_last) += 1;
+    moved_into_contact += !b.r.isZero() ? 1 : 0;
+  }
+  EXPECT_GT(answered_from_last, 40);
+  EXPECT_GT(asked_again, 40);
+  EXPECT_GT(moved_into_contact, 20);
+}
+
+TEST_F(CollisionLastQuery, APositiveMultiplierOrAMovedObstacleAsksAgain) {
+  int answered_from_last = 0;
+  for (int trial = 0; trial < 100; ++trial) {
+    const Eigen::VectorXd q = random_q();
+    CollisionFactor f(0, 0.0, 0.1, 0.05, 0.01, context);
+    const Eigen::VectorXd z0 = evaluate(f, q).z;
+    const Eigen::VectorXd q1 = q + Eigen::VectorXd::Constant(q.size(), 1e-9);
+    const Evaluation fresh = evaluate(CollisionFactor(0, 0.0, 0.1, 0.05, 0.01, context), q1);
+    answered_from_last += evaluate(f, q1).z == z0 && fresh.z != z0 ? 1 : 0;
+    // A multiplier on a row makes every row count again.
+    auto m = std::make_shared<Multipliers>(f.residual_dim(), 10.0);
+    m->lower[trial % f.residual_dim()] = 1.0;
+    f.bind(m);
+    EXPECT_EQ(evaluate(f, q1).z, fresh.z) << "trial " << trial;
+  }
+  EXPECT_GT(answered_from_last, 20);  // the shortcut was there to refuse
+  // The desk moves: the last query saw it elsewhere.
+  CollisionFactor f(0, 0.0, 0.1, 0.05, 0.01, context);
+  Eigen::VectorXd q = random_q();
+  evaluate(f, q);
+  Eigen::Isometry3d pose = context->obstacles[0].pose;
+  pose.translation().z() += 0.3;
+  ASSERT_TRUE(context->move_obstacle(0, pose).ok);
+  const Evaluation moved = evaluate(f, q);
+  EXPECT_EQ(moved.z, evaluate(CollisionFactor(0, 0.0, 0.1, 0.05, 0.01, context), q).z);
+}
+
+}  // namespace
+}  // namespace kinograph::planning
