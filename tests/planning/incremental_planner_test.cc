@@ -380,49 +380,55 @@ TEST(Replanner, MotionGoneOnAlongThePlanShiftsTheTree) {
   EXPECT_EQ(replanner.last_report().method, "warm-start");
 }
 
-// The iiwa desk task's goal 8 of the replanning benchmark with its desk top moved by that
-// benchmark's seeded offset: the incremental replan and the warm start on the incremental graph
-// stall, while the batch planner's warm start detours widely around the desk; the fallback is
-// that warm batch solve, carried into a new tree, and the next replan goes on from it.
+// The iiwa desk task's goal 20 of the replanning benchmark with its desk top moved by seeded
+// offsets: most moves replan incrementally, but some stall in the incremental replan while the
+// batch planner's warm start detours widely around the desk; the fallback is that warm batch
+// solve, carried into a new tree, and the next replan goes on from it. The moves are drawn in
+// turn until one needs the fallback (today the first does; which one depends on rounding).
 TEST(Replanner, AFailedReplanFallsBackToTheBatchPlannersWarmStart) {
   const Scene scene = load_scene(kScenes + "iiwa_desk.yaml");
   GoalSampler sampler(scene.problem, bench::iiwa_goal_options(1));
-  // A desk move whose incremental replan does not validate and whose warm batch solve does
-  // (the 20th of the replanning benchmark's draws; most replan incrementally).
   const std::vector<Eigen::VectorXd> goals = sampler.sample(20);
   ASSERT_EQ(goals.size(), 20u);
   Problem first = scene.problem;
   first.goal.q = goals[19];
-  std::mt19937_64 rng(5019);
-  std::uniform_real_distribution<double> u(-0.05, 0.05);
-  collision::Obstacle top = first.obstacles[0];
-  Problem moved = first;
-  do {
-    top.pose = first.obstacles[0].pose;
-    top.pose.translation() += Eigen::Vector3d(u(rng), u(rng), u(rng));
-    moved.obstacles[0] = top;
-  } while (!check_problem(moved).empty());
 
   ReplannerOptions options;
   options.retry_from_scratch = false;  // the warm batch solve alone must answer
   Replanner replanner(options);
-  const Plan plan = replanner.plan(first, true);
-  ASSERT_TRUE(plan.success()) << failures(plan);
-  ProblemChange change;
-  change.add_or_move.push_back(top);
-  const Plan re = replanner.replan(change);
-  ASSERT_TRUE(re.success()) << failures(re) << re.stats.reason;
-  EXPECT_TRUE(replanner.last_report().fell_back);
+  Plan previous = replanner.plan(first, true);
+  ASSERT_TRUE(previous.success()) << failures(previous);
+  std::mt19937_64 rng(5019);
+  std::uniform_real_distribution<double> u(-0.05, 0.05);
+  Problem moved = first;
+  Plan re;
+  bool fell_back = false;
+  for (int draw = 0; draw < 25 && !fell_back; ++draw) {
+    collision::Obstacle top = first.obstacles[0];
+    do {
+      top.pose = first.obstacles[0].pose;
+      top.pose.translation() += Eigen::Vector3d(u(rng), u(rng), u(rng));
+      moved.obstacles[0] = top;
+    } while (!check_problem(moved).empty());
+    ProblemChange change;
+    change.add_or_move.push_back(top);
+    re = replanner.replan(change);
+    ASSERT_TRUE(re.success()) << "desk move " << draw << ": " << failures(re) << re.stats.reason;
+    fell_back = replanner.last_report().fell_back;
+    if (!fell_back) previous = re;
+  }
+  ASSERT_TRUE(fell_back) << "no desk move of 25 needed the fallback";
   EXPECT_EQ(replanner.last_report().method, "batch after incremental");
   // The answer is the incremental planner's warm-started solve of the moved problem (a batch
-  // solve from the first plan, settled in the tree).
-  const Plan warm = IncrementalPlanner(options.incremental).plan(moved, &plan);
+  // solve from the plan before the move, settled in the tree).
+  const Plan warm = IncrementalPlanner(options.incremental).plan(moved, &previous);
   ASSERT_TRUE(warm.success());
   EXPECT_NEAR(re.stats.cost, warm.stats.cost, 1e-6 * warm.stats.cost);
-  // The tree carries the recovered plan: the goal moved a little replans incrementally.
+  // The tree carries the recovered plan: the goal moved by a hair replans incrementally from it
+  // (from the stalled result it would not validate).
   ProblemChange back;
   back.goal = moved.goal;
-  back.goal->q += Eigen::VectorXd::Constant(7, 0.01);
+  back.goal->q += Eigen::VectorXd::Constant(7, 1e-4);
   const Plan next = replanner.replan(back);
   ASSERT_TRUE(next.success()) << failures(next);
   EXPECT_TRUE(replanner.last_report().incremental);
