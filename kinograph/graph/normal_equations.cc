@@ -48,8 +48,18 @@ int checked_slot(const Values& values, const Factor& f, size_t fi, size_t k) {
 std::vector<std::vector<int>> coupled_block_rows(const std::vector<std::vector<int>>& factor_vars,
                                                  const std::vector<int>& pos_of_natural) {
   const int num_free = static_cast<int>(pos_of_natural.size());
+  // Counted first, so that each column's list is allocated once.
+  std::vector<int> count(num_free, 1);
+  for (const auto& vars : factor_vars) {
+    for (int va : vars) {
+      for (int vb : vars) count[pos_of_natural[vb]] += pos_of_natural[va] < pos_of_natural[vb];
+    }
+  }
   std::vector<std::vector<int>> block_rows(num_free);
-  for (int b = 0; b < num_free; ++b) block_rows[b].push_back(b);
+  for (int b = 0; b < num_free; ++b) {
+    block_rows[b].reserve(count[b]);
+    block_rows[b].push_back(b);
+  }
   for (const auto& vars : factor_vars) {
     for (int va : vars) {
       for (int vb : vars) {
@@ -105,6 +115,7 @@ NormalEquations::Incidence NormalEquations::incidence(const FactorGraph& graph,
     }
   }
   inc.factor_vars.reserve(graph.num_factors());
+  inc.factor_slots.reserve(graph.num_factors());
   for (size_t fi = 0; fi < graph.size(); ++fi) {
     if (graph[fi]) add_factor_keys(fi, *graph[fi], values, inc);
   }
@@ -115,6 +126,8 @@ NormalEquations::Incidence NormalEquations::incidence(const FactorGraph& graph,
 void NormalEquations::add_factor_keys(size_t fi, const Factor& f, const Values& values,
                                       Incidence& inc) {
   std::vector<int> vars, slots;
+  vars.reserve(f.keys().size());
+  slots.reserve(f.keys().size());
   for (size_t k = 0; k < f.keys().size(); ++k) {
     const int s = checked_slot(values, f, fi, k);
     slots.push_back(s);
@@ -160,6 +173,7 @@ std::vector<std::vector<int>> NormalEquations::lay_out_columns(
     std::sort(rows.begin(), rows.end());
     rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
     int within = 0;
+    block_within[b].reserve(rows.size());
     for (int a : rows) {
       block_within[b].push_back(within);
       within += var_dim_[a];
@@ -190,6 +204,11 @@ void NormalEquations::index_factors(const FactorGraph& graph, const Values& valu
                                     const Incidence& inc, const std::vector<int>& pos_of_natural,
                                     const BlockPattern& pattern) {
   size_t fi_dense = 0;
+  factors_.reserve(inc.factor_slots.size());
+  size_t keys = 0;
+  for (const auto& slots : inc.factor_slots) keys += slots.size();
+  key_value_offset_.reserve(keys);
+  key_col_.reserve(keys);
   for (size_t fi = 0; fi < graph.size(); ++fi) {
     if (!graph[fi]) continue;
     const auto& slots = inc.factor_slots[fi_dense++];
@@ -224,6 +243,7 @@ void NormalEquations::add_runs(const Factor& f, const std::vector<int>& pos,
   const auto& offsets = f.block_offsets();
   const auto& dims = f.dims();
   std::vector<int> by_position;  // the free keys in elimination order
+  by_position.reserve(pos.size());
   for (size_t i = 0; i < pos.size(); ++i) {
     if (pos[i] >= 0) by_position.push_back(static_cast<int>(i));
   }

@@ -385,6 +385,45 @@ TEST(IntervalDynamicsFactor, KeptEvaluationIsExactWhenRowsTurnOn) {
   expect_exact_linearization(f, x);
 }
 
+// The interval factors of a graph share one scratch per worker: each evaluation must equal
+// that of a factor with its own, whatever the factors evaluated before it on that scratch
+// (more or fewer check points, other values, with or without Jacobians).
+TEST(IntervalDynamicsFactor, FactorsSharingAWorkspaceEvaluateAsAlone) {
+  const auto model = testing::acrobot_model();
+  const double step = 0.05;
+  auto shared = std::make_shared<IntervalWorkspace>(model, step);
+  std::vector<IntervalDynamicsFactor> together, alone;
+  for (int checks : {5, 0, 3}) {
+    IntervalDynamicsOptions o;
+    o.checks = checks;
+    o.integration_step = step;
+    together.emplace_back(0, 0.1, model, o, shared);
+    alone.emplace_back(0, 0.1, model, o);
+  }
+  std::mt19937 rng(51);
+  for (int trial = 0; trial < 12; ++trial) {
+    const size_t i = static_cast<size_t>(trial) % together.size();
+    const graph::Values x = off_defect_interval(model->nq(), 0.1, rng);
+    Eigen::VectorXd r1, r2, z1, z2;
+    Eigen::MatrixXd J1, J2;
+    together[i].linearize(x, r1, J1);
+    alone[i].linearize(x, r2, J2);
+    EXPECT_EQ(r1, r2) << "factor " << i << " trial " << trial;
+    EXPECT_EQ(J1, J2) << "factor " << i << " trial " << trial;
+    const graph::Values y = off_defect_interval(model->nq(), 0.1, rng);
+    together[i].values_at(y, z1);
+    alone[i].values_at(y, z2);
+    EXPECT_EQ(z1, z2) << "factor " << i << " trial " << trial;
+  }
+  // A workspace is for one model and RK4 step.
+  IntervalDynamicsOptions o;
+  o.checks = 2;
+  EXPECT_THROW(IntervalDynamicsFactor(0, 0.1, model, o, shared), std::invalid_argument);
+  o.integration_step = step;
+  EXPECT_THROW(IntervalDynamicsFactor(0, 0.1, load_robot("robots/rr/rr.urdf"), o, shared),
+               std::invalid_argument);
+}
+
 TEST(IntervalDynamicsFactor, RowsOfTheAcrobot) {
   const auto model = testing::acrobot_model();
   IntervalDynamicsOptions o;

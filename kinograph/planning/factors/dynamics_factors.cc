@@ -14,6 +14,8 @@ std::vector<RowSpec> DynamicsStepFactor::rows_for(const dynamics::Model& model,
                                                   std::vector<int>* joint_of_row) {
   std::vector<RowSpec> rows;
   std::vector<int> joints;
+  rows.reserve(2 * model.nq());
+  joints.reserve(2 * model.nq());
   for (int j = 0; j < model.nq(); ++j) {
     const dynamics::Body& b = model.bodies[j];
     RowSpec r;

@@ -1,5 +1,6 @@
 #include "kinograph/planning/factors/interval_factors.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -12,8 +13,10 @@ namespace {
 std::vector<RowSpec> row_specs(const dynamics::Model& model, double dt,
                                const IntervalDynamicsOptions& o) {
   using Kind = IntervalDynamicsFactor::Row::Kind;
+  const std::vector<IntervalDynamicsFactor::Row> layout = IntervalDynamicsFactor::layout(model, o);
   std::vector<RowSpec> rows;
-  for (const IntervalDynamicsFactor::Row& r : IntervalDynamicsFactor::layout(model, o)) {
+  rows.reserve(layout.size());
+  for (const IntervalDynamicsFactor::Row& r : layout) {
     const dynamics::JointLimits& l = model.bodies[r.joint].limits;
     const double e = o.limit_epsilon;
     RowSpec spec;
@@ -41,6 +44,7 @@ std::vector<RowSpec> row_specs(const dynamics::Model& model, double dt,
 std::vector<IntervalDynamicsFactor::Row> IntervalDynamicsFactor::layout(
     const dynamics::Model& model, const IntervalDynamicsOptions& o) {
   std::vector<Row> rows;
+  rows.reserve(2 * model.nq() + 3 * model.nq() * std::max(0, o.checks));
   for (int j = 0; j < model.nq(); ++j) {
     if (!model.bodies[j].actuated) rows.push_back({Row::Kind::kDefectQ, j, -1});
   }
@@ -66,7 +70,8 @@ std::vector<IntervalDynamicsFactor::Row> IntervalDynamicsFactor::layout(
 
 IntervalDynamicsFactor::IntervalDynamicsFactor(int k, double dt,
                                                std::shared_ptr<const dynamics::Model> model,
-                                               const IntervalDynamicsOptions& options)
+                                               const IntervalDynamicsOptions& options,
+                                               std::shared_ptr<IntervalWorkspace> workspace)
     : ConstrainedFactor({q_key(k), v_key(k), a_key(k), q_key(k + 1), v_key(k + 1), a_key(k + 1)},
                         std::vector<int>(6, model->nq()),
                         (dt > 0 ? row_specs(*model, dt, options)
@@ -74,15 +79,21 @@ IntervalDynamicsFactor::IntervalDynamicsFactor(int k, double dt,
       model_(std::move(model)),
       dt_(dt),
       layout_(layout(*model_, options)),
-      interpolant_(*model_, options.integration_step) {
+      workspace_(workspace ? std::move(workspace)
+                           : std::make_shared<IntervalWorkspace>(model_, options.integration_step)) {
+  if (workspace_->model() != model_ || workspace_->integration_step() != options.integration_step) {
+    throw std::invalid_argument("IntervalDynamicsFactor: the workspace is for another model or "
+                                "RK4 step");
+  }
   while (defect_rows_ < static_cast<int>(layout_.size()) && layout_[defect_rows_].point < 0) {
     ++defect_rows_;
   }
   // Check points only where they have rows (limit_rows may leave a robot's points none).
   const int checks = defect_rows_ < static_cast<int>(layout_.size()) ? options.checks : 0;
+  times_.reserve(checks + 1);
+  point_begin_.reserve(checks + 1);
   for (int i = 1; i <= checks; ++i) times_.push_back(dt * i / (checks + 1));
   times_.push_back(dt);
-  points_.resize(times_.size());
   int row = defect_rows_;
   for (int i = 0; i < checks; ++i) {
     point_begin_.push_back(row);
@@ -107,8 +118,12 @@ void IntervalDynamicsFactor::compute(const graph::FactorValues& x, Eigen::Ref<Ei
   const int checks = static_cast<int>(times_.size()) - 1;
   // The defect needs the sensitivities to the end; check points only if a row of theirs is on.
   const bool derivatives = J != nullptr;
-  interpolant_.start(x[0], x[1], x[2], x[5], dt_, derivatives);
-  for (int i = 0; i < checks; ++i) interpolant_.at(times_[i], false, points_[i], effort_rows_);
+  IntervalScratch& w = workspace_->local();
+  IntervalInterpolant& interpolant = w.interpolant;
+  std::vector<InterpolantPoint>& points = w.points;
+  if (points.size() < times_.size()) points.resize(times_.size());  // grow only: keeps storage
+  interpolant.start(x[0], x[1], x[2], x[5], dt_, derivatives);
+  for (int i = 0; i < checks; ++i) interpolant.at(times_[i], false, points[i], effort_rows_);
   // The value of a row at a point.
   const auto value = [&](const Row& r, const InterpolantPoint& p) {
     switch (r.kind) {
@@ -118,21 +133,21 @@ void IntervalDynamicsFactor::compute(const graph::FactorValues& x, Eigen::Ref<Ei
     }
   };
   // Defect rows come in unactuated() order, positions first: row i reads y[i] and S.row(i).
-  const Eigen::VectorXd& y = interpolant_.end_state();
+  const Eigen::VectorXd& y = interpolant.end_state();
   for (int row = 0; row < defect_rows_; ++row) {
     const Row& r = layout_[row];
     const int block = r.kind == Kind::kDefectQ ? 3 : 4;
     z[row] = x[block][r.joint] - y[row];
     if (!derivatives) continue;
     J->block(block)(row, r.joint) = 1;
-    const Eigen::MatrixXd& S = interpolant_.end_sensitivity();
+    const Eigen::MatrixXd& S = interpolant.end_sensitivity();
     const int n = model_->nq(), key_of[4] = {0, 1, 2, 5};
     for (int b = 0; b < 4; ++b) J->block(key_of[b]).row(row) -= S.block(row, b * n, 1, n);
   }
   for (int i = 0; i < checks; ++i) {
     bool needed = false, tau_needed = false;  // a row of the point needs its Jacobian row
     for (int row = point_begin_[i]; row < point_begin_[i + 1]; ++row) {
-      z[row] = value(layout_[row], points_[i]);
+      z[row] = value(layout_[row], points[i]);
       if (derivatives && jacobian_row_needed(row, z[row])) {
         needed = true;
         tau_needed = tau_needed || layout_[row].kind == Kind::kTau;
@@ -140,14 +155,14 @@ void IntervalDynamicsFactor::compute(const graph::FactorValues& x, Eigen::Ref<Ei
     }
     if (!needed) continue;
     // Position and velocity rows alone need no dynamics' derivatives.
-    interpolant_.at(times_[i], true, with_derivatives_, tau_needed);
+    interpolant.at(times_[i], true, w.with_derivatives, tau_needed);
     for (int row = point_begin_[i]; row < point_begin_[i + 1]; ++row) {
       if (!jacobian_row_needed(row, z[row])) continue;
       const Kind kind = layout_[row].kind;
       jacobian_row(row,
-                   kind == Kind::kTau  ? with_derivatives_.dtau
-                   : kind == Kind::kQ ? with_derivatives_.dq
-                                      : with_derivatives_.dqd,
+                   kind == Kind::kTau  ? w.with_derivatives.dtau
+                   : kind == Kind::kQ ? w.with_derivatives.dq
+                                      : w.with_derivatives.dqd,
                    1, *J);
     }
   }

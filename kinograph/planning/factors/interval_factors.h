@@ -8,6 +8,7 @@
 
 #include "kinograph/dynamics/model.h"
 #include "kinograph/planning/factors/constrained_factor.h"
+#include "kinograph/planning/factors/interval_workspace.h"
 #include "kinograph/planning/interpolant.h"
 
 namespace kinograph::planning {
@@ -46,12 +47,15 @@ struct IntervalDynamicsOptions {
 /// rest from inverse dynamics alone.
 class IntervalDynamicsFactor final : public ConstrainedFactor {
  public:
-  /// Throws std::invalid_argument if the interval would have no rows or dt ≤ 0.
+  /// Evaluates in `workspace` (shared with the graph's other interval factors; its own when
+  /// null). Throws std::invalid_argument if the interval would have no rows, dt ≤ 0, or the
+  /// workspace is for another model or RK4 step than `options.integration_step`.
   IntervalDynamicsFactor(int k, double dt, std::shared_ptr<const dynamics::Model> model,
-                         const IntervalDynamicsOptions& options);
+                         const IntervalDynamicsOptions& options,
+                         std::shared_ptr<IntervalWorkspace> workspace = nullptr);
   void compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
                const graph::Jacobians* J) const override;
-  bool parallel_safe() const override { return true; }  // touches only its own state
+  bool parallel_safe() const override { return true; }  // its workspace is per worker
   /// A defect row as the unactuated joint missing the next knot (joint, times, amount); a limit
   /// row as the joint's q, q̇ or τ against its limit at the interior point's own time.
   std::string describe_row(int row, double z, const RowContext& c) const override;
@@ -77,9 +81,7 @@ class IntervalDynamicsFactor final : public ConstrainedFactor {
   std::vector<int> point_begin_;   // first row of each check point (and the row count last)
   int defect_rows_ = 0;
   bool effort_rows_ = false;  // τ at the check points: inverse dynamics at every evaluation
-  mutable IntervalInterpolant interpolant_;
-  mutable std::vector<InterpolantPoint> points_;  // values at the check points, then Δt
-  mutable InterpolantPoint with_derivatives_;     // one point's derivatives at a time
+  std::shared_ptr<IntervalWorkspace> workspace_;
 };
 
 }  // namespace kinograph::planning

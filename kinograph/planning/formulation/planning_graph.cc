@@ -172,6 +172,10 @@ std::vector<FactorEntry> timing_entries(const Problem& problem, const GraphOptio
     if (bits == kNoLimitRows) with_rows[bits].checks = 0;
     has_rows[bits] = !IntervalDynamicsFactor::layout(model, with_rows[bits]).empty();
   }
+  // One scratch per worker for all of them, not a dynamics workspace in every factor.
+  const auto workspace = rows.knots_only ? nullptr
+                                         : std::make_shared<IntervalWorkspace>(
+                                               problem.model, between.integration_step);
   for (int k = 0; k < problem.steps; ++k) {
     out.push_back(make_soft_entry(std::make_shared<GpPriorFactor>(k, n, dt, problem.objectives.qc),
                                   {FactorRole::kGpPrior, k}));
@@ -184,7 +188,8 @@ std::vector<FactorEntry> timing_entries(const Problem& problem, const GraphOptio
     const int bits = rows.limits.empty() ? kAllLimitRows : rows.limits[k] & kAllLimitRows;
     if (has_rows[bits]) {
       out.push_back(make_entry(
-          std::make_shared<IntervalDynamicsFactor>(k, dt, problem.model, with_rows[bits]),
+          std::make_shared<IntervalDynamicsFactor>(k, dt, problem.model, with_rows[bits],
+                                                   workspace),
           {FactorRole::kInterval, k}));
     }
   }
