@@ -4,6 +4,7 @@
 // positive or an obstacle moved. On the iiwa with the desk, a leg, the floor and its self pairs.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <random>
@@ -111,6 +112,37 @@ TEST_F(CollisionLastQuery, APositiveMultiplierOrAMovedObstacleAsksAgain) {
   ASSERT_TRUE(context->move_obstacle(0, pose).ok);
   const Evaluation moved = evaluate(f, q);
   EXPECT_EQ(moved.z, evaluate(CollisionFactor(0, 0.0, 0.1, 0.05, 0.01, context), q).z);
+}
+
+// The whitened rows are the hinges of the raw distances (unbound: μ = 1, λ = 0): zero and with
+// a zero Jacobian row for every pair beyond its ε, (ε − z)/s for one inside. A factor that has
+// proven every row clear skips evaluate()'s per-row test; this holds it to what that test gives,
+// at fresh queries and at answers from the last one.
+TEST_F(CollisionLastQuery, TheWhitenedRowsAreTheHingesOfTheRawDistances) {
+  int clear = 0, inside = 0;
+  CollisionFactor kept(0, 0.0, 0.1, 0.05, 0.01, context);
+  Eigen::VectorXd q = random_q();
+  for (int trial = 0; trial < 300; ++trial) {
+    q = trial % 3 == 0 ? random_q() : Eigen::VectorXd(q.array() + 1e-5);
+    for (const bool from_kept : {true, false}) {
+      const CollisionFactor fresh(0, 0.0, 0.1, 0.05, 0.01, context);
+      const Evaluation e = evaluate(from_kept ? kept : fresh, q);
+      bool any_inside = false;
+      for (int i = 0; i < e.z.size(); ++i) {
+        const RowSpec& row = kept.rows()[static_cast<size_t>(i)];
+        const double hinge = std::max(0.0, (row.lower - e.z[i]) / row.scale);
+        ASSERT_EQ(e.r[i], hinge) << "trial " << trial << " row " << i;
+        if (hinge == 0) {
+          EXPECT_TRUE(e.J.row(i).isZero()) << "trial " << trial << " row " << i;
+        } else {
+          any_inside = true;
+        }
+      }
+      (any_inside ? inside : clear) += 1;
+    }
+  }
+  EXPECT_GT(clear, 100);
+  EXPECT_GT(inside, 100);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #include "kinograph/planning/factors/collision_factors.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <utility>
@@ -151,9 +152,11 @@ void CollisionFactor::compute(const graph::FactorValues& x, Eigen::Ref<Eigen::Ve
   // from the last query's: while that stays below the last smallest gap and no multiplier is
   // positive, every row stays beyond its ε with its hinge off, so the last distances stand in
   // for the query (the factor's rows and Jacobian are zero either way).
-  if (last_.version == ctx.version && !ctx.moving && last_.gap > 0 && bound_multipliers_zero() &&
+  const bool no_multipliers = bound_multipliers_zero();
+  if (last_.version == ctx.version && !ctx.moving && last_.gap > 0 && no_multipliers &&
       2 * ctx.lever.dot((q - last_.q).cwiseAbs()) < last_.gap) {
     z = last_.z;
+    rows_proven_clear();
     return;
   }
   dynamics::forward_kinematics(model, c.data, q);
@@ -178,9 +181,15 @@ void CollisionFactor::compute(const graph::FactorValues& x, Eigen::Ref<Eigen::Ve
   last_.z = z;
   last_.gap = std::numeric_limits<double>::infinity();
   for (int i = 0; i < residual_dim(); ++i) {
-    last_.gap = std::min(last_.gap, z[i] - rows()[static_cast<size_t>(i)].lower);
+    const double gap = z[i] - rows()[static_cast<size_t>(i)].lower;
+    if (std::isnan(gap)) {  // a distance without a value: never taken as clear
+      last_.gap = gap;
+      break;
+    }
+    last_.gap = std::min(last_.gap, gap);
   }
   last_.version = ctx.version;
+  if (last_.gap > 0 && no_multipliers) rows_proven_clear();  // every row beyond its ε
 }
 
 namespace {

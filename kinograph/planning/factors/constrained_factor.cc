@@ -44,6 +44,8 @@ void ConstrainedFactor::penalty_changed() {
 namespace {
 // The factor whose evaluate() runs on this thread (jacobian_row_needed answers for it only).
 thread_local const ConstrainedFactor* evaluating = nullptr;
+// Set by rows_proven_clear() during that factor's compute().
+thread_local bool proven_clear = false;
 
 // Marks `f` as evaluating for its lifetime (also when compute() throws).
 struct Evaluating {
@@ -77,6 +79,10 @@ bool ConstrainedFactor::jacobian_row_needed(int row, double z) const {
   return h.a > 0 || h.b > 0;
 }
 
+void ConstrainedFactor::rows_proven_clear() const {
+  if (evaluating == this) proven_clear = true;
+}
+
 bool ConstrainedFactor::bound_multipliers_zero() const {
   return !m_ || ((m_->lower.array() == 0).all() && (m_->upper.array() == 0).all());
 }
@@ -88,9 +94,21 @@ void ConstrainedFactor::evaluate(const graph::FactorValues& x, Eigen::Ref<Eigen:
   graph::RowSupport* support = J != nullptr ? J->row_support() : nullptr;
   const bool unzeroed = support != nullptr && lists_written_rows_;
   if (unzeroed) support->rows.clear();
+  proven_clear = false;
   {
     const Evaluating guard(this);
     cached_compute(x, e, J);
+  }
+  if (proven_clear) {  // what the loop below would give, without it
+    e.setZero();
+    if (J == nullptr) return;
+    if (support != nullptr) {
+      support->rows.clear();
+      support->all = residual_dim() == 0;
+      return;
+    }
+    for (size_t k = 0; k < keys().size(); ++k) J->block(static_cast<int>(k)).setZero();
+    return;
   }
   thread_local std::vector<char> written;
   if (unzeroed) {

@@ -128,6 +128,11 @@ class ConstrainedFactor : public graph::Factor {
   /// Whether every multiplier is zero (so is an unbound factor's): a bound row's hinge is then
   /// off exactly where its value lies within its bounds.
   bool bound_multipliers_zero() const;
+  /// For compute() of a factor whose rows are all bounds, once it has found every value it
+  /// wrote strictly within its bounds and bound_multipliers_zero(): every hinge is then off, and
+  /// evaluate() zeroes the residual and lists no Jacobian row without testing each row. Has no
+  /// effect outside evaluate().
+  void rows_proven_clear() const;
   /// For a subclass whose compute() is linear in the variables: with soft and equality rows only
   /// the whitened Jacobian is then constant between penalty changes (Factor::jacobian_version).
   /// Throws std::logic_error if a row is a bound.
