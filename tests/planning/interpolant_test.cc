@@ -4,7 +4,11 @@
 // and the IntervalDynamicsFactor's Jacobians against central differences.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <limits>
+#include <memory>
 #include <random>
+#include <vector>
 
 #include "kinograph/dynamics/inverse_dynamics.h"
 #include "kinograph/graph/testing/numerical_jacobian.h"
@@ -274,6 +278,75 @@ TEST(IntervalDynamicsFactor, LimitRowsByKindReadTheSameValues) {
       EXPECT_EQ(limit_rows == 0, bits == kNoLimitRows) << model->name << " bits " << bits;
     }
   }
+}
+
+// A fully actuated arm's factor with q and q̇ rows only lists the rows it writes, so J arrives
+// unzeroed (filled with NaN here): its listed rows and residual must equal an evaluation into a
+// zeroed J, with rows kept on by a multiplier although inside their bounds, rows past a limit
+// (fast knots), and intervals where every row is clear (none listed). A factor with torque
+// rows keeps its Jacobian instead and gets J zeroed.
+TEST(IntervalDynamicsFactor, MotionRowsListedEqualAZeroedEvaluation) {
+  const auto model = load_robot("robots/iiwa14/iiwa14.urdf");
+  const int n = model->nq();
+  IntervalDynamicsOptions o;
+  o.checks = 9;
+  o.limit_rows = kMotionLimitRows;
+  o.limit_epsilon = 0.03;
+  const double dt = 0.1;
+  EXPECT_FALSE(IntervalDynamicsFactor(0, dt, model, [&] {
+                 IntervalDynamicsOptions all = o;
+                 all.limit_rows = kAllLimitRows;
+                 return all;
+               }()).writes_listed_rows_only());
+  struct Linearization {
+    Eigen::VectorXd r;
+    Eigen::MatrixXd J;
+    graph::RowSupport support;
+  };
+  const auto linearize = [](const IntervalDynamicsFactor& f, const graph::Values& v, double fill,
+                            bool with_list) {
+    std::vector<const double*> ptrs;
+    for (const graph::Key& k : f.keys()) ptrs.push_back(v.at(k).data());
+    Linearization l{Eigen::VectorXd::Zero(f.residual_dim()),
+                    Eigen::MatrixXd::Constant(f.residual_dim(), f.jacobian_cols(), fill), {}};
+    Eigen::Ref<Eigen::MatrixXd> J(l.J);
+    f.whitened(ptrs.data(), l.r, &J, with_list ? &l.support : nullptr);
+    return l;
+  };
+  std::mt19937 rng(31);
+  int listed = 0, kept_on = 0, clear = 0;
+  for (int trial = 0; trial < 48; ++trial) {
+    graph::Values x = random_interval(n, dt, rng);
+    const double speed = 0.5 * (1 + trial % 4);  // up to 2 rad/s: past joint 1's 1.48 limit
+    x.update(v_key(0), Eigen::VectorXd(speed * x.at(v_key(0))));
+    IntervalDynamicsFactor f(0, dt, model, o);
+    EXPECT_TRUE(f.writes_listed_rows_only());
+    auto m = std::make_shared<Multipliers>(f.residual_dim(), 10.0);
+    if (trial % 2 == 1) {
+      for (int i = 0; i < f.residual_dim(); i += 7) m->upper[i] = 50.0;
+    }
+    f.bind(m);
+    const Linearization whole = linearize(f, x, 0.0, false);
+    const Linearization part = linearize(f, x, std::numeric_limits<double>::quiet_NaN(), true);
+    EXPECT_EQ(part.r, whole.r) << "trial " << trial;
+    const std::vector<int> rows = part.support.all ? std::vector<int>() : part.support.rows;
+    if (!part.support.all && rows.empty()) {
+      ++clear;
+      EXPECT_TRUE(whole.r.isZero() && whole.J.isZero()) << "trial " << trial;
+    }
+    for (int i = 0; i < f.residual_dim(); ++i) {
+      if (!part.support.all && !std::binary_search(rows.begin(), rows.end(), i)) {
+        EXPECT_TRUE(whole.J.row(i).isZero()) << "trial " << trial << " row " << i;
+        continue;
+      }
+      ++listed;
+      EXPECT_EQ(part.J.row(i), whole.J.row(i)) << "trial " << trial << " row " << i;
+      kept_on += whole.r[i] != 0 && m->upper[i] > 0 ? 1 : 0;
+    }
+  }
+  EXPECT_GT(listed, 100);
+  EXPECT_GT(kept_on, 20);
+  EXPECT_GT(clear, 5);
 }
 
 // The factor's hinged residual Jacobian at x against central differences.

@@ -101,14 +101,26 @@ IntervalDynamicsFactor::IntervalDynamicsFactor(int k, double dt,
   }
   point_begin_.push_back(row);
   for (const Row& r : layout_) effort_rows_ = effort_rows_ || r.kind == Row::Kind::kTau;
-  cache_evaluations();
+  // Rows on the interpolant alone cost little to recompute, and few of them are ever near a
+  // limit: such a factor lists the rows it writes instead of keeping a copy of its Jacobian.
+  if (defect_rows_ == 0 && !effort_rows_) {
+    list_written_rows();
+  } else {
+    cache_evaluations();
+  }
 }
 
 void IntervalDynamicsFactor::jacobian_row(int row, const Eigen::MatrixXd& d, double sign,
-                                          const graph::Jacobians& J) const {
+                                          const graph::Jacobians& J, bool whole) const {
   const int n = model_->nq(), j = layout_[static_cast<size_t>(row)].joint;
   // d's blocks 0, 1, 2 are q_k, q̇_k, q̈_k; its fourth, q̈_{k+1}, is key 5.
   const int key_of[4] = {0, 1, 2, 5};
+  if (whole) {  // J arrived unzeroed: the row is written in full, q_{k+1} and q̇_{k+1} as zeros
+    J.block(3).row(row).setZero();
+    J.block(4).row(row).setZero();
+    for (int b = 0; b < 4; ++b) J.block(key_of[b]).row(row) = sign * d.block(j, b * n, 1, n);
+    return;
+  }
   for (int b = 0; b < 4; ++b) J.block(key_of[b]).row(row) += sign * d.block(j, b * n, 1, n);
 }
 
@@ -144,10 +156,16 @@ void IntervalDynamicsFactor::compute(const graph::FactorValues& x, Eigen::Ref<Ei
     const int n = model_->nq(), key_of[4] = {0, 1, 2, 5};
     for (int b = 0; b < 4; ++b) J->block(key_of[b]).row(row) -= S.block(row, b * n, 1, n);
   }
+  // With list_written_rows() and a row list, J arrives unzeroed and the rows written are listed.
+  graph::RowSupport* listed =
+      derivatives && writes_listed_rows_only() ? J->row_support() : nullptr;
+  bool within = defect_rows_ == 0;  // every row so far strictly inside its bounds
   for (int i = 0; i < checks; ++i) {
     bool needed = false, tau_needed = false;  // a row of the point needs its Jacobian row
     for (int row = point_begin_[i]; row < point_begin_[i + 1]; ++row) {
       z[row] = value(layout_[row], points[i]);
+      const RowSpec& spec = rows()[static_cast<size_t>(row)];
+      within = within && z[row] > spec.lower && z[row] < spec.upper;
       if (derivatives && jacobian_row_needed(row, z[row])) {
         needed = true;
         tau_needed = tau_needed || layout_[row].kind == Kind::kTau;
@@ -159,13 +177,16 @@ void IntervalDynamicsFactor::compute(const graph::FactorValues& x, Eigen::Ref<Ei
     for (int row = point_begin_[i]; row < point_begin_[i + 1]; ++row) {
       if (!jacobian_row_needed(row, z[row])) continue;
       const Kind kind = layout_[row].kind;
+      if (listed != nullptr) listed->rows.push_back(row);
       jacobian_row(row,
                    kind == Kind::kTau  ? w.with_derivatives.dtau
                    : kind == Kind::kQ ? w.with_derivatives.dq
                                       : w.with_derivatives.dqd,
-                   1, *J);
+                   1, *J, listed != nullptr);
     }
   }
+  // Limit rows only, all inside their bounds with no multiplier pressing: every hinge is off.
+  if (within && bound_multipliers_zero()) rows_proven_clear();
 }
 
 std::string IntervalDynamicsFactor::describe_row(int row, double z, const RowContext& c) const {

@@ -71,8 +71,10 @@ class IntervalDynamicsFactor final : public ConstrainedFactor {
 
  private:
   // Fills row `row`'s Jacobian from the point's derivatives (n × 4n over q_k, q̇_k, q̈_k,
-  // q̈_{k+1}), with the sign of the value.
-  void jacobian_row(int row, const Eigen::MatrixXd& d, double sign, const graph::Jacobians& J) const;
+  // q̈_{k+1}), with the sign of the value: added to a zeroed row, or written `whole` (every
+  // block) into an unzeroed one.
+  void jacobian_row(int row, const Eigen::MatrixXd& d, double sign, const graph::Jacobians& J,
+                    bool whole = false) const;
 
   std::shared_ptr<const dynamics::Model> model_;
   double dt_;
