@@ -9,6 +9,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -608,6 +609,37 @@ TEST(DetourOptions, RankingIsTheSameOnOneWorker) {
     EXPECT_EQ(alone[i].via, shared[i].via) << i;
     EXPECT_EQ(alone[i].clearance, shared[i].clearance) << i;
   }
+}
+
+// Asked for the `best` best, the ranking gives up on candidates that cannot be among them: what
+// it returns must be exactly the head of the full ranking (via points, clearances, order), on
+// the desk, for goals around it, on two workers or one.
+TEST(DetourOptions, TheBestAreTheHeadOfTheFullRanking) {
+  Problem p = load_scene(std::string(KINOGRAPH_SOURCE_DIR) + "/robots/scenes/iiwa_desk.yaml").problem;
+  std::mt19937 rng(11);
+  int compared = 0;
+  for (int goal = 0; goal < 8; ++goal) {
+    Eigen::VectorXd g = p.goal.q;
+    for (int j = 0; j < g.size(); ++j) g[j] += std::uniform_real_distribution<double>(-0.6, 0.6)(rng);
+    const std::vector<Detour> all = detour_candidates(p, g);
+    ASSERT_EQ(all.size(), static_cast<size_t>(DetourOptions().candidates));
+    for (int best : {1, 3, 4, 30}) {
+      std::vector<Detour> head = detour_candidates(p, g, {}, best), alone;
+      auto body = [&](int worker) {
+        if (worker == 0) alone = detour_candidates(p, g, {}, best);
+      };
+      graph::run_on_workers(2, body);
+      ASSERT_EQ(head.size(), std::min(all.size(), static_cast<size_t>(best)));
+      ASSERT_EQ(alone.size(), head.size());
+      for (size_t i = 0; i < head.size(); ++i, ++compared) {
+        EXPECT_EQ(head[i].via, all[i].via) << "goal " << goal << " best " << best << " " << i;
+        EXPECT_EQ(head[i].clearance, all[i].clearance) << "goal " << goal << " " << i;
+        EXPECT_EQ(alone[i].via, all[i].via) << "goal " << goal << " best " << best << " " << i;
+      }
+    }
+  }
+  EXPECT_EQ(compared, 8 * (1 + 3 + 4 + 24));
+  EXPECT_TRUE(detour_candidates(p, p.goal.q, {}, 0).empty());
 }
 
 // Each detour's clearance is that of its two segments sampled `samples` times, capped at ε.

@@ -115,10 +115,10 @@ Plan BatchPlanner::plan(const Problem& problem, const Plan* warm, BatchSolution*
   auto add_restarts = [&](bool detour_goes_first, size_t tried) {
     if (detours_added || !may_detour) return false;
     detours_added = true;
-    const std::vector<Detour> vias = detour_candidates(problem, q_goal, options_.detour);
-    const size_t first = inits.size();
     const int detours = options_.max_restarts - (may_search ? 1 : 0);
-    for (int r = 0; r < detours && r < static_cast<int>(vias.size()); ++r) {
+    const std::vector<Detour> vias = detour_candidates(problem, q_goal, options_.detour, detours);
+    const size_t first = inits.size();
+    for (int r = 0; r < static_cast<int>(vias.size()); ++r) {
       inits.push_back(via_point(problem, vias[r].via, q_goal));
     }
     const bool swapped = detour_goes_first && inits.size() > first && vias[0].clearance >= 0;

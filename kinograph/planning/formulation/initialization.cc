@@ -3,9 +3,12 @@
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <numeric>
 #include <random>
 #include <stdexcept>
@@ -199,18 +202,31 @@ Trajectory via_point(const Problem& problem, const Eigen::VectorXd& q_via,
 namespace {
 // Smallest clearance along a → b, travelled from time t0 to t1 (for moving obstacles), with a
 // prepared world and workspace; a clearance above `cap` counts as `cap`, which saves finding
-// the closest pair wherever none is within it.
+// the closest pair wherever none is within it. The samples are visited coarse to fine (ends,
+// middle, quarters, …: a segment's worst point is rarely at its ends), and the walk gives up as
+// soon as `give_up(smallest so far)` says so, returning that smallest; the minimum does not
+// depend on the order.
+template <class GiveUp>
 double clearance_along(const dynamics::Model& model, collision::CollisionWorld& world,
                        dynamics::Data& data, const Eigen::VectorXd& a, const Eigen::VectorXd& b,
-                       double t0, double t1, int samples, double cap) {
+                       double t0, double t1, int samples, double cap, GiveUp give_up) {
   double worst = std::numeric_limits<double>::infinity();
-  for (int i = 0; i <= samples; ++i) {
+  const auto visit = [&](int i) {
     graph::throw_if_cancelled();  // the detour ranking walks many segments before any solve
     const double s = static_cast<double>(i) / samples, t = (1 - s) * t0 + s * t1;
     dynamics::forward_kinematics(model, data, (1 - s) * a + s * b);
     worst = std::min(worst, std::isfinite(cap) && !world.any_within(data, t, cap)
                                 ? cap
                                 : world.closest(data, t).distance);
+    return give_up(std::min(worst, cap));
+  };
+  if (visit(0) || visit(samples)) return std::min(worst, cap);
+  int top = 1;
+  while (2 * top < samples) top *= 2;
+  for (int stride = top; stride >= 1; stride /= 2) {
+    for (int i = stride; i < samples; i += 2 * stride) {
+      if (visit(i)) return std::min(worst, cap);
+    }
   }
   return std::min(worst, cap);
 }
@@ -223,12 +239,13 @@ double segment_clearance(const Problem& problem, const Eigen::VectorXd& a, const
   for (const auto& o : problem.obstacles) world.add_obstacle(o);
   dynamics::Data data(*problem.model);
   return clearance_along(*problem.model, world, data, a, b, 0, problem.horizon,
-                         std::max(1, samples), std::numeric_limits<double>::infinity());
+                         std::max(1, samples), std::numeric_limits<double>::infinity(),
+                         [](double) { return false; });
 }
 
 std::vector<Detour> detour_candidates(const Problem& problem, const Eigen::VectorXd& q_goal,
-                                      const DetourOptions& options) {
-  if (problem.obstacles.empty() || options.candidates <= 0) return {};
+                                      const DetourOptions& options, int best) {
+  if (problem.obstacles.empty() || options.candidates <= 0 || best == 0) return {};
   const dynamics::Model& model = *problem.model;
   const int n = model.nq();
   // Every via point is drawn first, in the seed's order; their paths are then checked on the
@@ -244,6 +261,7 @@ std::vector<Detour> detour_candidates(const Problem& problem, const Eigen::Vecto
       q[j] = std::clamp(q[j] + u(rng), l.lower, l.upper);
     }
   }
+  const size_t keep = best < 0 ? vias.size() : std::min(vias.size(), static_cast<size_t>(best));
   struct Probe {
     collision::CollisionWorld world;
     dynamics::Data data;
@@ -258,29 +276,51 @@ std::vector<Detour> detour_candidates(const Problem& problem, const Eigen::Vecto
   const int samples = std::max(1, options.samples);
   const double T = problem.horizon, half = problem.dt() * (problem.steps / 2);
   struct Candidate {
-    double score;
+    double score = -std::numeric_limits<double>::infinity();
     Detour detour;
+    bool ranked = false;  // checked to the end (not given up)
   };
   std::vector<Candidate> ranked(vias.size());
+  // The keep-th best score of the candidates checked to the end so far (−∞ until there are
+  // keep of them). A candidate whose score, which only falls as its samples are checked,
+  // drops below it cannot be among the kept: its check stops there. So every candidate that
+  // a full check would keep is checked to the end, with the same score, whatever the order.
+  std::mutex kept_mutex;
+  std::vector<double> kept_scores;  // descending, at most keep
+  std::atomic<double> bar{-std::numeric_limits<double>::infinity()};
   auto check = [&](int c, int) {
     Probe& p = probes.local();
     const Eigen::VectorXd& q = vias[static_cast<size_t>(c)];
     // Clearance capped at ε (anything clearer is as good), then a small preference for short
     // detours, so the ranking is: collision-free first, then by joint-space length.
-    const double c1 =
-        clearance_along(model, p.world, p.data, problem.start_q, q, 0, half, samples, eps);
-    const double c2 = clearance_along(model, p.world, p.data, q, q_goal, half, T, samples, eps);
     const double length = (q - problem.start_q).norm() + (q_goal - q).norm();
-    ranked[static_cast<size_t>(c)] = {std::min(c1, c2) - 1e-3 * length,
-                                      Detour{q, std::min(c1, c2)}};
+    double c1 = eps;
+    const auto below_bar = [&](double clearance) {
+      return std::min(c1, clearance) - 1e-3 * length < bar.load(std::memory_order_relaxed);
+    };
+    c1 = clearance_along(model, p.world, p.data, problem.start_q, q, 0, half, samples, eps,
+                         below_bar);
+    if (below_bar(c1)) return;
+    const double c2 =
+        clearance_along(model, p.world, p.data, q, q_goal, half, T, samples, eps, below_bar);
+    if (below_bar(c2)) return;
+    const double score = std::min(c1, c2) - 1e-3 * length;
+    ranked[static_cast<size_t>(c)] = {score, Detour{q, std::min(c1, c2)}, true};
+    const std::lock_guard<std::mutex> lock(kept_mutex);
+    kept_scores.insert(std::upper_bound(kept_scores.begin(), kept_scores.end(), score,
+                                        std::greater<double>()),
+                       score);
+    if (kept_scores.size() > keep) kept_scores.pop_back();
+    if (kept_scores.size() == keep) bar.store(kept_scores.back(), std::memory_order_relaxed);
   };
   std::vector<int> items(vias.size());
   std::iota(items.begin(), items.end(), 0);
   graph::share_out(graph::kMaxWorkers, {}, items, check, 1);
-  std::stable_sort(ranked.begin(), ranked.end(),
-                   [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
+  std::stable_sort(ranked.begin(), ranked.end(), [](const Candidate& a, const Candidate& b) {
+    return a.ranked != b.ranked ? a.ranked : a.score > b.score;
+  });
   std::vector<Detour> out;
-  for (auto& c : ranked) out.push_back(std::move(c.detour));
+  for (size_t i = 0; i < keep && ranked[i].ranked; ++i) out.push_back(std::move(ranked[i].detour));
   return out;
 }
 

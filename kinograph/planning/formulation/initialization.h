@@ -60,9 +60,10 @@ struct Detour {
 
 /// Detours drawn around the midpoint of start and goal, best first: ranked by the clearance of
 /// their two-segment joint-space path to the problem's obstacles (capped at the planner's ε, so
-/// among clear paths the shorter wins). Empty without obstacles.
+/// among clear paths the shorter wins). Only the `best` best (all when negative): the others'
+/// checks stop as soon as they cannot be among them. Empty without obstacles.
 std::vector<Detour> detour_candidates(const Problem& problem, const Eigen::VectorXd& q_goal,
-                                      const DetourOptions& options = {});
+                                      const DetourOptions& options = {}, int best = -1);
 
 /// Smallest clearance (m) to the problem's obstacles along the joint-space segment a → b,
 /// travelled over the whole horizon and sampled at `samples` + 1 configurations (+inf without
