@@ -13,30 +13,16 @@
 #include "kinograph/planning/clearance_world.h"
 #include "kinograph/planning/factors/collision_factors.h"
 #include "kinograph/planning/factors/trajectory_factors.h"
+#include "listed_rows.h"
 #include "test_problems.h"
 
 namespace kinograph::planning {
 namespace {
 
 using testing::box_obstacle;
+using testing::Linearization;
+using testing::linearize;
 
-struct Linearization {
-  Eigen::VectorXd r;
-  Eigen::MatrixXd J;
-  graph::RowSupport support;
-};
-
-// whitened() at v into a J filled with `fill`, with or without a row list.
-Linearization linearize(const CollisionFactor& f, const graph::Values& v, double fill,
-                        bool with_list) {
-  std::vector<const double*> ptrs;
-  for (const graph::Key& k : f.keys()) ptrs.push_back(v.at(k).data());
-  Linearization l{Eigen::VectorXd::Zero(f.residual_dim()),
-                  Eigen::MatrixXd::Constant(f.residual_dim(), f.jacobian_cols(), fill), {}};
-  Eigen::Ref<Eigen::MatrixXd> J(l.J);
-  f.whitened(ptrs.data(), l.r, &J, with_list ? &l.support : nullptr);
-  return l;
-}
 
 TEST(CollisionRowsListed, ListedRowsEqualAZeroedEvaluation) {
   const auto model = testing::iiwa_with_block();

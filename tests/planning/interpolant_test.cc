@@ -16,6 +16,7 @@
 #include "kinograph/planning/factors/trajectory_factors.h"
 #include "kinograph/planning/interpolant.h"
 #include "kinograph/planning/trajectory_sampler.h"
+#include "listed_rows.h"
 #include "test_problems.h"
 
 namespace kinograph::planning {
@@ -298,21 +299,6 @@ TEST(IntervalDynamicsFactor, MotionRowsListedEqualAZeroedEvaluation) {
                  all.limit_rows = kAllLimitRows;
                  return all;
                }()).writes_listed_rows_only());
-  struct Linearization {
-    Eigen::VectorXd r;
-    Eigen::MatrixXd J;
-    graph::RowSupport support;
-  };
-  const auto linearize = [](const IntervalDynamicsFactor& f, const graph::Values& v, double fill,
-                            bool with_list) {
-    std::vector<const double*> ptrs;
-    for (const graph::Key& k : f.keys()) ptrs.push_back(v.at(k).data());
-    Linearization l{Eigen::VectorXd::Zero(f.residual_dim()),
-                    Eigen::MatrixXd::Constant(f.residual_dim(), f.jacobian_cols(), fill), {}};
-    Eigen::Ref<Eigen::MatrixXd> J(l.J);
-    f.whitened(ptrs.data(), l.r, &J, with_list ? &l.support : nullptr);
-    return l;
-  };
   std::mt19937 rng(31);
   int listed = 0, kept_on = 0, clear = 0;
   for (int trial = 0; trial < 48; ++trial) {
@@ -326,8 +312,9 @@ TEST(IntervalDynamicsFactor, MotionRowsListedEqualAZeroedEvaluation) {
       for (int i = 0; i < f.residual_dim(); i += 7) m->upper[i] = 50.0;
     }
     f.bind(m);
-    const Linearization whole = linearize(f, x, 0.0, false);
-    const Linearization part = linearize(f, x, std::numeric_limits<double>::quiet_NaN(), true);
+    const testing::Linearization whole = testing::linearize(f, x, 0.0, false);
+    const testing::Linearization part =
+        testing::linearize(f, x, std::numeric_limits<double>::quiet_NaN(), true);
     EXPECT_EQ(part.r, whole.r) << "trial " << trial;
     const std::vector<int> rows = part.support.all ? std::vector<int>() : part.support.rows;
     if (!part.support.all && rows.empty()) {
