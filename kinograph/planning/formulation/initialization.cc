@@ -202,10 +202,10 @@ Trajectory via_point(const Problem& problem, const Eigen::VectorXd& q_via,
 namespace {
 // Smallest clearance along a → b, travelled from time t0 to t1 (for moving obstacles), with a
 // prepared world and workspace; a clearance above `cap` counts as `cap`, which saves finding
-// the closest pair wherever none is within it. The samples are visited coarse to fine (ends,
-// middle, quarters, …: a segment's worst point is rarely at its ends), and the walk gives up as
-// soon as `give_up(smallest so far)` says so, returning that smallest; the minimum does not
-// depend on the order.
+// the closest pair wherever none is within it. The ends come first, then the rest coarse to
+// fine (middle, quarters, …), so a segment through an obstacle shows it after a few samples;
+// the walk gives up as soon as `give_up(smallest so far)` says so, returning that smallest. The
+// minimum does not depend on the order.
 template <class GiveUp>
 double clearance_along(const dynamics::Model& model, collision::CollisionWorld& world,
                        dynamics::Data& data, const Eigen::VectorXd& a, const Eigen::VectorXd& b,
