@@ -13,6 +13,7 @@
 #include "kinograph/planning/clearance_world.h"
 #include "kinograph/planning/factors/collision_factors.h"
 #include "kinograph/planning/factors/trajectory_factors.h"
+#include "measured_values.h"
 #include "test_problems.h"
 
 namespace kinograph::planning {
@@ -25,13 +26,13 @@ struct Evaluation {
   Eigen::MatrixXd J;
 };
 
-// The raw distances, and the whitened residual and Jacobian, of `f` at q.
+// The raw distances (every reported pair measured), and the whitened residual and Jacobian,
+// of `f` at q.
 Evaluation evaluate(const CollisionFactor& f, const Eigen::VectorXd& q) {
   const double* ptrs[1] = {q.data()};
   const graph::FactorValues x(ptrs, f.dims().data());
-  Evaluation e{Eigen::VectorXd::Zero(f.residual_dim()), Eigen::VectorXd::Zero(f.residual_dim()),
+  Evaluation e{testing::measured_values(f, x), Eigen::VectorXd::Zero(f.residual_dim()),
                Eigen::MatrixXd::Zero(f.residual_dim(), f.jacobian_cols())};
-  f.compute(x, e.z, nullptr);
   Eigen::Ref<Eigen::MatrixXd> J(e.J);
   f.whitened(ptrs, e.r, &J);
   return e;
@@ -112,6 +113,56 @@ TEST_F(CollisionLastQuery, APositiveMultiplierOrAMovedObstacleAsksAgain) {
   ASSERT_TRUE(context->move_obstacle(0, pose).ok);
   const Evaluation moved = evaluate(f, q);
   EXPECT_EQ(moved.z, evaluate(CollisionFactor(0, 0.0, 0.1, 0.05, 0.01, context), q).z);
+}
+
+// Values alone without multipliers (a cost, a violation) measure only the pairs within their ε:
+// the whitened rows are those of an evaluation that measures every pair, the rows within their
+// ε read their distances and the others some value beyond it. Once a multiplier is set, values
+// read again at the same point are measured in full: the kept evaluation no longer stands in.
+TEST_F(CollisionLastQuery, ValuesAloneMeasureOnlyThePairsWithinTheirEpsilon) {
+  int unmeasured = 0, inside = 0;
+  Eigen::VectorXd q_unmeasured;
+  for (int trial = 0; trial < 200; ++trial) {
+    const Eigen::VectorXd q = random_q();
+    const double* ptrs[1] = {q.data()};
+    const CollisionFactor alone(0, 0.0, 0.1, 0.05, 0.01, context);
+    const graph::FactorValues x(ptrs, alone.dims().data());
+    Eigen::VectorXd z = Eigen::VectorXd::Zero(alone.residual_dim());
+    alone.compute(x, z, nullptr);
+    const CollisionFactor measuring(0, 0.0, 0.1, 0.05, 0.01, context);
+    const Eigen::VectorXd full = testing::measured_values(measuring, x);
+    Eigen::VectorXd r_alone = Eigen::VectorXd::Zero(alone.residual_dim());
+    CollisionFactor(0, 0.0, 0.1, 0.05, 0.01, context).whitened(ptrs, r_alone, nullptr);
+    EXPECT_EQ(r_alone, evaluate(CollisionFactor(0, 0.0, 0.1, 0.05, 0.01, context), q).r)
+        << "trial " << trial;
+    for (int i = 0; i < z.size(); ++i) {
+      const double lower = alone.rows()[static_cast<size_t>(i)].lower;
+      if (full[i] <= lower) {
+        EXPECT_EQ(z[i], full[i]) << "trial " << trial << " row " << i;
+        ++inside;
+      } else {
+        EXPECT_GT(z[i], lower) << "trial " << trial << " row " << i;
+        if (z[i] != full[i]) {
+          ++unmeasured;
+          q_unmeasured = q;
+        }
+      }
+    }
+  }
+  EXPECT_GT(inside, 20);
+  ASSERT_GT(unmeasured, 20);
+  graph::Values v;
+  v.insert(q_key(0), q_unmeasured);
+  CollisionFactor f(0, 0.0, 0.1, 0.05, 0.01, context);
+  Eigen::VectorXd alone, bound;
+  f.values_at(v, alone);
+  const Eigen::VectorXd full = testing::measured_values(f, v);
+  EXPECT_NE(alone, full);
+  auto m = std::make_shared<Multipliers>(f.residual_dim(), 10.0);
+  m->lower[0] = 1.0;
+  f.bind(m);
+  f.values_at(v, bound);
+  EXPECT_EQ(bound, full);
 }
 
 // The whitened rows are the hinges of the raw distances (unbound: μ = 1, λ = 0): zero and with

@@ -19,6 +19,7 @@
 #include "kinograph/planning/io/scene.h"
 #include "kinograph/planning/problem_check.h"
 #include "kinograph/planning/validate.h"
+#include "measured_values.h"
 #include "test_problems.h"
 
 namespace kinograph::planning {
@@ -63,8 +64,7 @@ TEST(SelfCollisionFactor, JacobiansWithBothBodiesMovingAndTheFloor) {
   v.insert(v_key(1), q7(-0.1, 0.2, 0.1, -0.3, 0.2, 0.3, -0.2));
   for (double s : {0.0, 0.4}) {
     CollisionFactor f(0, s, 0.2, 0.05, 0.01, ctx);
-    Eigen::VectorXd z;
-    f.values_at(v, z);
+    const Eigen::VectorXd z = testing::measured_values(f, v);
     EXPECT_LT(z.head(ctx->num_obstacle_rows).maxCoeff(), 2.0);  // floor rows reported
     EXPECT_LT(z.tail(ctx->num_pairs - ctx->num_obstacle_rows).minCoeff(), 0.2);
     auto c = check_jacobians(f, v, {1e-4, 1e-3, false});

@@ -131,6 +131,9 @@ CollisionFactor::CollisionFactor(int k, double s, double dt, double epsilon, dou
       t_((k + s) * dt),
       ctx_(std::move(context)) {
   if (!(s >= 0 && s < 1)) throw std::invalid_argument("CollisionFactor needs 0 <= s < 1");
+  double widest = -std::numeric_limits<double>::infinity();
+  for (const RowSpec& r : rows()) widest = std::max(widest, r.lower);
+  hinge_query_distance_ = std::min(ctx_->query_distance, widest);
   const double s2 = s * s, s3 = s2 * s;
   h_ << 2 * s3 - 3 * s2 + 1, s3 - 2 * s2 + s, -2 * s3 + 3 * s2, s3 - s2;
   cache_values();
@@ -161,7 +164,13 @@ void CollisionFactor::compute(const graph::FactorValues& x, Eigen::Ref<Eigen::Ve
   }
   dynamics::forward_kinematics(model, c.data, q);
   z.setConstant(ctx.query_distance);
-  for (const collision::Proximity& p : c.world.query(c.data, t_)) {
+  // Values alone without multipliers (a cost or a violation) need only the pairs within their
+  // ε: every other hinge is off at any distance beyond it. Most pairs the query reports lie
+  // between ε and the query distance, and GJK is most of a query's time.
+  const bool hinges_only = J == nullptr && no_multipliers;
+  for (const collision::Proximity& p :
+       hinges_only ? c.world.query(c.data, t_, hinge_query_distance_)
+                   : c.world.query(c.data, t_)) {
     const int row = ctx.row(p);
     if (row < 0) continue;
     z[row] = p.distance;
@@ -177,19 +186,24 @@ void CollisionFactor::compute(const graph::FactorValues& x, Eigen::Ref<Eigen::Ve
       J->block(3).row(row) = h_[3] * dt_ * c.gradient.transpose();
     }
   }
-  last_.q = q;
-  last_.z = z;
-  last_.gap = std::numeric_limits<double>::infinity();
+  double gap = std::numeric_limits<double>::infinity();
   for (int i = 0; i < residual_dim(); ++i) {
-    const double gap = z[i] - rows()[static_cast<size_t>(i)].lower;
-    if (std::isnan(gap)) {  // a distance without a value: never taken as clear
-      last_.gap = gap;
+    const double row_gap = z[i] - rows()[static_cast<size_t>(i)].lower;
+    if (std::isnan(row_gap)) {  // a distance without a value: never taken as clear
+      gap = row_gap;
       break;
     }
-    last_.gap = std::min(last_.gap, gap);
+    gap = std::min(gap, row_gap);
   }
+  if (gap > 0 && no_multipliers) rows_proven_clear();  // every row beyond its ε
+  if (hinges_only) {
+    clear_rows_not_measured();
+    return;  // the last query stays the one that measured every pair it stands in for
+  }
+  last_.q = q;
+  last_.z = z;
+  last_.gap = gap;
   last_.version = ctx.version;
-  if (last_.gap > 0 && no_multipliers) rows_proven_clear();  // every row beyond its ε
 }
 
 namespace {

@@ -77,7 +77,9 @@ struct CollisionContext {
 /// Signed distances d ≥ ε of every pair (self rows: d ≥ the context's self ε) at the state q(s)
 /// between steps k and k+1 (s = 0: state k exactly, keys q_k only; 0 < s < 1: the cubic Hermite
 /// interpolation of q_k, q̇_k, q_{k+1}, q̇_{k+1}, keys in that order). Pairs farther than the query
-/// distance read as that distance. Obstacles are taken at time t = (k + s)Δt.
+/// distance read as that distance; so do the pairs beyond their ε in an evaluation without
+/// Jacobians while no multiplier is set (a cost or a violation: their hinges are off at any
+/// distance). Obstacles are taken at time t = (k + s)Δt.
 class CollisionFactor final : public ConstrainedFactor {
  public:
   CollisionFactor(int k, double s, double dt, double epsilon, double scale,
@@ -93,6 +95,9 @@ class CollisionFactor final : public ConstrainedFactor {
 
  private:
   double s_, dt_, t_;
+  // The distance up to which pairs are measured when only the hinges are asked for: the
+  // largest ε of the rows (no further than the query distance).
+  double hinge_query_distance_ = 0;
   Eigen::Vector4d h_;  // Hermite weights of q_k, Δt·q̇_k, q_{k+1}, Δt·q̇_{k+1}
   std::shared_ptr<CollisionContext> ctx_;
   // The last query of the world (at q, giving z), with the smallest z − ε over the rows.

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
+#include <utility>
 
 namespace kinograph::planning {
 
@@ -46,6 +47,8 @@ namespace {
 thread_local const ConstrainedFactor* evaluating = nullptr;
 // Set by rows_proven_clear() during that factor's compute().
 thread_local bool proven_clear = false;
+// Set by clear_rows_not_measured() during the compute() that cached_compute() runs.
+thread_local bool not_measured = false;
 
 // Marks `f` as evaluating for its lifetime (also when compute() throws).
 struct Evaluating {
@@ -82,6 +85,8 @@ bool ConstrainedFactor::jacobian_row_needed(int row, double z) const {
 void ConstrainedFactor::rows_proven_clear() const {
   if (evaluating == this) proven_clear = true;
 }
+
+void ConstrainedFactor::clear_rows_not_measured() const { not_measured = true; }
 
 bool ConstrainedFactor::bound_multipliers_zero() const {
   return !m_ || ((m_->lower.array() == 0).all() && (m_->upper.array() == 0).all());
@@ -229,10 +234,11 @@ void ConstrainedFactor::keep(Evaluation& k, const graph::FactorValues& x,
   }
   k.z = z;
   k.valid = true;
+  k.clear_rows_not_measured = std::exchange(not_measured, false);
 }
 
 bool ConstrainedFactor::kept_at(const Evaluation& k, const graph::FactorValues& x) const {
-  if (!k.valid) return false;
+  if (!k.valid || (k.clear_rows_not_measured && !bound_multipliers_zero())) return false;
   for (size_t b = 0; b < keys().size(); ++b) {
     const int i = static_cast<int>(b);
     const size_t bytes = sizeof(double) * static_cast<size_t>(dims()[b]);
@@ -254,6 +260,7 @@ bool ConstrainedFactor::reusable(const graph::FactorValues& x, bool with_jacobia
 void ConstrainedFactor::cached_compute(const graph::FactorValues& x,
                                        Eigen::Ref<Eigen::VectorXd> z,
                                        const graph::Jacobians* J) const {
+  not_measured = false;
   if (kept_.empty()) {
     compute(x, z, J);
     return;
@@ -288,6 +295,9 @@ void ConstrainedFactor::cached_compute(const graph::FactorValues& x,
   compute(x, z, J);
   keep(k, x, z);
   if (J == nullptr) return;
+  if (k.clear_rows_not_measured) {
+    throw std::logic_error(name() + ": rows left unmeasured in an evaluation with Jacobians");
+  }
   for (size_t b = 0; b < keys().size(); ++b) {
     k.J.middleCols(offsets[b], dims()[b]) = J->block(static_cast<int>(b));
   }

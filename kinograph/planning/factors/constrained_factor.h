@@ -133,6 +133,11 @@ class ConstrainedFactor : public graph::Factor {
   /// evaluate() zeroes the residual and lists no Jacobian row without testing each row. Has no
   /// effect outside evaluate().
   void rows_proven_clear() const;
+  /// For compute() without Jacobians, when bound_multipliers_zero(): it measured only the rows
+  /// at or past a bound and wrote some value strictly within the bounds for the others (their
+  /// hinges are off whatever the value). The kept evaluation is then read again only while
+  /// every multiplier stays zero, and never for a Jacobian.
+  void clear_rows_not_measured() const;
   /// For a subclass whose compute() is linear in the variables: with soft and equality rows only
   /// the whitened Jacobian is then constant between penalty changes (Factor::jacobian_version).
   /// Throws std::logic_error if a row is a bound.
@@ -164,6 +169,7 @@ class ConstrainedFactor : public graph::Factor {
     Eigen::MatrixXd J;
     std::vector<char> filled;
     bool valid = false;
+    bool clear_rows_not_measured = false;  // see clear_rows_not_measured()
   };
   // compute(), or the kept evaluation when it is at the same x and has every Jacobian row
   // needed now (called while this factor is evaluating, so inactive rows are known).
@@ -172,7 +178,8 @@ class ConstrainedFactor : public graph::Factor {
   // Records x and z as `k`'s evaluation.
   void keep(Evaluation& k, const graph::FactorValues& x,
             const Eigen::Ref<const Eigen::VectorXd>& z) const;
-  // Whether `k` was evaluated at x.
+  // Whether `k` was evaluated at x and its values serve now (clear rows measured, or every
+  // multiplier zero).
   bool kept_at(const Evaluation& k, const graph::FactorValues& x) const;
   // Whether the kept evaluation is at x (and has the Jacobian rows needed now, if asked).
   bool reusable(const graph::FactorValues& x, bool with_jacobian) const;
