@@ -269,6 +269,41 @@ TEST(ConstrainedFactor, KeptValuesServeOnlyValues) {
   EXPECT_DOUBLE_EQ(z[0], 0.16);
 }
 
+// z = q with the bound z ≥ 0.1, whose compute() says it left its clear rows unmeasured (as the
+// collision rows do for values alone), counting its evaluations.
+class UnmeasuringFactor : public ConstrainedFactor {
+ public:
+  UnmeasuringFactor()
+      : ConstrainedFactor({q_key(0)}, {1}, {RowSpec{RowKind::kBounds, 0.1, 1e9, 1, 1}}) {
+    cache_values();
+  }
+  void compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
+               const graph::Jacobians* J) const override {
+    ++calls;
+    z[0] = x[0][0];
+    if (J != nullptr) J->block(0)(0, 0) = 1;
+    clear_rows_not_measured();
+  }
+  mutable int calls = 0;
+};
+
+TEST(ConstrainedFactor, UnmeasuredValuesServeOnlyWhileNoMultiplierIsSet) {
+  graph::Values v;
+  v.insert(q_key(0), Eigen::VectorXd::Constant(1, 0.3));
+  UnmeasuringFactor f;
+  Eigen::VectorXd z, r;
+  Eigen::MatrixXd J;
+  f.values_at(v, z);
+  f.values_at(v, z);
+  EXPECT_EQ(f.calls, 1);
+  auto m = std::make_shared<Multipliers>(1, 10.0);
+  m->lower[0] = 1.0;
+  f.bind(m);
+  f.values_at(v, z);  // a multiplier needs every row measured
+  EXPECT_EQ(f.calls, 2);
+  EXPECT_THROW(f.linearize(v, r, J), std::logic_error);
+}
+
 TEST(DynamicsStepFactor, JacobiansOnIiwaWithPayloadAndAcrobot) {
   std::mt19937 rng(3);
   auto iiwa = std::make_shared<const dynamics::Model>(dynamics::attach_box_payload(

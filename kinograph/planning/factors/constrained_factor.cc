@@ -261,8 +261,15 @@ void ConstrainedFactor::cached_compute(const graph::FactorValues& x,
                                        Eigen::Ref<Eigen::VectorXd> z,
                                        const graph::Jacobians* J) const {
   not_measured = false;
-  if (kept_.empty()) {
+  // compute(), holding it to clear_rows_not_measured()'s contract.
+  auto compute_here = [&] {
     compute(x, z, J);
+    if (J != nullptr && not_measured) {
+      throw std::logic_error(name() + ": rows left unmeasured in an evaluation with Jacobians");
+    }
+  };
+  if (kept_.empty()) {
+    compute_here();
     return;
   }
   if (kept_.size() == 1) {  // cache_values(): the last values, from either kind of evaluation
@@ -271,7 +278,7 @@ void ConstrainedFactor::cached_compute(const graph::FactorValues& x,
       z = k.z;
       return;
     }
-    compute(x, z, J);
+    compute_here();
     keep(k, x, z);
     return;
   }
@@ -292,12 +299,9 @@ void ConstrainedFactor::cached_compute(const graph::FactorValues& x,
     }
     return;
   }
-  compute(x, z, J);
+  compute_here();
   keep(k, x, z);
   if (J == nullptr) return;
-  if (k.clear_rows_not_measured) {
-    throw std::logic_error(name() + ": rows left unmeasured in an evaluation with Jacobians");
-  }
   for (size_t b = 0; b < keys().size(); ++b) {
     k.J.middleCols(offsets[b], dims()[b]) = J->block(static_cast<int>(b));
   }

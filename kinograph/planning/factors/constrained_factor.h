@@ -134,9 +134,9 @@ class ConstrainedFactor : public graph::Factor {
   /// effect outside evaluate().
   void rows_proven_clear() const;
   /// For compute() without Jacobians, when bound_multipliers_zero(): it measured only the rows
-  /// at or past a bound and wrote some value strictly within the bounds for the others (their
-  /// hinges are off whatever the value). The kept evaluation is then read again only while
-  /// every multiplier stays zero, and never for a Jacobian.
+  /// at or past a bound and wrote some value within the bounds for the others (their hinges are
+  /// off whatever the value). The kept values are then read again only while every multiplier
+  /// stays zero. Called in an evaluation with Jacobians, it throws std::logic_error.
   void clear_rows_not_measured() const;
   /// For a subclass whose compute() is linear in the variables: with soft and equality rows only
   /// the whitened Jacobian is then constant between penalty changes (Factor::jacobian_version).
