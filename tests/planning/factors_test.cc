@@ -208,11 +208,15 @@ TEST(ConstrainedFactor, BoundRowInsideItsBoundsIsOnOnlyWhenAMultiplierPushes) {
 }
 
 // z = q², counting its evaluations, with the evaluations kept (as the dynamics rows keep them)
-// or only the values (as the collision rows).
+// or only the values (as the collision rows). `unmeasured`: the row is the bound z ≥ 0.01 and
+// compute() says it left its clear rows unmeasured (as the collision rows do for values alone).
 class CountingFactor : public ConstrainedFactor {
  public:
-  explicit CountingFactor(bool values_only = false)
-      : ConstrainedFactor({q_key(0)}, {1}, {RowSpec{RowKind::kSoft, 0, 0, 1, 2}}) {
+  explicit CountingFactor(bool values_only = false, bool unmeasured = false)
+      : ConstrainedFactor({q_key(0)}, {1},
+                          {unmeasured ? RowSpec{RowKind::kBounds, 0.01, 1e9, 1, 1}
+                                      : RowSpec{RowKind::kSoft, 0, 0, 1, 2}}),
+        unmeasured_(unmeasured) {
     if (values_only) {
       cache_values();
     } else {
@@ -224,8 +228,12 @@ class CountingFactor : public ConstrainedFactor {
     ++calls;
     z[0] = x[0][0] * x[0][0];
     if (J != nullptr) J->block(0)(0, 0) = 2 * x[0][0];
+    if (unmeasured_) clear_rows_not_measured();
   }
   mutable int calls = 0;
+
+ private:
+  bool unmeasured_;
 };
 
 TEST(ConstrainedFactor, ValuesAtTheLastLinearizationAreNotComputedAgain) {
@@ -269,28 +277,10 @@ TEST(ConstrainedFactor, KeptValuesServeOnlyValues) {
   EXPECT_DOUBLE_EQ(z[0], 0.16);
 }
 
-// z = q with the bound z ≥ 0.1, whose compute() says it left its clear rows unmeasured (as the
-// collision rows do for values alone), counting its evaluations.
-class UnmeasuringFactor : public ConstrainedFactor {
- public:
-  UnmeasuringFactor()
-      : ConstrainedFactor({q_key(0)}, {1}, {RowSpec{RowKind::kBounds, 0.1, 1e9, 1, 1}}) {
-    cache_values();
-  }
-  void compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
-               const graph::Jacobians* J) const override {
-    ++calls;
-    z[0] = x[0][0];
-    if (J != nullptr) J->block(0)(0, 0) = 1;
-    clear_rows_not_measured();
-  }
-  mutable int calls = 0;
-};
-
 TEST(ConstrainedFactor, UnmeasuredValuesServeOnlyWhileNoMultiplierIsSet) {
   graph::Values v;
   v.insert(q_key(0), Eigen::VectorXd::Constant(1, 0.3));
-  UnmeasuringFactor f;
+  CountingFactor f(/*values_only=*/true, /*unmeasured=*/true);
   Eigen::VectorXd z, r;
   Eigen::MatrixXd J;
   f.values_at(v, z);
