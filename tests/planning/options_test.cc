@@ -885,6 +885,33 @@ TEST(OuterLoopOptions, MaxStalledUpdates) {
   EXPECT_LT(stalled.stats.outer_iterations, ran_on.stats.outer_iterations);
 }
 
+// The same weak elbow: its knot-only solve stalls far from feasible (a worst scaled violation
+// above 1), so by default the attempt ends there; with abandon_violation = 0 it goes on to the
+// warm-up and the rows on the interpolant, which stall too, and both report the knot-level
+// infeasibility as a failure.
+TEST(BatchPlannerOptions, AbandonViolation) {
+  Problem p = load_scene(kScenes + "acrobot_swingup.yaml").problem;
+  auto weak = std::make_shared<dynamics::Model>(*p.model);
+  weak->bodies[1].limits.effort = 0.2;
+  p.model = weak;
+  BatchPlannerOptions o;
+  o.max_restarts = 0;
+  o.effort_continuation.clear();
+  const Plan abandoned = BatchPlanner(o).plan(p);
+  o.abandon_violation = 0;
+  const Plan went_on = BatchPlanner(o).plan(p);
+  for (const Plan* plan : {&abandoned, &went_on}) {
+    EXPECT_FALSE(plan->success());
+    EXPECT_EQ(plan->stats.status, PlanStatus::kInfeasible);
+    EXPECT_FALSE(plan->stats.reason.empty());
+  }
+  EXPECT_GT(abandoned.stats.max_constraint_violation, 0);
+  EXPECT_LT(2 * abandoned.stats.iterations, went_on.stats.iterations);
+  // A threshold above the stalled violation lets the attempt go on, as if off.
+  o.abandon_violation = 1e3;
+  EXPECT_EQ(BatchPlanner(o).plan(p).stats.iterations, went_on.stats.iterations);
+}
+
 TEST(BatchPlannerOptions, ValidationThresholdsJudgeThePlan) {
   BatchPlannerOptions o;
   o.validation.final_velocity = -1;  // no plan can meet this

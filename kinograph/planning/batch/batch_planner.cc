@@ -319,6 +319,14 @@ Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init, const s
         stage.iterations, to_string(stage.status),
         std::count_if(between.limits.begin(), between.limits.end(), [](char c) { return c != 0; }),
         problem.steps);
+    // A knot-only solve that stalled far from feasible ends the attempt: the rows between the
+    // knots only add constraints.
+    if (between.knots_only && r.status == PlanStatus::kInfeasible &&
+        options_.abandon_violation > 0 && r.worst.scaled_violation > options_.abandon_violation) {
+      spdlog::debug("{}: the knot-only solve ended infeasible (worst {:.3g} at {}); attempt "
+                    "abandoned", problem.name, r.worst.scaled_violation, r.worst.where);
+      break;
+    }
     // A warm-up's graph is never the answer: the rows on the interpolant follow it, even with
     // no iterations left.
     const bool on_interpolant = between.integration_step == kMaxIntegrationStep;

@@ -62,6 +62,13 @@ struct BatchPlannerOptions {
   /// the straight line collides, first (second after the best detour when that detour's path is
   /// clear); else right after a failed first attempt. max_samples = 0 switches it off.
   PathSearchOptions path_search;
+  /// An attempt whose knot-only solve ends infeasible (its violation stalled at the largest
+  /// penalty, or its iterations ran out) with a worst scaled violation above this ends there: the rows between the knots
+  /// would only add constraints to a solve already far from feasible, so the next
+  /// initialization starts at once. Scaled as OuterLoopOptions::constraint_tolerance (the
+  /// default is 500 times it; attempts that end valid stall, if at all, far below it);
+  /// 0 = every attempt goes on to the rows between the knots.
+  double abandon_violation = 0.5;
   /// When no attempt validates and the robot has an unactuated joint and a finite effort limit
   /// (effort_continuation_applies), one more attempt by continuation in the effort limits: the
   /// problem with every actuated joint's limit multiplied by each of these factors in turn (the
