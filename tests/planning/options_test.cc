@@ -864,17 +864,23 @@ TEST(OuterLoopOptions, DampingCarry) {
   EXPECT_LT(carried.stats.iterations, restarted.stats.iterations);
 }
 
-// An elbow far too weak to swing the Acrobot up: at the largest penalty the violation stops
-// shrinking, and the loop gives up after max_stalled_updates such updates instead of running
-// to max_outer_iterations.
-TEST(OuterLoopOptions, MaxStalledUpdates) {
+// The Acrobot with an elbow far too weak to swing it up, and options for one attempt at it
+// (no restarts, no continuation in the effort limits).
+Problem weak_elbow_acrobot(BatchPlannerOptions& o) {
   Problem p = load_scene(kScenes + "acrobot_swingup.yaml").problem;
   auto weak = std::make_shared<dynamics::Model>(*p.model);
   weak->bodies[1].limits.effort = 0.2;
   p.model = weak;
-  BatchPlannerOptions o;
   o.max_restarts = 0;
   o.effort_continuation.clear();
+  return p;
+}
+
+// At the largest penalty the weak elbow's violation stops shrinking, and the loop gives up
+// after max_stalled_updates such updates instead of running to max_outer_iterations.
+TEST(OuterLoopOptions, MaxStalledUpdates) {
+  BatchPlannerOptions o;
+  const Problem p = weak_elbow_acrobot(o);
   const Plan stalled = BatchPlanner(o).plan(p);
   o.outer_loop.max_stalled_updates = 0;
   const Plan ran_on = BatchPlanner(o).plan(p);
@@ -885,17 +891,12 @@ TEST(OuterLoopOptions, MaxStalledUpdates) {
   EXPECT_LT(stalled.stats.outer_iterations, ran_on.stats.outer_iterations);
 }
 
-// The same weak elbow: its knot-only solve stalls far from feasible (a worst scaled violation
+// The weak elbow's knot-only solve stalls far from feasible (a worst scaled violation
 // of about 1.4), so with abandon_violation = 1 the attempt ends there; with 0 it goes on to the
 // warm-up and the rows on the interpolant, which stall too. Both report the failure.
 TEST(BatchPlannerOptions, AbandonViolation) {
-  Problem p = load_scene(kScenes + "acrobot_swingup.yaml").problem;
-  auto weak = std::make_shared<dynamics::Model>(*p.model);
-  weak->bodies[1].limits.effort = 0.2;
-  p.model = weak;
   BatchPlannerOptions o;
-  o.max_restarts = 0;
-  o.effort_continuation.clear();
+  const Problem p = weak_elbow_acrobot(o);
   o.abandon_violation = 1;
   const Plan abandoned = BatchPlanner(o).plan(p);
   o.abandon_violation = 0;
