@@ -63,12 +63,12 @@ struct BatchPlannerOptions {
   /// clear); else right after a failed first attempt. max_samples = 0 switches it off.
   PathSearchOptions path_search;
   /// An attempt whose knot-only solve ends infeasible (its violation stalled at the largest
-  /// penalty, or its iterations ran out) with a worst scaled violation above this ends there: the rows between the knots
-  /// would only add constraints to a solve already far from feasible, so the next
-  /// initialization starts at once. Scaled as OuterLoopOptions::constraint_tolerance: the
-  /// default is 2000 times it, a collision row 6 cm inside its safety distance at the default
-  /// scale (the attempts seen to end valid after a stall stalled below 0.9; most that fail, at
-  /// 2–4); 0 = every attempt goes on to the rows between the knots.
+  /// penalty, or its iterations ran out) with a worst scaled violation above this ends there,
+  /// and the next initialization starts at once: the rows between the knots only add
+  /// constraints to a solve already this far from feasible. Scaled as
+  /// OuterLoopOptions::constraint_tolerance; the default, a collision row 6 cm inside its safety
+  /// distance at the default scale, lies far above where attempts that still end valid stall.
+  /// 0 = every attempt goes on to the rows between the knots.
   double abandon_violation = 2;
   /// When no attempt validates and the robot has an unactuated joint and a finite effort limit
   /// (effort_continuation_applies), one more attempt by continuation in the effort limits: the
