@@ -31,15 +31,15 @@ std::string describe(const planning::ReplanReport& r, const planning::Plan& plan
   const planning::IncrementalStats& s = r.statistics;
   char buf[512];
   std::snprintf(buf, sizeof buf,
-                "replan: method %s%s, %d ISAM2 updates, %d multiplier rounds, %ld cliques "
-                "re-eliminated, %ld variables relinearized, %d factors replaced, %d added, "
+                "replan: method %s%s, %d ISAM2 updates, %d multiplier rounds, %ld variables "
+                "re-eliminated, %ld relinearized, %d factors replaced, %d added, "
                 "%d re-added; incremental %.1f ms, total %.1f ms\n",
                 r.method.c_str(),
                 r.retried_from_scratch ? " (planned from scratch: the replan did not validate)"
                 : r.fell_back ? " (fell back: the incremental plan did not validate)"
                               : "",
                 s.updates,
-                s.rounds, s.cliques_reeliminated, s.variables_relinearized, s.factors_replaced,
+                s.rounds, s.variables_reeliminated, s.variables_relinearized, s.factors_replaced,
                 s.factors_added, s.factors_readded, s.incremental_time_s * 1e3,
                 plan.stats.solve_time_s * 1e3);
   return buf;

@@ -74,6 +74,7 @@ struct ISAM2::UpdateWork {
   std::vector<int> orphans;       // roots of the subtrees below the affected top
   std::vector<int> factors;       // factors eliminated into the new cliques
   std::vector<int> new_cliques;   // cliques built by this update
+  bool banded = false;            // solved whole by banded_ (no cliques built)
   std::vector<int> changed;       // variables back-substitution changed (last trial)
   double lambda = 0;              // damping of the last trial
   bool accepted = true;           // the last trial did not raise the error
@@ -111,12 +112,13 @@ ISAM2::ISAM2(ISAM2Options options)
 
 void ISAM2::sync_layout() {
   const int n = theta_.size();
-  std::vector<int> dims(n), offsets(n);
+  slot_dims_.resize(n);
+  slot_offsets_.resize(n);
   for (int s = 0; s < n; ++s) {
-    dims[s] = theta_.dim(s);
-    offsets[s] = theta_.offset(s);
+    slot_dims_[s] = theta_.dim(s);
+    slot_offsets_[s] = theta_.offset(s);
   }
-  tree_.set_layout(dims, offsets);
+  tree_.set_layout(slot_dims_, slot_offsets_);
   const Eigen::Index old = delta_.size();
   const Eigen::Index total = theta_.total_dim();
   delta_.conservativeResize(total);
@@ -377,7 +379,8 @@ ISAM2Result ISAM2::update(const std::vector<FactorPtr>& new_factors,
   }
 
   // Without a change only the prepared tree's step is taken.
-  if ((reeliminate && !detach_and_linearize(work, res)) || !eliminate_and_solve(work, res)) {
+  if ((reeliminate && !detach_and_linearize(work, res, /*allow_banded=*/true)) ||
+      !eliminate_and_solve(work, res)) {
     res.total_s = seconds_since(t_start);
     return res;
   }
@@ -419,12 +422,12 @@ ISAM2Result ISAM2::relinearize_at_estimate(const std::vector<Key>& last) {
   work.options = &all;
   ++stamp_counter_;
   relinearize(all, work, res);
-  if (work.marked.empty() && !needs_full_) {
+  if (work.marked.empty() && !needs_full_ && !tree_deferred_) {
     report_unchanged(work, res);
     res.total_s = seconds_since(t_start);
     return res;
   }
-  if (!detach_and_linearize(work, res)) {
+  if (!detach_and_linearize(work, res, /*allow_banded=*/false)) {
     res.total_s = seconds_since(t_start);
     return res;
   }
@@ -625,7 +628,8 @@ std::vector<int> ISAM2::variables_to_relinearize(const ISAM2UpdateOptions& updat
   }
   std::vector<int> chosen;
   for (int s = 0; s < theta_.size(); ++s) {
-    if (theta_.is_fixed_slot(s) || tree_.clique_of(s) < 0) continue;
+    // A variable not yet eliminated has no δ; a deferred tree holds none, the banded step all.
+    if (theta_.is_fixed_slot(s) || (!tree_deferred_ && tree_.clique_of(s) < 0)) continue;
     if (!check && !took_step[s]) continue;
     const auto d = delta_.segment(theta_.offset(s), theta_.dim(s));
     if (d.cwiseAbs().maxCoeff() <= (took_step[s] ? 0.0 : threshold)) continue;
@@ -726,6 +730,7 @@ void ISAM2::fail(ISAM2Result& res, ISAM2Status status, std::string reason) {
   res.status = status;
   res.reason = std::move(reason);
   tree_.clear();
+  tree_deferred_ = false;
   needs_full_ = true;
   prepared_ = false;
   prepared_damped_.clear();
@@ -739,7 +744,7 @@ void ISAM2::fail_singular(ISAM2Result& res, int slot) {
 
 // The affected top detached, its factors linearized and its new cliques built (symbolically);
 // false (the result says which factor) if a factor is not finite.
-bool ISAM2::detach_and_linearize(UpdateWork& work, ISAM2Result& res) {
+bool ISAM2::detach_and_linearize(UpdateWork& work, ISAM2Result& res, bool allow_banded) {
   const auto t_lin = Clock::now();
   find_affected_top(work);
   res.full_reelimination = work.full;
@@ -747,8 +752,28 @@ bool ISAM2::detach_and_linearize(UpdateWork& work, ISAM2Result& res) {
   if (!linearize_factors(work.to_linearize, res)) return false;
   work.factors = factors_to_eliminate(work);
   res.linearize_s = seconds_since(t_lin);
+  const auto t_elim = Clock::now();
+  work.banded = allow_banded && solve_banded(work, res.variables_relinearized);
+  tree_deferred_ = work.banded;
+  if (work.banded) {
+    banded_.assemble(linearized_, work.factors);
+    res.eliminate_s = seconds_since(t_elim);
+    res.variables_reeliminated = static_cast<int>(work.vars.size());
+    return true;
+  }
   build_affected_top(*work.options, work, res);
   return true;
+}
+
+// Whether this update's step comes from the whole system (banded_full_updates): a Gauss–Newton
+// update that relinearizes most variables (it re-eliminates the whole tree however small its
+// own change) on a graph whose Hessian is banded in slot order.
+bool ISAM2::solve_banded(const UpdateWork& work, int relinearized) {
+  if (!options_.banded_full_updates || !work.gauss_newton || !work.full ||
+      relinearized <= options_.full_reelimination_fraction * static_cast<double>(work.vars.size())) {
+    return false;
+  }
+  return banded_.prepare(work.vars, slot_dims_, linearized_, work.factors);
 }
 
 // Factors eliminated into the new cliques (those with a free variable): every one after a full
@@ -903,16 +928,31 @@ Eigen::VectorXd ISAM2::damping_diagonal(const std::vector<int>& vars) const {
 bool ISAM2::factorize_and_solve(UpdateWork& work, const Eigen::VectorXd* damping,
                                 ISAM2Result& res) {
   int bad_slot = -1;
-  const auto t_factor = Clock::now();
-  const bool factored = tree_.factorize(work.new_cliques, linearized_, damping, &bad_slot);
-  res.eliminate_s += seconds_since(t_factor);
-  if (!factored) {  // J is rank deficient: damping would only hide it
-    fail_singular(res, bad_slot);
-    return false;
+  if (work.banded) {
+    const auto t_factor = Clock::now();
+    if (!banded_.solve(damping, slot_offsets_, delta_gn_, &bad_slot)) {
+      res.eliminate_s += seconds_since(t_factor);
+      fail_singular(res, bad_slot);
+      return false;
+    }
+    res.eliminate_s += seconds_since(t_factor);
+    work.changed = work.vars;
+    res.cliques_solved = 0;
+  } else {
+    const auto t_factor = Clock::now();
+    const bool factored = tree_.factorize(work.new_cliques, linearized_, damping, &bad_slot);
+    res.eliminate_s += seconds_since(t_factor);
+    if (!factored) {  // J is rank deficient: damping would only hide it
+      fail_singular(res, bad_slot);
+      return false;
+    }
   }
   const auto t_solve = Clock::now();
-  work.changed.clear();
-  res.cliques_solved = tree_.back_substitute(options_.wildfire_threshold, delta_gn_, &work.changed);
+  if (!work.banded) {
+    work.changed.clear();
+    res.cliques_solved =
+        tree_.back_substitute(options_.wildfire_threshold, delta_gn_, &work.changed);
+  }
   if (work.gauss_newton) {
     for (int s : work.changed) {
       delta_.segment(theta_.offset(s), theta_.dim(s)) =
@@ -1000,6 +1040,7 @@ Eigen::VectorXd ISAM2::cauchy_point() const {
 }
 
 std::string ISAM2::check_invariants() const {
+  if (tree_deferred_ && tree_.empty()) return "";  // nothing to check until it is rebuilt
   std::vector<int> factors;
   for (size_t f = 0; f < graph_.size(); ++f) {
     if (!graph_[f]) continue;

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "kinograph/graph/banded_system.h"
 #include "kinograph/graph/bayes_tree.h"
 #include "kinograph/graph/factor_graph.h"
 #include "kinograph/graph/share_out_choice.h"
@@ -49,6 +50,13 @@ struct ISAM2Options {
   double constrain_touched_fraction = 0.3;
   /// How the linear solution becomes a new estimate (see ISAM2Step).
   ISAM2Step step = ISAM2Step::kGaussNewton;
+  /// A Gauss–Newton update that relinearizes more than full_reelimination_fraction of the
+  /// variables solves the whole system with a banded Cholesky in slot order (BandedSystem)
+  /// when its Hessian is a band there, as a trajectory's is, instead of rebuilding the Bayes
+  /// tree: the same step up to rounding, at a fraction of the cost. The tree is rebuilt by the
+  /// next update that changes only part of the graph or by relinearize_at_estimate(); until
+  /// then bayes_tree() is empty. Off: the tree is always current.
+  bool banded_full_updates = true;
 
   /// While the safeguard (or Dogleg) evaluates the error at a new estimate, also linearize
   /// there, so a variable relinearized at that estimate reuses it instead of evaluating its
@@ -219,7 +227,8 @@ class ISAM2 {
   std::vector<int> factors_to_eliminate(const UpdateWork& work) const;
   void build_affected_top(const ISAM2UpdateOptions& options, UpdateWork& work,
                           ISAM2Result& result);
-  bool detach_and_linearize(UpdateWork& work, ISAM2Result& result);
+  bool detach_and_linearize(UpdateWork& work, ISAM2Result& result, bool allow_banded);
+  bool solve_banded(const UpdateWork& work, int relinearized);
   bool eliminate_and_solve(UpdateWork& work, ISAM2Result& result);
   bool factorize_and_solve(UpdateWork& work, const Eigen::VectorXd* damping,
                            ISAM2Result& result);
@@ -280,6 +289,9 @@ class ISAM2 {
   Eigen::VectorXd delta_;     // applied step (θ + delta_ = estimate)
   Eigen::VectorXd delta_gn_;  // Bayes tree solution (equals delta_ with Gauss–Newton)
   BayesTree tree_;
+  std::vector<int> slot_dims_, slot_offsets_;  // per slot, in θ's layout
+  BandedSystem banded_;  // the whole system, for banded_full_updates
+  bool tree_deferred_ = false;  // the last update was banded: the tree waits to be rebuilt
   std::vector<LinearizedFactor> linearized_;    // per factor index
   std::vector<LinearizedFactor> at_estimate_;   // per factor: linearized at the estimate
   std::vector<char> at_estimate_ok_;            // per factor: at_estimate_ is current

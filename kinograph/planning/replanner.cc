@@ -171,10 +171,10 @@ Plan Replanner::answer_incremental(const Problem& problem, Plan plan, const Plan
   report_.incremental = true;
   const IncrementalStats& st = report_.statistics;
   spdlog::info(
-      "iDFGP: {}{} ISAM2 updates, {} multiplier rounds, {} cliques re-eliminated, factors {} "
+      "iDFGP: {}{} ISAM2 updates, {} multiplier rounds, {} variables re-eliminated, factors {} "
       "replaced + {} added, {:.1f} ms incremental",
       knots > 0 ? "shifted " + std::to_string(knots) + " knots, " : std::string(), st.updates,
-      st.rounds, st.cliques_reeliminated, st.factors_replaced, st.factors_added,
+      st.rounds, st.variables_reeliminated, st.factors_replaced, st.factors_added,
       st.incremental_time_s * 1e3);
   if (plan.success()) return plan;
   return recover(problem, std::move(plan), previous);

@@ -1004,7 +1004,7 @@ TEST(ISAM2, APreparedTreeTakesTheForcedUpdatesStepReeliminatingOnlyItsChange) {
         << "round " << it;
     ASSERT_EQ(b.check_invariants(), "");
     if (rb.trials == 1) {
-      EXPECT_LT(rb.cliques_reeliminated, ra.cliques_reeliminated) << "round " << it;
+      EXPECT_LT(rb.variables_reeliminated, ra.variables_reeliminated) << "round " << it;
       partial += rb.full_reelimination ? 0 : 1;
     } else {
       EXPECT_TRUE(rb.full_reelimination) << "round " << it;
@@ -1013,6 +1013,86 @@ TEST(ISAM2, APreparedTreeTakesTheForcedUpdatesStepReeliminatingOnlyItsChange) {
   }
   EXPECT_GT(partial, 0);
   EXPECT_GT(widened, 0);  // the rejected-trial path ran too
+}
+
+TEST(ISAM2, BandedFullUpdatesTakeTheTreesSteps) {
+  // The stiff chain (damped trials included) in lockstep with and without banded full updates:
+  // the forced updates relinearize every variable, so B solves them as one banded system and
+  // keeps no tree, with the steps of A's tree to rounding.
+  const int n = 15;
+  const Stiff s = make_stiff(n);
+  ISAM2Options opt;
+  opt.wildfire_threshold = 0;
+  ISAM2Options tree_only = opt;
+  tree_only.banded_full_updates = false;
+  ISAM2 a(tree_only), b(opt);
+  ISAM2UpdateOptions force;
+  force.force_relinearize = true;
+  ASSERT_TRUE(a.update(s.factors, {}, s.initial, force).ok());
+  ASSERT_TRUE(b.update(s.factors, {}, s.initial, force).ok());
+  ASSERT_FALSE(b.bayes_tree().empty());  // nothing was relinearized: the tree is built
+  int damped = 0;
+  for (int it = 0; it < 20; ++it) {
+    const ISAM2Result ra = a.update({}, {}, {}, force);
+    const ISAM2Result rb = b.update({}, {}, {}, force);
+    ASSERT_TRUE(ra.ok() && rb.ok()) << ra.reason << rb.reason;
+    ASSERT_EQ(ra.trials, rb.trials) << "update " << it;
+    ASSERT_EQ(ra.lambda, rb.lambda) << "update " << it;
+    EXPECT_LT((a.estimate().vector() - b.estimate().vector()).cwiseAbs().maxCoeff(), 1e-9)
+        << "update " << it;
+    EXPECT_GT(ra.cliques_reeliminated, 0);
+    EXPECT_EQ(rb.cliques_reeliminated, 0);
+    EXPECT_EQ(rb.variables_reeliminated, n);
+    EXPECT_TRUE(b.bayes_tree().empty());
+    EXPECT_EQ(b.check_invariants(), "");
+    damped += rb.trials > 1 ? 1 : 0;
+  }
+  EXPECT_GT(damped, 0);  // the rejected-step path ran too
+}
+
+TEST(ISAM2, AfterABandedUpdateASmallChangeRebuildsTheTree) {
+  // A linear chain: a forced update relinearizes every variable (banded, no tree); a new goal
+  // then touches one variable and relinearizes none, so the tree is rebuilt whole, and the
+  // next new goal re-eliminates only part of it. Every estimate is the dense solution.
+  const int n = 40;
+  Chain chain = make_chain(n, Eigen::Vector2d(3, 1));
+  ISAM2Options opt;
+  opt.wildfire_threshold = 0;
+  opt.relinearize_threshold = 1e9;
+  ISAM2 isam(opt);
+  ISAM2UpdateOptions force;
+  force.force_relinearize = true;
+  force.constrained_last = {X(n - 1)};
+  ISAM2Result res = isam.update(chain.factors, {}, chain.values, force);
+  ASSERT_TRUE(res.ok()) << res.reason;
+  size_t goal = res.new_factor_indices[chain.goal_index];
+  res = isam.update({}, {}, {}, force);
+  ASSERT_TRUE(res.ok()) << res.reason;
+  EXPECT_EQ(res.variables_relinearized, n);
+  EXPECT_EQ(res.cliques_reeliminated, 0);
+  EXPECT_TRUE(isam.bayes_tree().empty());
+  EXPECT_LT((isam.estimate().vector() - dense_solve(isam.graph(), isam.estimate()))
+                .cwiseAbs()
+                .maxCoeff(),
+            1e-9);
+  ISAM2UpdateOptions last;
+  last.constrained_last = {X(n - 1)};
+  for (int round = 0; round < 2; ++round) {
+    auto new_goal = std::make_shared<PriorFactor>(X(n - 1), Eigen::Vector2d(2 - round, 1 + round),
+                                                  isotropic(2, 0.1));
+    res = isam.update({new_goal}, {goal}, {}, last);
+    ASSERT_TRUE(res.ok()) << res.reason;
+    goal = res.new_factor_indices[0];
+    EXPECT_EQ(res.variables_relinearized, 0);
+    EXPECT_EQ(res.full_reelimination, round == 0) << "round " << round;
+    EXPECT_GT(res.cliques_reeliminated, 0);
+    ASSERT_EQ(isam.check_invariants(), "");
+    EXPECT_LT((isam.estimate().vector() - dense_solve(isam.graph(), isam.estimate()))
+                  .cwiseAbs()
+                  .maxCoeff(),
+              1e-9)
+        << "round " << round;
+  }
 }
 
 TEST(ISAM2, AnUnchangedUpdateTakesThePreparedStep) {

@@ -296,7 +296,7 @@ Plan IncrementalPlanner::answer_replan(Clock::time_point t0) {
   if (reason.empty()) {
     std::ostringstream os;
     os << stats_.updates << " ISAM2 updates, " << stats_.rounds << " multiplier rounds, "
-       << stats_.cliques_reeliminated << " cliques re-eliminated";
+       << stats_.variables_reeliminated << " variables re-eliminated";
     plan.stats.reason = os.str();
   }
   if (!valid_plan && (status == PlanStatus::kMaxUpdates || status == PlanStatus::kMaxRounds)) {

@@ -12,9 +12,12 @@ struct IncrementalStats {
   int factors_replaced = 0;  ///< factors removed for the change itself
   int factors_added = 0;     ///< factors added for the change itself
   int factors_readded = 0;   ///< factors re-added for multiplier or penalty changes
-  long cliques_reeliminated = 0;
+  long cliques_reeliminated = 0;   ///< cliques of the Bayes tree built by the updates
+  /// Variables re-eliminated by the updates, in cliques or in a banded solve of the whole
+  /// system (ISAM2Options::banded_full_updates), which builds no clique.
+  long variables_reeliminated = 0;
   long variables_relinearized = 0;
-  int full_reeliminations = 0;
+  int full_reeliminations = 0;     ///< updates that re-eliminated every variable
   double incremental_time_s = 0;  ///< the ISAM2 part (whole replan time is in Plan::stats)
   double penalty = 0;             ///< μ at the end
 };

@@ -136,6 +136,7 @@ graph::ISAM2Result IncrementalTree::update(bool force_relinearize, IncrementalSt
   pending_values_ = graph::Values();
   ++stats.updates;
   stats.cliques_reeliminated += r.cliques_reeliminated;
+  stats.variables_reeliminated += r.variables_reeliminated;
   stats.variables_relinearized += r.variables_relinearized;
   stats.full_reeliminations += r.full_reelimination ? 1 : 0;
   return r;
