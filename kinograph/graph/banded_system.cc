@@ -47,6 +47,7 @@ bool BandedSystem::prepare(const std::vector<int>& free_slots, const std::vector
   dim_ = dims;
   lower_ = std::move(lower);
   lower_rows_.assign(slots, {});
+  diagonal_row_.assign(slots, 0);
   col_ptr_.assign(1, 0);
   row_idx_.clear();
   for (int b : slots_) {
@@ -56,6 +57,7 @@ bool BandedSystem::prepare(const std::vector<int>& free_slots, const std::vector
       offsets.push_back(rows);
       rows += dim_[a];
     }
+    diagonal_row_[b] = rows;
     for (int j = 0; j < dim_[b]; ++j) {
       for (int a : lower_[b]) {
         for (int r = 0; r < dim_[a]; ++r) row_idx_.push_back(column_[a] + r);
@@ -88,11 +90,8 @@ int BandedSystem::row_offset(int b, int a) const {
 void BandedSystem::add_block(const Eigen::MatrixXd& H, int row, int col, int a, int b) {
   const int c0 = column_[b];
   if (a == b) {
-    const int diagonal = static_cast<int>(lower_rows_[b].empty()
-                                              ? 0
-                                              : lower_rows_[b].back() + dim_[lower_[b].back()]);
     for (int j = 0; j < dim_[b]; ++j) {
-      double* out = h_.data() + col_ptr_[c0 + j] + diagonal;
+      double* out = h_.data() + col_ptr_[c0 + j] + diagonal_row_[b];
       const double* in = H.data() + static_cast<Eigen::Index>(col + j) * H.rows() + row;
       for (int r = 0; r <= j; ++r) out[r] += in[r];
     }

@@ -41,13 +41,14 @@ class BandedSystem {
   void add_block(const Eigen::MatrixXd& H, int row, int col, int a, int b);
 
   std::vector<int> signature_, signature_scratch_;  // the factors' variables, −1 after each
-  std::vector<int> slots_;                    // free slots, in column order
-  std::vector<int> column_;                   // per slot: first column, −1 if not free
-  std::vector<int> dim_;                      // per slot
-  std::vector<std::vector<int>> lower_;       // per slot: free neighbours left of it, sorted
-  std::vector<std::vector<int>> lower_rows_;  // per slot: row offset of each of them
+  std::vector<int> slots_;                          // free slots, in column order
+  std::vector<int> column_;                         // per slot: first column, −1 if not free
+  std::vector<int> dim_;                            // per slot
+  std::vector<std::vector<int>> lower_;             // per slot: free neighbours left of it, sorted
+  std::vector<std::vector<int>> lower_rows_;        // per slot: row offset of each of them
+  std::vector<int> diagonal_row_;                   // per slot: row offset of its diagonal block
   std::vector<int> col_ptr_, row_idx_;
-  std::vector<double> h_;                     // Σ H_f, pattern order
+  std::vector<double> h_;  // Σ H_f, pattern order
   Eigen::VectorXd g_, rhs_, x_;
   std::unique_ptr<EnvelopeCholesky> cholesky_;  // null when the envelope does not win
 };

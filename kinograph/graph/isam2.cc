@@ -769,8 +769,8 @@ bool ISAM2::detach_and_linearize(UpdateWork& work, ISAM2Result& res, bool allow_
 // update that relinearizes most variables (it re-eliminates the whole tree however small its
 // own change) on a graph whose Hessian is banded in slot order.
 bool ISAM2::solve_banded(const UpdateWork& work, int relinearized) {
-  if (!options_.banded_full_updates || !work.gauss_newton || !work.full ||
-      relinearized <= options_.full_reelimination_fraction * static_cast<double>(work.vars.size())) {
+  const double most = options_.full_reelimination_fraction * static_cast<double>(work.vars.size());
+  if (!options_.banded_full_updates || !work.gauss_newton || !work.full || relinearized <= most) {
     return false;
   }
   return banded_.prepare(work.vars, slot_dims_, linearized_, work.factors);
