@@ -200,13 +200,19 @@ Chain make_chain(int n, const Eigen::Vector2d& goal) {
   return c;
 }
 
+// Options for a linear graph solved exactly: nothing is relinearized unless forced, and
+// back-substitution visits every clique.
+ISAM2Options exact_linear_options() {
+  ISAM2Options opt;
+  opt.wildfire_threshold = 0;
+  opt.relinearize_threshold = 1e9;
+  return opt;
+}
+
 TEST(ISAM2, ChangingTheLastFactorReeliminatesOnlyThePathToTheRoot) {
   const int n = 60;
   Chain chain = make_chain(n, Eigen::Vector2d(3, 1));
-  ISAM2Options opt;
-  opt.wildfire_threshold = 0;
-  opt.relinearize_threshold = 1e9;  // linear: relinearizing would only re-eliminate more
-  ISAM2 isam(opt);
+  ISAM2 isam(exact_linear_options());
   ISAM2UpdateOptions first;
   first.constrained_last = {X(n - 1)};
   auto res = isam.update(chain.factors, {}, chain.values, first);
@@ -420,10 +426,7 @@ TEST(ISAM2, FactorsAddedOrRemovedWithoutActiveRowsReeliminateNothing) {
   // the chain is pulled past it: a limit the tree did not hold would let the point through.
   const int n = 20, mid = n / 2;
   Chain chain = make_chain(n, Eigen::Vector2d(3, 1));
-  ISAM2Options opt;
-  opt.wildfire_threshold = 0;
-  opt.relinearize_threshold = 1e9;  // linear chain: nothing to relinearize
-  ISAM2 isam(opt);
+  ISAM2 isam(exact_linear_options());
   auto res = isam.update(chain.factors, {}, chain.values);
   ASSERT_TRUE(res.ok()) << res.reason;
   const size_t goal = res.new_factor_indices[chain.goal_index];
@@ -733,10 +736,7 @@ TEST(ISAM2, FixedVariablesStayConstant) {
 TEST(ISAM2, RenamedVariablesKeepTheTree) {
   const int n = 30;
   Chain chain = make_chain(n, Eigen::Vector2d(3, 1));
-  ISAM2Options opt;
-  opt.wildfire_threshold = 0;
-  opt.relinearize_threshold = 1e9;
-  ISAM2 isam(opt);
+  ISAM2 isam(exact_linear_options());
   ISAM2UpdateOptions first;
   first.constrained_last = {X(n - 1)};
   auto res = isam.update(chain.factors, {}, chain.values, first);
@@ -877,9 +877,7 @@ TEST(ISAM2, ChangeTouchingMostVariablesKeepsCliquesSmall) {
       factors.push_back(
           std::make_shared<PriorFactor>(X(i), Eigen::Vector2d(1, 0), isotropic(2, 5)));
     }
-    ISAM2Options opt;
-    opt.relinearize_threshold = 1e9;
-    opt.wildfire_threshold = 0;
+    ISAM2Options opt = exact_linear_options();
     opt.constrain_touched_fraction = fraction;
     ISAM2 isam(opt);
     auto res = isam.update(factors, {}, values);
@@ -1056,10 +1054,7 @@ TEST(ISAM2, AfterABandedUpdateASmallChangeRebuildsTheTree) {
   // next new goal re-eliminates only part of it. Every estimate is the dense solution.
   const int n = 40;
   Chain chain = make_chain(n, Eigen::Vector2d(3, 1));
-  ISAM2Options opt;
-  opt.wildfire_threshold = 0;
-  opt.relinearize_threshold = 1e9;
-  ISAM2 isam(opt);
+  ISAM2 isam(exact_linear_options());
   ISAM2UpdateOptions force;
   force.force_relinearize = true;
   force.constrained_last = {X(n - 1)};
@@ -1191,9 +1186,7 @@ TEST(ISAM2, FullReeliminationFractionDecidesWhenTheTreeIsRebuilt) {
   const int n = 40;
   auto run = [&](double fraction, bool change_start) {
     Chain chain = make_chain(n, Eigen::Vector2d(3, 1));
-    ISAM2Options opt;
-    opt.wildfire_threshold = 0;
-    opt.relinearize_threshold = 1e9;
+    ISAM2Options opt = exact_linear_options();
     opt.full_reelimination_fraction = fraction;
     ISAM2 isam(opt);
     ISAM2UpdateOptions first;
