@@ -742,8 +742,9 @@ void ISAM2::fail_singular(ISAM2Result& res, int slot) {
            " is not positive definite (too few factors on it?)");
 }
 
-// The affected top detached, its factors linearized and its new cliques built (symbolically);
-// false (the result says which factor) if a factor is not finite.
+// The affected top detached, its factors linearized and its new cliques built (symbolically),
+// or for a banded update the whole system assembled; false (the result says which factor) if a
+// factor is not finite.
 bool ISAM2::detach_and_linearize(UpdateWork& work, ISAM2Result& res, bool allow_banded) {
   const auto t_lin = Clock::now();
   find_affected_top(work);
@@ -923,32 +924,26 @@ Eigen::VectorXd ISAM2::damping_diagonal(const std::vector<int>& vars) const {
   return diag_H.cwiseMax(options_.min_diagonal);
 }
 
-// One trial: factorizes the new cliques (damped if given) and back-substitutes δ; Gauss–Newton
-// takes it as the step. False (the result says where) when a clique is not positive definite.
+// One trial: factorizes the new cliques (damped if given) and back-substitutes δ, or solves the
+// banded system; Gauss–Newton takes it as the step. False (the result says where) when the
+// system is not positive definite.
 bool ISAM2::factorize_and_solve(UpdateWork& work, const Eigen::VectorXd* damping,
                                 ISAM2Result& res) {
   int bad_slot = -1;
-  if (work.banded) {
-    const auto t_factor = Clock::now();
-    if (!banded_.solve(damping, slot_offsets_, delta_gn_, &bad_slot)) {
-      res.eliminate_s += seconds_since(t_factor);
-      fail_singular(res, bad_slot);
-      return false;
-    }
-    res.eliminate_s += seconds_since(t_factor);
-    work.changed = work.vars;
-    res.cliques_solved = 0;
-  } else {
-    const auto t_factor = Clock::now();
-    const bool factored = tree_.factorize(work.new_cliques, linearized_, damping, &bad_slot);
-    res.eliminate_s += seconds_since(t_factor);
-    if (!factored) {  // J is rank deficient: damping would only hide it
-      fail_singular(res, bad_slot);
-      return false;
-    }
+  const auto t_factor = Clock::now();
+  const bool factored = work.banded
+                            ? banded_.solve(damping, slot_offsets_, delta_gn_, &bad_slot)
+                            : tree_.factorize(work.new_cliques, linearized_, damping, &bad_slot);
+  res.eliminate_s += seconds_since(t_factor);
+  if (!factored) {  // J is rank deficient: damping would only hide it
+    fail_singular(res, bad_slot);
+    return false;
   }
   const auto t_solve = Clock::now();
-  if (!work.banded) {
+  if (work.banded) {
+    work.changed = work.vars;  // the banded solve gave every variable's step
+    res.cliques_solved = 0;
+  } else {
     work.changed.clear();
     res.cliques_solved =
         tree_.back_substitute(options_.wildfire_threshold, delta_gn_, &work.changed);

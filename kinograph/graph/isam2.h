@@ -287,7 +287,7 @@ class ISAM2 {
   Values theta_;
   Values estimate_;
   Eigen::VectorXd delta_;     // applied step (θ + delta_ = estimate)
-  Eigen::VectorXd delta_gn_;  // Bayes tree solution (equals delta_ with Gauss–Newton)
+  Eigen::VectorXd delta_gn_;  // linear solution, tree or banded (delta_ with Gauss–Newton)
   BayesTree tree_;
   std::vector<int> slot_dims_, slot_offsets_;  // per slot, in θ's layout
   BandedSystem banded_;  // the whole system, for banded_full_updates
