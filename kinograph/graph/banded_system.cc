@@ -14,8 +14,8 @@ bool BandedSystem::prepare(const std::vector<int>& free_slots, const std::vector
     signature_scratch_.insert(signature_scratch_.end(), vars.begin(), vars.end());
     signature_scratch_.push_back(-1);
   }
-  if (cholesky_ && signature_scratch_ == signature_ && free_slots == slots_ && dims == dim_) {
-    return true;
+  if (signature_scratch_ == signature_ && free_slots == slots_ && dims == dim_) {
+    return cholesky_ != nullptr;  // the same pattern, which suits the envelope or not
   }
   std::swap(signature_, signature_scratch_);
   const int slots = static_cast<int>(dims.size());
@@ -67,11 +67,7 @@ bool BandedSystem::prepare(const std::vector<int>& free_slots, const std::vector
     }
   }
   cholesky_.reset();
-  if (n == 0 || !EnvelopeCholesky::wins(n, col_ptr_, row_idx_)) {
-    column_.clear();  // nothing kept: the next call builds again
-    signature_.clear();
-    return false;
-  }
+  if (n == 0 || !EnvelopeCholesky::wins(n, col_ptr_, row_idx_)) return false;
   cholesky_ = std::make_unique<EnvelopeCholesky>(n, col_ptr_, row_idx_);
   h_.assign(row_idx_.size(), 0.0);
   g_.resize(n);
