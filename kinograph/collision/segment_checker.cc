@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 #include "kinograph/collision/convex_shape.h"
 #include "kinograph/dynamics/kinematics.h"
@@ -126,10 +128,17 @@ void SegmentChecker::set_pair_levers() {
 
 PathCheckResult SegmentChecker::check_path(CollisionWorld& world, dynamics::Data& data,
                                            const Eigen::Ref<const Eigen::MatrixXd>& path,
-                                           const std::vector<double>& times, double clearance) {
+                                           const std::vector<double>& times, double clearance,
+                                           const Eigen::Ref<const Eigen::MatrixXd>& deviation) {
   PathCheckResult result;
   result.min_distance = result.lower_bound = std::numeric_limits<double>::infinity();
   const int m = static_cast<int>(path.rows());
+  const bool curved = deviation.size() > 0;
+  if (curved && (deviation.rows() != m - 1 || deviation.cols() != model_.nq())) {
+    throw std::invalid_argument("check_path: the deviation must have one row per segment (" +
+                                std::to_string(std::max(0, m - 1)) +
+                                ") and one column per joint (" + std::to_string(model_.nq()) + ")");
+  }
   if (m == 0) return result;
   const bool moving = world.has_moving_obstacles();
   auto time_at = [&](int i, double u) {
@@ -150,6 +159,14 @@ PathCheckResult SegmentChecker::check_path(CollisionWorld& world, dynamics::Data
   auto sweep_of = [&](int i) {
     return relative * (path.row(i + 1) - path.row(i)).cwiseAbs().dot(lever_.transpose());
   };
+  // Per segment the most its stray could move a point of the robot (the whole robot's bound;
+  // two geometries approach by at most twice it). A pair's own share costs a dot product and
+  // is asked only of pairs near enough to need it.
+  if (curved) seg_stray_.noalias() = deviation.cwiseAbs() * lever_;
+  auto stray_on = [&](int i) { return curved && i < m - 1 ? seg_stray_[i] : 0.0; };
+  auto pair_stray = [&](int k, int i) {
+    return pair_lever_.row(k).dot(deviation.row(i).cwiseAbs());
+  };
   auto sample = [&](int i, double u) {
     if (i + 1 < m) {
       q_ = path.row(i).transpose() + u * (path.row(i + 1) - path.row(i)).transpose();
@@ -161,8 +178,23 @@ PathCheckResult SegmentChecker::check_path(CollisionWorld& world, dynamics::Data
     dynamics::forward_kinematics(model_, data, q_);
     ++result.samples;
     const Proximity p = world.closest(data, time_at(i, u));
-    if (p.distance < result.min_distance) {
-      result.min_distance = p.distance;
+    // Off the rows the curve may be closer than the segment by its stray: each pair near
+    // enough to matter counts its own, from at least the closest pair's distance. A sample
+    // that cannot come below the smallest so far is left as it is.
+    double distance = p.distance;
+    const int seg = std::min(i, m - 2);
+    const double stray = stray_on(seg);
+    if (stray > 0 && p.distance - relative * stray < result.min_distance) {
+      const std::span<const double> bounds = world.pair_bounds();
+      for (int k = 0; k < pair_count; ++k) {
+        if (bounds[static_cast<size_t>(k)] < p.distance + relative * stray) {
+          distance = std::min(
+              distance, std::max(bounds[static_cast<size_t>(k)], p.distance) - pair_stray(k, seg));
+        }
+      }
+    }
+    if (distance < result.min_distance) {
+      result.min_distance = distance;
       result.segment = i;
       result.s = u;
       result.closest = p;
@@ -184,26 +216,37 @@ PathCheckResult SegmentChecker::check_path(CollisionWorld& world, dynamics::Data
     used_.setZero();
     double least = options_.max_sweep_step;
     double time_budget = moving ? options_.max_time_step : std::numeric_limits<double>::infinity();
-    double swept = 0;
+    double swept = 0, stretch_stray = 0;
+    bool at_start = true;  // the stretch has not moved from its sample yet
     while (i < m - 1) {
       dq_ = (path.row(i + 1) - path.row(i)).cwiseAbs().transpose();
       rate_.noalias() = pair_lever_ * dq_;
+      const double stray = stray_on(i);
+      stretch_stray = std::max(stretch_stray, relative * stray);
       const double seg_sweep = sweep_of(i);
       const double seg_time = std::abs(time_at(i, 1) - time_at(i, 0));
       const double left = 1 - u;
-      // The fraction of this segment the budgets allow: until the first pair's allowance runs
-      // out, but at least the least step.
+      // The fraction of this segment the budgets allow: until the first pair's allowance, less
+      // what the segment's stray could close, runs out, but at least the least step.
       // A pair whose distance this segment cannot change sets no limit; an allowance that is
       // not a number allows nothing.
       double by_pairs = left;
+      const double whole = relative * stray;
       for (int k = 0; k < pair_count; ++k) {
-        if (rate_[k] > 0 && !(rate_[k] * left <= allowance_[k])) {
-          by_pairs = std::min(by_pairs, allowance_[k] > 0 ? allowance_[k] / rate_[k] : 0.0);
+        // The whole robot's bound first; the pair's own share only where that one limits.
+        if (rate_[k] * left <= allowance_[k] - whole) continue;
+        const double own = stray > 0 ? pair_stray(k, i) : 0.0, room = allowance_[k] - own;
+        if ((rate_[k] > 0 || own > 0) && !(rate_[k] * left <= room)) {
+          by_pairs = std::min(by_pairs, room > 0 && rate_[k] > 0 ? room / rate_[k] : 0.0);
         }
       }
       const double by_least =
           seg_sweep * left > least ? std::max(0.0, least) / seg_sweep : left;
       double f = std::max(by_pairs, by_least);
+      // A segment whose stray could close a pair's allowance starts with a sample, which counts
+      // that stray, even where its straight part does not move.
+      if (curved && by_pairs <= 0 && !at_start) f = 0;
+      at_start = at_start && f <= 0;
       if (moving && seg_time * left > time_budget) f = std::min(f, time_budget / seg_time);
       allowance_ -= f * rate_;
       used_ += f * rate_;
@@ -230,8 +273,8 @@ PathCheckResult SegmentChecker::check_path(CollisionWorld& world, dynamics::Data
     // Along the stretch each pair stays at least (d_a + d_b − its sweep) / 2 away.
     const auto next = Eigen::Map<const Eigen::VectorXd>(world.pair_bounds().data(), pair_count);
     if (pair_count > 0) {
-      result.lower_bound =
-          std::min(result.lower_bound, 0.5 * (last_bound_ + next - used_).minCoeff());
+      result.lower_bound = std::min(result.lower_bound,
+                                    0.5 * (last_bound_ + next - used_).minCoeff() - stretch_stray);
     }
     last_bound_ = next;
   }

@@ -91,9 +91,17 @@ class SegmentChecker {
   // yet clear stretches, and stretches whose near pairs barely move, cost one query. Allocates
   // nothing after the first call with a given joint count and pair count. Stops after
   // max_path_samples queries or max_path_sweep of sweep (complete false).
-  PathCheckResult check_path(CollisionWorld& world, dynamics::Data& data,
-                             const Eigen::Ref<const Eigen::MatrixXd>& path,
-                             const std::vector<double>& times = {}, double clearance = 0);
+  // A curved path sampled at the rows: `deviation` (one row per segment, one column per joint)
+  // bounds how far each joint of the true path strays from the straight segment between two
+  // rows (rad; m for prismatic joints). Each pair's allowance on a segment then shrinks by what
+  // that stray could close of it, and a sample's distance is the least, over the pairs near
+  // enough, of what each could come to, so the figures and the walk hold for the curve. Empty:
+  // the path is the polyline.
+  // Throws std::invalid_argument when `deviation` is neither empty nor segments × joints.
+  PathCheckResult check_path(
+      CollisionWorld& world, dynamics::Data& data, const Eigen::Ref<const Eigen::MatrixXd>& path,
+      const std::vector<double>& times = {}, double clearance = 0,
+      const Eigen::Ref<const Eigen::MatrixXd>& deviation = Eigen::MatrixXd());
   // Number of intervals the segment is cut into (samples − 1); the time span counts only
   // when there are moving obstacles.
   int intervals(const Eigen::Ref<const Eigen::VectorXd>& q0,
@@ -119,7 +127,8 @@ class SegmentChecker {
   // last and the next sample, and what the stretch used of the allowance.
   std::vector<CollisionWorld::PairIndex> pairs_;
   Eigen::MatrixXd pair_lever_;
-  Eigen::VectorXd rate_, allowance_, last_bound_, used_, dq_;
+  // With a curved path, per segment the most its stray moves a point of the robot.
+  Eigen::VectorXd rate_, allowance_, last_bound_, used_, dq_, seg_stray_;
   std::vector<char> ancestor_;
 };
 

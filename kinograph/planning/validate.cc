@@ -17,6 +17,7 @@
 #include "kinograph/graph/worker_pool.h"
 #include "kinograph/planning/clearance_world.h"
 #include "kinograph/planning/factors/pose_error.h"
+#include "kinograph/planning/interpolant.h"
 #include "kinograph/planning/trajectory_sampler.h"
 #include "kinograph/planning/user_terms.h"
 
@@ -33,16 +34,6 @@ void add_failure(Validation& v, std::string why) { v.failures.push_back(std::mov
 
 // How far x leaves [lo, hi] (0 inside).
 double excess(double x, double lo, double hi) { return std::max({0.0, lo - x, x - hi}); }
-
-// Cubic Hermite state between two steps at fraction s (positions from q, q̇ at both ends); the
-// validator's own interpolation, independent of the planner's collocation.
-Eigen::VectorXd hermite(const Plan& plan, int k, double s, double dt) {
-  const double h00 = 2 * s * s * s - 3 * s * s + 1, h10 = s * s * s - 2 * s * s + s;
-  const double h01 = -2 * s * s * s + 3 * s * s, h11 = s * s * s - s * s;
-  return (h00 * plan.q.row(k) + h10 * dt * plan.qd.row(k) + h01 * plan.q.row(k + 1) +
-          h11 * dt * plan.qd.row(k + 1))
-      .transpose();
-}
 
 // The trajectory's shape and numbers; false (with the failure) when nothing else can be checked.
 bool check_shape(const Problem& problem, const Plan& plan, Validation& v) {
@@ -330,42 +321,31 @@ void check_tasks(const Problem& problem, const Plan& plan, dynamics::Data& data,
 // fixed, never the thread count's: a plan's figures are the same on any machine.
 constexpr int kCollisionPieces = 4;
 
-// Clearance (obstacles, the floor, self pairs): every step and dense samples along the
-// validator's Hermite interpolation, walked by conservative advancement (stretches far from
-// everything cost one query; near something the samples are as dense as the segment checker's
-// sweep step). The constructor builds the path, walk(p) checks piece p (on any thread: each
-// piece has its own world), report() turns the pieces' results into figures and failures.
+// Clearance (obstacles, the floor, self pairs) along the plan's interpolant: its states at
+// `collision_samples` points of every interval, and between two of them the straight segment
+// widened by how far the interpolant strays from it, walked by conservative advancement
+// (stretches far from everything cost one query; near something the samples are as dense as the
+// segment checker's sweep step). The constructor builds the path, walk(p) checks piece p (on
+// any thread: each piece has its own world), report() turns the pieces' results into figures
+// and failures.
 class CollisionWalk {
  public:
   CollisionWalk(const Problem& problem, const Plan& plan, const ValidationThresholds& thresholds)
-      : problem_(problem), clearance_(thresholds.min_clearance) {
-    const dynamics::Model& model = *problem.model;
-    const int n = model.nq(), N = problem.steps, rows = N + 1;
-    const double dt = problem.dt();
-    const int sub = std::max(1, thresholds.collision_samples);
-    path_.resize(N * sub + 1, n);
-    times_.resize(N * sub + 1);
-    const bool timed = plan.t.size() == static_cast<size_t>(rows);
-    for (int k = 0; k < N; ++k) {
-      for (int i = 0; i < sub; ++i) {
-        const double s = static_cast<double>(i) / sub;
-        path_.row(k * sub + i) =
-            i == 0 ? Eigen::VectorXd(plan.q.row(k).transpose()) : hermite(plan, k, s, dt);
-        times_[k * sub + i] = (timed ? plan.t[k] : k * dt) + s * dt;
-      }
-    }
-    path_.row(N * sub) = plan.q.row(N);
-    times_[N * sub] = timed ? plan.t[N] : N * dt;
-    const int pieces = std::clamp(N, 1, kCollisionPieces);
-    for (int p = 0; p <= pieces; ++p) first_row_.push_back(p * N / pieces * sub);
+      : problem_(problem),
+        plan_(plan),
+        clearance_(thresholds.min_clearance),
+        sub_(std::max(1, thresholds.collision_samples)),
+        timed_(plan.t.size() == static_cast<size_t>(problem.steps + 1)) {
+    const int N = problem.steps, pieces = std::clamp(N, 1, kCollisionPieces);
+    for (int p = 0; p <= pieces; ++p) first_knot_.push_back(p * N / pieces);
     results_.resize(pieces);
     errors_.resize(pieces);
   }
 
   int pieces() const { return static_cast<int>(results_.size()); }
 
-  // Walks piece p: rows first_row_[p] … first_row_[p + 1] of the path, with its share of the
-  // walk's budgets.
+  // Walks piece p, knots first_knot_[p] … first_knot_[p + 1], with its share of the walk's
+  // budgets.
   void walk(int p) {
     std::unique_ptr<collision::CollisionWorld> world;
     try {
@@ -379,9 +359,11 @@ class CollisionWalk {
     options.max_path_sweep /= pieces();
     collision::SegmentChecker checker(*problem_.model, options);
     dynamics::Data data(*problem_.model);
-    const int r0 = first_row_[p], count = first_row_[p + 1] - r0 + 1;
-    const std::vector<double> times(times_.begin() + r0, times_.begin() + r0 + count);
-    results_[p] = checker.check_path(*world, data, path_.middleRows(r0, count), times, clearance_);
+    Eigen::MatrixXd path, stray;
+    std::vector<double> times;
+    sample(first_knot_[p], first_knot_[p + 1], path, stray, times);
+    results_[p] = checker.check_path(*world, data, path, times, clearance_, stray);
+    const int r0 = first_knot_[p] * sub_;
     results_[p].segment += r0;
     results_[p].stopped_segment += r0;
   }
@@ -423,17 +405,69 @@ class CollisionWalk {
   }
 
  private:
-  // The time a fraction s along path segment i.
-  double time_at(int segment, double s) const {
-    const size_t at = std::min(static_cast<size_t>(segment), times_.size() - 1);
-    return at + 1 < times_.size() ? times_[at] + s * (times_[at + 1] - times_[at]) : times_[at];
+  double knot_time(int k) const { return timed_ ? plan_.t[k] : k * problem_.dt(); }
+
+  // The time a fraction s along path segment r (sub_ segments an interval).
+  double time_at(int r, double s) const {
+    const int k = std::min(r / sub_, problem_.steps);
+    if (k == problem_.steps) return knot_time(k);
+    const double dt = knot_time(k + 1) - knot_time(k);
+    return knot_time(k) + dt * (r % sub_ + s) / sub_;
+  }
+
+  // The path of knots k0 … k1: the interpolant at sub_ points an interval (rows, at `times`),
+  // and per segment and joint how far the interpolant strays from the straight segment.
+  void sample(int k0, int k1, Eigen::MatrixXd& path, Eigen::MatrixXd& stray,
+              std::vector<double>& times) const {
+    const dynamics::Model& model = *problem_.model;
+    const int n = model.nq(), sub = sub_;
+    path.resize((k1 - k0) * sub + 1, n);
+    stray.setZero((k1 - k0) * sub, n);
+    times.resize(path.rows());
+    IntervalInterpolant interpolant(model);
+    InterpolantPoint point;
+    Eigen::MatrixXd qdd(sub + 1, n);  // |q̈| at the interval's samples and its end
+    for (int k = k0; k < k1; ++k) {
+      const double dt = knot_time(k + 1) - knot_time(k);
+      const int first = (k - k0) * sub;
+      for (int i = 0; i < sub; ++i) times[first + i] = time_at(k * sub + i, 0);
+      if (!(dt > 0) || !std::isfinite(dt)) {  // the physics reports the times; nothing moves
+        path.middleRows(first, sub) = plan_.q.row(k).replicate(sub, 1);
+        continue;
+      }
+      interpolant.start(plan_.q.row(k).transpose(), plan_.qd.row(k).transpose(),
+                        plan_.qdd.row(k).transpose(), plan_.qdd.row(k + 1).transpose(), dt, false);
+      for (int i = 0; i <= sub; ++i) {
+        interpolant.at(dt * i / sub, false, point, /*with_tau=*/false);
+        if (i < sub) path.row(first + i) = point.q.transpose();
+        qdd.row(i) = point.qdd.cwiseAbs().transpose();
+      }
+      // Off its samples a joint strays from the chord by at most h²/8 · max |q̈| between them
+      // (linear on an actuated joint's cubic; an unactuated joint takes its interval's largest),
+      // and the last chord ends at the next knot, not where the interpolant arrives.
+      const double h = dt / sub;
+      for (int j = 0; j < n; ++j) {
+        const double interval_max = qdd.col(j).maxCoeff();
+        for (int i = 0; i < sub; ++i) {
+          const double a =
+              model.bodies[j].actuated ? std::max(qdd(i, j), qdd(i + 1, j)) : interval_max;
+          double e = h * h / 8 * a;
+          if (i + 1 == sub) e += std::abs(point.q[j] - plan_.q(k + 1, j));
+          // Non-finite only where the path itself is: the walk stops there and says so.
+          stray(first + i, j) = std::isfinite(e) ? e : 0.0;
+        }
+      }
+    }
+    path.row(path.rows() - 1) = plan_.q.row(k1);
+    times.back() = knot_time(k1);
   }
 
   const Problem& problem_;
+  const Plan& plan_;
   double clearance_;
-  Eigen::MatrixXd path_;
-  std::vector<double> times_;
-  std::vector<int> first_row_;  // piece p walks rows first_row_[p] … first_row_[p + 1]
+  int sub_;                      // path rows an interval
+  bool timed_;                   // the plan has its own times; else the problem's grid
+  std::vector<int> first_knot_;  // piece p walks knots first_knot_[p] … first_knot_[p + 1]
   std::vector<collision::PathCheckResult> results_;
   std::vector<std::string> errors_;  // a world that could not be built, per piece
 };

@@ -20,7 +20,10 @@ struct ValidationThresholds {
   double goal = 1e-2;                  ///< goal error (rad; m and rad for pose goals)
   double start = 1e-6;                 ///< start state error (rad, rad/s)
   double final_velocity = 1e-2;        ///< |q̇_N|, |q̈_N| at the goal
-  int collision_samples = 10;          ///< states checked per interval (dense sampling)
+  /// Interpolant states per interval that the collision walk passes through; between them it
+  /// bounds how far the interpolant strays from the straight segment. Fewer: a looser bound
+  /// near obstacles, never a missed collision.
+  int collision_samples = 10;
   /// Points per interval (the knot and interval_samples − 1 between, and at least one per RK4
   /// node of the interpolant: limit_points) where limits and the unactuated torque are
   /// checked on the interpolant.

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -207,6 +208,78 @@ TEST_F(RrSegment, PathCheckIsBoundedByDenseSampling) {
     }
   }
   EXPECT_GT(penetrating, 0);  // the seed must exercise the penetrating case
+}
+
+// A path sampled from a curve: between two rows a joint that turns around strays from the
+// straight segment. Two equal rows about 2 cm from a ball: as a polyline the path keeps its
+// distance; with the elbow free to stray 0.05 rad, the tip (0.845 m from the elbow axis) may
+// reach the ball, and the sample says so. No stray is the polyline to the bit; a deviation of
+// the wrong size is refused.
+TEST_F(RrSegment, PathCheckCountsHowFarTheCurveStraysFromItsSegments) {
+  CollisionWorld world(model);
+  add_obstacle(world, Shape::sphere(0.05), at(0.115, 0, 1.8));
+  Eigen::MatrixXd path(2, 2);
+  path << 0, 0, 0, 0;
+  SegmentChecker checker(model);
+  dynamics::forward_kinematics(model, data, path.row(0).transpose());
+  const double d0 = world.closest(data).distance;
+  ASSERT_GT(d0, 0.015);
+  const PathCheckResult polyline = checker.check_path(world, data, path);
+  EXPECT_NEAR(polyline.min_distance, d0, 1e-12);
+  const PathCheckResult none =
+      checker.check_path(world, data, path, {}, 0, Eigen::MatrixXd::Zero(1, 2));
+  EXPECT_EQ(none.min_distance, polyline.min_distance);
+  EXPECT_EQ(none.samples, polyline.samples);
+  const Eigen::MatrixXd elbow = (Eigen::MatrixXd(1, 2) << 0, 0.05).finished();
+  const PathCheckResult curve = checker.check_path(world, data, path, {}, 0, elbow);
+  EXPECT_NEAR(curve.min_distance, d0 - 0.845 * 0.05, 1e-9);
+  EXPECT_LE(curve.lower_bound, curve.min_distance);
+  EXPECT_THROW(checker.check_path(world, data, path, {}, 0, Eigen::MatrixXd::Zero(2, 2)),
+               std::invalid_argument);
+}
+
+// Cubics with a linear acceleration (the planner's interpolant) sampled at six points, each
+// segment's deviation h²/8 · max |q̈| at its ends: the walk's certified bound stays below the
+// densely sampled minimum of the curve itself, and every penetration of the curve is found.
+TEST_F(RrSegment, PathCheckOfACurveIsBoundedByDenseSamplingOfTheCurve) {
+  CollisionWorld world(model);
+  add_obstacle(world, Shape::sphere(0.05), at(0.9, 0, 1.3));
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> pos(-1, 1.5), vel(-2, 2), acc(-30, 30);
+  const double T = 0.5;
+  const int rows = 6, dense_points = 2000;
+  SegmentChecker checker(model);
+  int penetrating = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    Eigen::Vector2d q0, v0, a0, a1;
+    q0 << pos(rng), pos(rng);
+    v0 << vel(rng), vel(rng);
+    a0 << acc(rng), acc(rng);
+    a1 << acc(rng), acc(rng);
+    const auto q = [&](double s) -> Eigen::Vector2d {
+      return q0 + v0 * s + a0 * s * s / 2 + (a1 - a0) * s * s * s / (6 * T);
+    };
+    const auto qdd = [&](double s) -> Eigen::Vector2d { return a0 + (a1 - a0) * s / T; };
+    const double h = T / (rows - 1);
+    Eigen::MatrixXd path(rows, 2), deviation(rows - 1, 2);
+    for (int i = 0; i < rows; ++i) path.row(i) = q(i * h).transpose();
+    for (int i = 0; i + 1 < rows; ++i) {
+      deviation.row(i) =
+          (h * h / 8 * qdd(i * h).cwiseAbs().cwiseMax(qdd((i + 1) * h).cwiseAbs())).transpose();
+    }
+    double dense_min = std::numeric_limits<double>::infinity();
+    for (int i = 0; i <= dense_points; ++i) {
+      dynamics::forward_kinematics(model, data, q(T * i / dense_points));
+      dense_min = std::min(dense_min, world.closest(data).distance);
+    }
+    const PathCheckResult r = checker.check_path(world, data, path, {}, 0, deviation);
+    EXPECT_LE(r.lower_bound, dense_min + 1e-9) << trial;
+    if (dense_min < 0) {
+      ++penetrating;
+      EXPECT_LT(r.min_distance, 0) << trial;
+    }
+  }
+  EXPECT_GT(penetrating, 0);  // the seed must exercise penetrations
 }
 
 // A pair's allowance is spent only by the joints that move it: with a ball 3 cm from the upper

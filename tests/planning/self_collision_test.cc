@@ -160,7 +160,8 @@ TEST(Validate, PlanThroughTheFloorIsInvalidAndTheFloorCanBeSwitchedOff) {
 
 TEST(Validate, SelfCollisionBetweenTheKnotsIsFound) {
   // Links 5 and 7 overlap when |q6| > 1.83 rad. Both knots have q6 = 1.6, but their velocities
-  // (within the 2.36 rad/s limit) make the Hermite interpolant swing q6 to 2.18 at mid-interval.
+  // (within the 2.36 rad/s limit) and q̈6 = −4.6 rad/s² make the interpolant swing q6 to 2.18
+  // at mid-interval.
   Problem p;
   p.model = load_robot("robots/iiwa14/iiwa14.urdf");
   p.horizon = 1;
@@ -174,6 +175,7 @@ TEST(Validate, SelfCollisionBetweenTheKnotsIsFound) {
   plan.qd = Eigen::MatrixXd(2, 7);
   plan.qd << p.start_qd.transpose(), -p.start_qd.transpose();
   plan.qdd = Eigen::MatrixXd::Zero(2, 7);
+  plan.qdd.col(5).setConstant(-2 * 2.3);
   plan.tau = Eigen::MatrixXd::Zero(2, 7);
   plan.t = {0, 1};
   EXPECT_EQ(check_problem(p), "");  // both knots are clear

@@ -3,6 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
+#include "kinograph/collision/collision_world.h"
 #include "kinograph/dynamics/inverse_dynamics.h"
 #include "kinograph/dynamics/kinematics.h"
 #include "kinograph/graph/worker_pool.h"
@@ -97,6 +100,50 @@ TEST(Validate, ACollisionLateInThePlanIsReportedAtItsTime) {
   const Validation v = validate(f.problem, f.plan);
   EXPECT_LT(v.min_clearance, 0);
   EXPECT_TRUE(mentions_all(v, {"collision: ", "at t = 0.8"})) << all_failures(v);
+}
+
+// The walk follows the interpolant, not the chords between its samples. The RR arm's shoulder
+// decelerates at 5 rad/s² from 2.25 rad/s and turns back at t = 0.45 s, between the samples at
+// 0.4 and 0.5 s (equal there), 6.25 mrad beyond them; a ball just past the turn is touched only
+// at the turn. The straight segments between the samples keep 7 mm from it.
+TEST(Validate, ACollisionBetweenTheWalksSamplesIsFound) {
+  const double c = 5, v0 = 2.25;  // the turn at v0 / c = 0.45 s, at angle v0² / 2c
+  Problem problem;
+  problem.model = testing::load_robot("robots/rr/rr.urdf");
+  problem.horizon = 1;
+  problem.steps = 1;
+  Plan plan;
+  plan.q = (Eigen::MatrixXd(2, 2) << 0, 0, v0 - c / 2, 0).finished();
+  plan.qd = (Eigen::MatrixXd(2, 2) << v0, 0, v0 - c, 0).finished();
+  plan.qdd = (Eigen::MatrixXd(2, 2) << -c, 0, -c, 0).finished();
+  plan.tau.setZero(2, 2);
+  plan.t = {0, 1};
+  problem.start_q = plan.q.row(0).transpose();
+  problem.start_qd = plan.qd.row(0).transpose();
+  problem.goal.q = plan.q.row(1).transpose();
+  // No self pairs: they would count the stray twice, as two geometries may both move.
+  problem.self_and_floor.self_collision = false;
+  // The tip ball (radius 0.045 at 1.8 m) 4 mm into a ball of radius 0.05 at the turn.
+  const double turn = v0 * v0 / (2 * c), beyond = 2 * std::asin(0.091 / 3.6);
+  collision::Obstacle ball;
+  ball.id = 3;
+  ball.shape = collision::Shape::sphere(0.05);
+  ball.pose.translation() =
+      1.8 * Eigen::Vector3d(std::sin(turn + beyond), 0, std::cos(turn + beyond));
+  problem.obstacles.push_back(ball);
+  collision::CollisionWorld world(*problem.model);
+  ASSERT_TRUE(world.add_obstacle(ball));
+  dynamics::Data data(*problem.model);
+  const auto distance = [&](double q0) {
+    dynamics::forward_kinematics(*problem.model, data, Eigen::Vector2d(q0, 0));
+    return world.closest(data).distance;
+  };
+  ASSERT_LT(distance(turn), -0.003);
+  ASSERT_GT(distance(turn - c * 0.05 * 0.05 / 2), 0.006);  // the samples at 0.4 and 0.5 s
+  const Validation v = validate(problem, plan);
+  EXPECT_TRUE(mentions_all(v, {"collision: ", "obstacle 3 overlap"})) << all_failures(v);
+  EXPECT_LT(v.min_clearance, -0.003);
+  EXPECT_GT(v.min_clearance, -0.006);  // the bound is close: the stray is exact at the turn
 }
 
 // Start, goal and task failures say which joint or frame misses, by how much, and when.
