@@ -106,6 +106,30 @@ struct StateWorst {
   }
 };
 
+// The plan with its own times, or a copy of it on the problem's grid when it has none.
+const Plan& with_times(const Problem& problem, const Plan& plan, Plan& copy) {
+  const int rows = problem.steps + 1;
+  if (plan.t.size() == static_cast<size_t>(rows)) return plan;
+  copy = plan;
+  copy.t.resize(rows);
+  for (int k = 0; k < rows; ++k) copy.t[k] = k * problem.dt();
+  return copy;
+}
+
+// Where between two knots the interpolant is checked: fractions of the interval, the next
+// knot (1) last. As dense as the planner's limit points, and at least interval_samples (the
+// knot included).
+std::vector<double> interval_fractions(const Problem& problem,
+                                       const ValidationThresholds& thresholds) {
+  const int samples = std::max(1, thresholds.interval_samples) > 1
+                          ? limit_points(thresholds.interval_samples - 1, problem.dt()) + 1
+                          : 1;
+  std::vector<double> fractions;
+  for (int i = 1; i < samples; ++i) fractions.push_back(static_cast<double>(i) / samples);
+  fractions.push_back(1.0);
+  return fractions;
+}
+
 // Physics on the plan's interpolant (interpolant.h): inverse dynamics at the knots, the
 // interpolant's continuity into every next knot (the collocation and, for unactuated joints,
 // the shooting defect), and every limit at the knots and at `interval_samples` points of every
@@ -114,15 +138,8 @@ void check_physics(const Problem& problem, const Plan& plan, const ValidationThr
                    dynamics::Data& data, Validation& v) {
   const dynamics::Model& model = *problem.model;
   const int N = problem.steps, rows = N + 1;
-  const double dt = problem.dt();
-  Plan timed;  // the validator reads times from the plan, or the problem's grid without them
-  const Plan* p = &plan;
-  if (plan.t.size() != static_cast<size_t>(rows)) {
-    timed = plan;
-    timed.t.resize(rows);
-    for (int k = 0; k < rows; ++k) timed.t[k] = k * dt;
-    p = &timed;
-  }
+  Plan copy;
+  const Plan* p = &with_times(problem, plan, copy);
   StateWorst knots, between;
   Worst position, velocity;
   for (int k = 0; k < rows; ++k) {
@@ -139,13 +156,7 @@ void check_physics(const Problem& problem, const Plan& plan, const ValidationThr
     }
   }
   TrajectorySampler sampler(model, *p);
-  // As dense as the planner's limit points, and at least interval_samples (knot included).
-  const int samples = std::max(1, thresholds.interval_samples) > 1
-                          ? limit_points(thresholds.interval_samples - 1, dt) + 1
-                          : 1;
-  std::vector<double> fractions;
-  for (int i = 1; i < samples; ++i) fractions.push_back(static_cast<double>(i) / samples);
-  fractions.push_back(1.0);
+  const std::vector<double> fractions = interval_fractions(problem, thresholds);
   std::vector<InterpolantPoint> points;
   for (int k = 0; k < N; ++k) {
     sampler.interval(k, fractions, points);
@@ -284,11 +295,36 @@ void check_start_and_goal(const Problem& problem, const Plan& plan,
                        at_time(t_end) + ")");
 }
 
-// Task constraints at every step, naming the frame and the time of the worst step.
-void check_tasks(const Problem& problem, const Plan& plan, dynamics::Data& data, Validation& v) {
+// Task constraints on the interpolant, at the knots and where the physics is checked between
+// them, naming the frame and the time of the worst point.
+void check_tasks(const Problem& problem, const Plan& plan, const ValidationThresholds& thresholds,
+                 dynamics::Data& data, Validation& v) {
+  if (problem.task_constraints.empty()) return;
   const dynamics::Model& model = *problem.model;
-  const int rows = problem.steps + 1;
-  const bool timed = plan.t.size() == static_cast<size_t>(rows);
+  const int N = problem.steps;
+  Plan copy;
+  const Plan& p = with_times(problem, plan, copy);
+  for (int k = 0; k < N; ++k) {
+    if (!(p.t[k + 1] > p.t[k])) return;  // the physics reports the times
+  }
+  // The configurations checked and their times: every knot, then the points between.
+  std::vector<Eigen::VectorXd> q;
+  std::vector<double> t;
+  for (int k = 0; k <= N; ++k) {
+    q.push_back(p.q.row(k).transpose());
+    t.push_back(p.t[k]);
+  }
+  TrajectorySampler sampler(model, p);
+  std::vector<double> fractions = interval_fractions(problem, thresholds);
+  fractions.pop_back();  // the next knot is checked as a knot
+  std::vector<InterpolantPoint> points;
+  for (int k = 0; k < N && !fractions.empty(); ++k) {
+    sampler.interval(k, fractions, points);
+    for (const InterpolantPoint& x : points) {
+      q.push_back(x.q);
+      t.push_back(p.t[k] + x.s);
+    }
+  }
   for (const TaskConstraint& task : problem.task_constraints) {
     int frame = -1;
     try {
@@ -298,21 +334,21 @@ void check_tasks(const Problem& problem, const Plan& plan, dynamics::Data& data,
       continue;
     }
     double worst = 0;
-    int worst_step = 0;
-    for (int k = 0; k < rows; ++k) {
-      dynamics::forward_kinematics(model, data, plan.q.row(k).transpose());
+    size_t worst_at = 0;
+    for (size_t i = 0; i < q.size(); ++i) {
+      dynamics::forward_kinematics(model, data, q[i]);
       const PoseError e = pose_error(dynamics::frame_pose(model, data, frame), task.target);
       const double err = task.orientation_only ? e.rotation : std::max(e.rotation, e.position);
       if (err > worst) {
         worst = err;
-        worst_step = k;
+        worst_at = i;
       }
     }
     v.max_task_error = std::max(v.max_task_error, worst);
     if (worst > task.tolerance)
       add_failure(v,
                   fmt(("task constraint on '" + task.frame + "'").c_str(), worst, task.tolerance) +
-                      " at " + at_time(timed ? plan.t[worst_step] : worst_step * problem.dt()));
+                      " at " + at_time(t[worst_at]));
   }
 }
 
@@ -493,7 +529,7 @@ Validation validate(const Problem& problem, const Plan& plan,
   };
   graph::share_out(static_cast<int>(items.size()), {}, items, one, 1);
   check_start_and_goal(problem, plan, thresholds, data, v);
-  check_tasks(problem, plan, data, v);
+  check_tasks(problem, plan, thresholds, data, v);
   // A caller that only needs the verdict has no use for the clearance once another check failed.
   if (walk && !(verdict_only && !v.failures.empty())) walk->report(v);
   v.valid = v.failures.empty();
