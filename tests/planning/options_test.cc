@@ -424,27 +424,14 @@ TEST(ValidationThresholds, FinalVelocity) {
 }
 
 // Between steps the validator walks the interpolant through collision_samples states per
-// interval and bounds how far it strays between them: one interval whose elbow swings out and
-// back (q̇ = ±4 rad/s at its ends, q̈ = −8 rad/s² throughout, q the same at both ends) passes a
-// ball that the straight segment between the two knots never comes near. Dense samples bound
-// the overlap closely; one sample per interval still finds it, through a far looser bound.
+// interval and bounds how far it strays between them: the elbow that swings out and back
+// within one interval passes a ball that the straight segment between the two knots never
+// comes near. Dense samples bound the overlap closely; one sample per interval still finds it,
+// through a far looser bound.
 TEST(ValidationThresholds, CollisionSamples) {
-  Problem p;
-  p.model = testing::load_robot("robots/rr/rr.urdf");
-  p.horizon = 1;
-  p.steps = 1;
-  p.start_q = Eigen::Vector2d(0, 0);
-  p.start_qd = Eigen::Vector2d(0, 4);
-  p.goal.q = Eigen::Vector2d(0, 0);
-  Plan plan;
-  plan.q = Eigen::MatrixXd::Zero(2, 2);
-  plan.qd = Eigen::MatrixXd::Zero(2, 2);
-  plan.qd(0, 1) = 4;
-  plan.qd(1, 1) = -4;
-  plan.qdd = Eigen::MatrixXd::Zero(2, 2);
-  plan.qdd.col(1).setConstant(-8);
-  plan.tau = Eigen::MatrixXd::Zero(2, 2);
-  plan.t = {0, 1};
+  testing::SwingingRr f;
+  Problem& p = f.problem;
+  const Plan& plan = f.plan;
   // Where the tip is half-way along the interpolant: elbow at 4 (s − s²) = 1 rad.
   dynamics::Data d(*p.model);
   dynamics::forward_kinematics(*p.model, d, Eigen::Vector2d(0, 1.0));

@@ -131,19 +131,27 @@ inline Goal tip_goal(const Problem& p, const Eigen::VectorXd& q) {
   return g;
 }
 
+/// The RR arm over `steps` steps of 1 s in all, from (start_q, start_qd) to goal_q, no obstacles.
+inline Problem rr_over_a_second(int steps, const Eigen::Vector2d& start_q,
+                                const Eigen::Vector2d& start_qd, const Eigen::Vector2d& goal_q) {
+  Problem problem;
+  problem.model = load_robot("robots/rr/rr.urdf");
+  problem.horizon = 1;
+  problem.steps = steps;
+  problem.start_q = start_q;
+  problem.start_qd = start_qd;
+  problem.goal.q = goal_q;
+  return problem;
+}
+
 /// The RR arm holding still at q* = (0.5, −0.3) for 1 s over 10 steps, with its exact plan
 /// (consistent, within limits, τ = gravity torque): a plan for validation tests to doctor.
 struct StillRr {
   Problem problem;
   Plan plan;
   StillRr() {
-    problem.model = load_robot("robots/rr/rr.urdf");
-    problem.horizon = 1;
-    problem.steps = 10;
     const Eigen::Vector2d q(0.5, -0.3);
-    problem.start_q = q;
-    problem.start_qd = Eigen::Vector2d::Zero();
-    problem.goal.q = q;
+    problem = rr_over_a_second(10, q, Eigen::Vector2d::Zero(), q);
     const int rows = problem.steps + 1;
     plan.q = q.transpose().replicate(rows, 1);
     plan.qd = Eigen::MatrixXd::Zero(rows, 2);
@@ -196,6 +204,23 @@ struct FastRr {
     auto m = std::make_shared<dynamics::Model>(*problem.model);
     m->bodies[0].limits.velocity = limit;
     problem.model = m;
+  }
+};
+
+// The RR arm over one interval of 1 s whose elbow swings out and back: q̇ = ±4 rad/s at its
+// ends, q̈ = −8 rad/s² throughout, q = 0 at both knots and 1 rad half-way. Consistent on the
+// interpolant; τ left at zero.
+struct SwingingRr {
+  Problem problem;
+  Plan plan;
+  SwingingRr() {
+    problem = rr_over_a_second(1, Eigen::Vector2d::Zero(), Eigen::Vector2d(0, 4),
+                               Eigen::Vector2d::Zero());
+    plan.q = Eigen::MatrixXd::Zero(2, 2);
+    plan.qd = (Eigen::MatrixXd(2, 2) << 0, 4, 0, -4).finished();
+    plan.qdd = (Eigen::MatrixXd(2, 2) << 0, -8, 0, -8).finished();
+    plan.tau = Eigen::MatrixXd::Zero(2, 2);
+    plan.t = {0, 1};
   }
 };
 

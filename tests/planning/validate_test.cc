@@ -188,22 +188,11 @@ TEST(Validate, StartGoalAndTaskFailuresNameJointFrameAndTime) {
 }
 
 // A task constraint holds along the interpolant, not only at the knots: the RR arm's elbow
-// swings out and back within one interval (q̇ = ±4 rad/s, q̈ = −8 rad/s²), so the ee, level at
-// both knots, tilts by 1 rad half-way.
+// swings out and back within one interval, so the ee, level at both knots, tilts by 1 rad
+// half-way.
 TEST(Validate, TaskConstraintsHoldBetweenTheKnots) {
-  Problem p;
-  p.model = testing::load_robot("robots/rr/rr.urdf");
-  p.horizon = 1;
-  p.steps = 1;
-  p.start_q = Eigen::Vector2d(0, 0);
-  p.start_qd = Eigen::Vector2d(0, 4);
-  p.goal.q = Eigen::Vector2d(0, 0);
-  Plan plan;
-  plan.q = Eigen::MatrixXd::Zero(2, 2);
-  plan.qd = (Eigen::MatrixXd(2, 2) << 0, 4, 0, -4).finished();
-  plan.qdd = (Eigen::MatrixXd(2, 2) << 0, -8, 0, -8).finished();
-  plan.tau = Eigen::MatrixXd::Zero(2, 2);
-  plan.t = {0, 1};
+  testing::SwingingRr f;
+  Problem& p = f.problem;
   dynamics::Data d(*p.model);
   dynamics::forward_kinematics(*p.model, d, p.start_q);
   TaskConstraint level;
@@ -211,7 +200,7 @@ TEST(Validate, TaskConstraintsHoldBetweenTheKnots) {
   level.target = dynamics::frame_pose(*p.model, d, p.model->frame_index("ee"));
   level.tolerance = 0.05;
   p.task_constraints.push_back(level);
-  const Validation v = validate(p, plan);
+  const Validation v = validate(p, f.plan);
   EXPECT_TRUE(mentions_all(v, {"task constraint on 'ee' 1 exceeds 0.05", "at t = 0.5 s"}))
       << all_failures(v);
   EXPECT_NEAR(v.max_task_error, 1.0, 1e-9);
