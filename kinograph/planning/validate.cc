@@ -361,9 +361,9 @@ constexpr int kCollisionPieces = 4;
 // `collision_samples` points of every interval, and between two of them the straight segment
 // widened by how far the interpolant strays from it, walked by conservative advancement
 // (stretches far from everything cost one query; near something the samples are as dense as the
-// segment checker's sweep step). The constructor builds the path, walk(p) checks piece p (on
-// any thread: each piece has its own world), report() turns the pieces' results into figures
-// and failures.
+// segment checker's sweep step). walk(p) samples and checks piece p (on any thread: each piece
+// has its own world and interpolant), report() turns the pieces' results into figures and
+// failures.
 class CollisionWalk {
  public:
   CollisionWalk(const Problem& problem, const Plan& plan, const ValidationThresholds& thresholds)
