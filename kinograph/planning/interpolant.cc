@@ -18,6 +18,29 @@ int limit_points(int requested, double dt) {
   return std::max(requested, integration_steps(dt) - 1);
 }
 
+void actuated_turning_times(double qd0, double qdd0, double qdd1, double dt,
+                            std::vector<double>& out) {
+  const auto keep = [&](double s) {
+    if (s > 0 && s < dt) out.push_back(s);
+  };
+  // q̈(s) = q̈0 + (q̈1 − q̈0) s / Δt and q̇(s) = q̇0 + q̈0 s + (q̈1 − q̈0) s² / (2Δt).
+  const double jerk = (qdd1 - qdd0) / dt;
+  if (jerk != 0) keep(-qdd0 / jerk);
+  const double a = jerk / 2, b = qdd0, c = qd0;
+  if (a == 0) {
+    if (b != 0) keep(-c / b);
+    return;
+  }
+  const double disc = b * b - 4 * a * c;
+  if (!(disc >= 0)) return;
+  // The root of larger magnitude first, the other from their product: no cancellation. (q = 0
+  // only for the double root s = 0.)
+  const double q = -0.5 * (b + std::copysign(std::sqrt(disc), b));
+  if (q == 0) return;
+  keep(q / a);
+  keep(c / q);
+}
+
 IntervalInterpolant::IntervalInterpolant(const dynamics::Model& model, double max_step)
     : model_(model), max_step_(max_step), coarse_(max_step > kMaxIntegrationStep), data_(model) {
   if (!(max_step > 0)) throw std::invalid_argument("interpolant: the RK4 step must be > 0");

@@ -29,6 +29,12 @@ int integration_steps(double dt, double max_step = kMaxIntegrationStep);
 /// 0 when requested ≤ 0.
 int limit_points(int requested, double dt);
 
+/// The instants in (0, dt) where an actuated joint's cubic can peak, appended to `out`: where
+/// its q̇ is zero (q turns back) and where its q̈ is zero (q̇ turns back). From the knot's q̇0
+/// and q̈0 and the next knot's q̈1.
+void actuated_turning_times(double qd0, double qdd0, double qdd1, double dt,
+                            std::vector<double>& out);
+
 /// The interpolant at one instant, s seconds after the interval's first knot: q, q̇, q̈ and
 /// τ = RNEA(q, q̇, q̈) (zero on unactuated joints up to rounding). With derivatives, also their
 /// derivatives (n × 4n each) with respect to the interval's inputs z = [q_k; q̇_k; q̈_k; q̈_{k+1}].

@@ -130,6 +130,24 @@ std::vector<double> interval_fractions(const Problem& problem,
   return fractions;
 }
 
+// Whether actuated joint j's q or q̇ could reach a limit between interval k's samples (the
+// knot, then `points`, evenly spaced): off the samples its cubic's q moves at most
+// h²/8 · max |q̈| and its q̇ at most h²/8 · |q⃛| beyond them.
+bool near_limit_between_samples(const dynamics::JointLimits& lim, const Plan& plan, int k, int j,
+                                const std::vector<InterpolantPoint>& points, int samples) {
+  const double dt = plan.t[k + 1] - plan.t[k], h = dt / samples;
+  const double q_reach =
+      h * h / 8 * std::max(std::abs(plan.qdd(k, j)), std::abs(plan.qdd(k + 1, j)));
+  const double qd_reach = h * h / 8 * std::abs(plan.qdd(k + 1, j) - plan.qdd(k, j)) / dt;
+  double lo = plan.q(k, j), hi = lo, fastest = std::abs(plan.qd(k, j));
+  for (const InterpolantPoint& x : points) {
+    lo = std::min(lo, x.q[j]);
+    hi = std::max(hi, x.q[j]);
+    fastest = std::max(fastest, std::abs(x.qd[j]));
+  }
+  return lo - q_reach < lim.lower || hi + q_reach > lim.upper || fastest + qd_reach > lim.velocity;
+}
+
 // Physics on the plan's interpolant (interpolant.h): inverse dynamics at the knots, the
 // interpolant's continuity into every next knot (the collocation and, for unactuated joints,
 // the shooting defect), and every limit at the knots and at `interval_samples` points of every
@@ -158,11 +176,33 @@ void check_physics(const Problem& problem, const Plan& plan, const ValidationThr
   TrajectorySampler sampler(model, *p);
   const std::vector<double> fractions = interval_fractions(problem, thresholds);
   std::vector<InterpolantPoint> points;
+  std::vector<double> turning;
+  std::vector<InterpolantPoint> extremes;
   for (int k = 0; k < N; ++k) {
     sampler.interval(k, fractions, points);
     for (int i = 0; i + 1 < static_cast<int>(points.size()); ++i) {
       const InterpolantPoint& x = points[i];
       between.see(model, x.q, x.qd, &x.qdd, x.tau, p->t[k] + x.s, k);
+    }
+    // Between the samples an actuated joint's q and q̇ peak where its cubic turns: read there
+    // too, where the samples come near a limit (unless only the knots are asked for).
+    turning.clear();
+    for (int j = 0; j < model.nq() && fractions.size() > 1; ++j) {
+      if (!model.bodies[j].actuated) continue;
+      if (near_limit_between_samples(model.bodies[j].limits, *p, k, j, points,
+                                     static_cast<int>(fractions.size()))) {
+        actuated_turning_times(p->qd(k, j), p->qdd(k, j), p->qdd(k + 1, j), p->t[k + 1] - p->t[k],
+                               turning);
+      }
+    }
+    if (!turning.empty()) {
+      const double dt = p->t[k + 1] - p->t[k];
+      for (double& s : turning) s /= dt;
+      std::sort(turning.begin(), turning.end());
+      sampler.interval(k, turning, extremes);
+      for (const InterpolantPoint& x : extremes) {
+        between.see(model, x.q, x.qd, &x.qdd, x.tau, p->t[k] + x.s, k);
+      }
     }
     const InterpolantPoint& end = points.back();
     for (int j = 0; j < model.nq(); ++j) {

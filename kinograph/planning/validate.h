@@ -26,7 +26,8 @@ struct ValidationThresholds {
   int collision_samples = 10;
   /// Points per interval (the knot and interval_samples − 1 between, and at least one per RK4
   /// node of the interpolant: limit_points) where limits and the unactuated torque are
-  /// checked on the interpolant.
+  /// checked on the interpolant; above 1, also where an actuated joint's cubic turns near a
+  /// q or q̇ limit. 1: at the knots only.
   int interval_samples = 10;
 };
 

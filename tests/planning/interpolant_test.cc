@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <memory>
 #include <random>
@@ -43,6 +44,36 @@ graph::Values random_interval(int n, double dt, std::mt19937& rng) {
   x.insert(v_key(1), Eigen::VectorXd(v0 + dt / 2 * (a0 + a1)));
   x.insert(a_key(1), a1);
   return x;
+}
+
+// The turning instants are where the cubic's q̇ and q̈ vanish: checked against the cubic
+// itself, and none outside (0, Δt).
+TEST(Interpolant, ActuatedTurningTimesAreWhereTheCubicTurns) {
+  const double dt = 0.5;
+  const auto qd = [&](double qd0, double a0, double a1, double s) {
+    return qd0 + a0 * s + (a1 - a0) * s * s / (2 * dt);
+  };
+  const auto qdd = [&](double a0, double a1, double s) { return a0 + (a1 - a0) * s / dt; };
+  struct Case {
+    double qd0, a0, a1;
+    size_t count;
+  } cases[] = {{1, -4, -4, 1},    // constant q̈: q turns once, at 0.25 s
+               {1, -8, 6, 3},     // q̈ crosses zero, q̇ twice
+               {1, 2, 3, 0},      // speeding up: no turn
+               {0.1, 2, -30, 2},  // q̈ and one zero of q̇ inside, the other before 0
+               {-0.5, 0, 0, 0}};  // constant q̇
+  for (const Case& c : cases) {
+    std::vector<double> s;
+    actuated_turning_times(c.qd0, c.a0, c.a1, dt, s);
+    EXPECT_EQ(s.size(), c.count) << c.qd0 << " " << c.a0 << " " << c.a1;
+    for (double t : s) {
+      EXPECT_GT(t, 0);
+      EXPECT_LT(t, dt);
+      EXPECT_TRUE(std::abs(qd(c.qd0, c.a0, c.a1, t)) < 1e-12 ||
+                  std::abs(qdd(c.a0, c.a1, t)) < 1e-12)
+          << t;
+    }
+  }
 }
 
 TEST(Interpolant, IntegrationStepsFollowTheLongestStep) {

@@ -304,6 +304,30 @@ TEST(Validate, ChecksLimitsBetweenTheKnots) {
   EXPECT_NE(why.find("t = 0.15 s"), std::string::npos) << why;
 }
 
+// Between the samples a joint's q peaks where its cubic turns, and is read there: the RR
+// shoulder decelerates at 5 rad/s² from 2.25 rad/s and turns back at t = 0.45 s, 6.25 mrad
+// beyond the samples at 0.4 and 0.5 s. With its upper limit 3 mrad below the turn, every
+// sample is within it and the turn is not.
+TEST(Validate, ALimitPassedBetweenTheSamplesIsFound) {
+  const double c = 5, v0 = 2.25, turn = v0 * v0 / (2 * c);
+  Problem p = testing::rr_over_a_second(1, Eigen::Vector2d::Zero(), Eigen::Vector2d(v0, 0),
+                                        Eigen::Vector2d(v0 - c / 2, 0));
+  auto model = std::make_shared<dynamics::Model>(*p.model);
+  model->bodies[0].limits.upper = turn - 0.003;
+  p.model = model;
+  Plan plan;
+  plan.q = (Eigen::MatrixXd(2, 2) << 0, 0, v0 - c / 2, 0).finished();
+  plan.qd = (Eigen::MatrixXd(2, 2) << v0, 0, v0 - c, 0).finished();
+  plan.qdd = (Eigen::MatrixXd(2, 2) << -c, 0, -c, 0).finished();
+  plan.tau.setZero(2, 2);
+  plan.t = {0, 1};
+  const Validation v = validate(p, plan);
+  EXPECT_NEAR(v.max_q_violation, 0.003, 1e-12);
+  EXPECT_TRUE(mentions_all(v, {"joint position limit violation (rad) 0.003", "joint 'joint1'",
+                               "at t = 0.45 s (between knots 0 and 1)"}))
+      << all_failures(v);
+}
+
 TEST(Validate, ChecksEffortBetweenTheKnots) {
   // The RR arm's shoulder swept at a constant 2 rad/s (q̈ = 0, elbow still) through the angle
   // of its largest gravity torque: the torque between the knots exceeds both knots' torques.
