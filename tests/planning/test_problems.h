@@ -224,4 +224,22 @@ struct SwingingRr {
   }
 };
 
+// The RR arm over one interval of 1 s whose shoulder decelerates at kC = 5 rad/s² from
+// kV0 = 2.25 rad/s and turns back at t = 0.45 s, at kTurn = 0.50625 rad: between the samples
+// at 0.4 and 0.5 s (6.25 mrad below the turn at both). Elbow still; τ left at zero.
+struct TurningRr {
+  static constexpr double kC = 5, kV0 = 2.25, kTurn = kV0 * kV0 / (2 * kC);
+  Problem problem;
+  Plan plan;
+  TurningRr() {
+    problem = rr_over_a_second(1, Eigen::Vector2d::Zero(), Eigen::Vector2d(kV0, 0),
+                               Eigen::Vector2d(kV0 - kC / 2, 0));
+    plan.q = (Eigen::MatrixXd(2, 2) << 0, 0, kV0 - kC / 2, 0).finished();
+    plan.qd = (Eigen::MatrixXd(2, 2) << kV0, 0, kV0 - kC, 0).finished();
+    plan.qdd = (Eigen::MatrixXd(2, 2) << -kC, 0, -kC, 0).finished();
+    plan.tau = Eigen::MatrixXd::Zero(2, 2);
+    plan.t = {0, 1};
+  }
+};
+
 }  // namespace kinograph::planning::testing

@@ -102,29 +102,19 @@ TEST(Validate, ACollisionLateInThePlanIsReportedAtItsTime) {
   EXPECT_TRUE(mentions_all(v, {"collision: ", "at t = 0.8"})) << all_failures(v);
 }
 
-// The walk follows the interpolant, not the chords between its samples. The RR arm's shoulder
-// decelerates at 5 rad/s² from 2.25 rad/s and turns back at t = 0.45 s, between the samples at
-// 0.4 and 0.5 s (equal there), 6.25 mrad beyond them; a ball just past the turn is touched only
-// at the turn. The straight segments between the samples keep 7 mm from it.
+// The walk follows the interpolant, not the chords between its samples. The RR shoulder turns
+// back between the samples at 0.4 and 0.5 s (equal there), 6.25 mrad beyond them; a ball just
+// past the turn is touched only at the turn. The straight segments between the samples keep
+// 7 mm from it.
 TEST(Validate, ACollisionBetweenTheWalksSamplesIsFound) {
-  const double c = 5, v0 = 2.25;  // the turn at v0 / c = 0.45 s, at angle v0² / 2c
-  Problem problem;
-  problem.model = testing::load_robot("robots/rr/rr.urdf");
-  problem.horizon = 1;
-  problem.steps = 1;
-  Plan plan;
-  plan.q = (Eigen::MatrixXd(2, 2) << 0, 0, v0 - c / 2, 0).finished();
-  plan.qd = (Eigen::MatrixXd(2, 2) << v0, 0, v0 - c, 0).finished();
-  plan.qdd = (Eigen::MatrixXd(2, 2) << -c, 0, -c, 0).finished();
-  plan.tau.setZero(2, 2);
-  plan.t = {0, 1};
-  problem.start_q = plan.q.row(0).transpose();
-  problem.start_qd = plan.qd.row(0).transpose();
-  problem.goal.q = plan.q.row(1).transpose();
+  testing::TurningRr f;
+  Problem& problem = f.problem;
+  const Plan& plan = f.plan;
+  const double c = f.kC, turn = f.kTurn;
   // No self pairs: they would count the stray twice, as two geometries may both move.
   problem.self_and_floor.self_collision = false;
   // The tip ball (radius 0.045 at 1.8 m) 4 mm into a ball of radius 0.05 at the turn.
-  const double turn = v0 * v0 / (2 * c), beyond = 2 * std::asin(0.091 / 3.6);
+  const double beyond = 2 * std::asin(0.091 / 3.6);
   collision::Obstacle ball;
   ball.id = 3;
   ball.shape = collision::Shape::sphere(0.05);
@@ -305,22 +295,15 @@ TEST(Validate, ChecksLimitsBetweenTheKnots) {
 }
 
 // Between the samples a joint's q peaks where its cubic turns, and is read there: the RR
-// shoulder decelerates at 5 rad/s² from 2.25 rad/s and turns back at t = 0.45 s, 6.25 mrad
-// beyond the samples at 0.4 and 0.5 s. With its upper limit 3 mrad below the turn, every
-// sample is within it and the turn is not.
+// shoulder turns back at t = 0.45 s, 6.25 mrad beyond the samples at 0.4 and 0.5 s. With its
+// upper limit 3 mrad below the turn, every sample is within it and the turn is not.
 TEST(Validate, ALimitPassedBetweenTheSamplesIsFound) {
-  const double c = 5, v0 = 2.25, turn = v0 * v0 / (2 * c);
-  Problem p = testing::rr_over_a_second(1, Eigen::Vector2d::Zero(), Eigen::Vector2d(v0, 0),
-                                        Eigen::Vector2d(v0 - c / 2, 0));
+  testing::TurningRr f;
+  Problem& p = f.problem;
+  const Plan& plan = f.plan;
   auto model = std::make_shared<dynamics::Model>(*p.model);
-  model->bodies[0].limits.upper = turn - 0.003;
+  model->bodies[0].limits.upper = f.kTurn - 0.003;
   p.model = model;
-  Plan plan;
-  plan.q = (Eigen::MatrixXd(2, 2) << 0, 0, v0 - c / 2, 0).finished();
-  plan.qd = (Eigen::MatrixXd(2, 2) << v0, 0, v0 - c, 0).finished();
-  plan.qdd = (Eigen::MatrixXd(2, 2) << -c, 0, -c, 0).finished();
-  plan.tau.setZero(2, 2);
-  plan.t = {0, 1};
   const Validation v = validate(p, plan);
   EXPECT_NEAR(v.max_q_violation, 0.003, 1e-12);
   EXPECT_TRUE(mentions_all(v, {"joint position limit violation (rad) 0.003", "joint 'joint1'",
