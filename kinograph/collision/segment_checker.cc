@@ -205,7 +205,8 @@ PathCheckResult SegmentChecker::check_path(CollisionWorld& world, dynamics::Data
   double u = 0;  // fraction along it
   sample(0, 0);
   last_bound_ = Eigen::Map<const Eigen::VectorXd>(world.pair_bounds().data(), pair_count);
-  if (m == 1) {
+  result.stopped_below = result.min_distance < options_.stop_below;
+  if (m == 1 || result.stopped_below) {
     result.lower_bound = result.min_distance;
     return result;
   }
@@ -277,6 +278,10 @@ PathCheckResult SegmentChecker::check_path(CollisionWorld& world, dynamics::Data
                                     0.5 * (last_bound_ + next - used_).minCoeff() - stretch_stray);
     }
     last_bound_ = next;
+    if (result.min_distance < options_.stop_below) {
+      result.stopped_below = true;
+      break;
+    }
   }
   result.lower_bound = std::min(result.lower_bound, result.min_distance);
   return result;

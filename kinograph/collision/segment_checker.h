@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <limits>
 #include <vector>
 
 #include "kinograph/collision/collision_world.h"
@@ -31,6 +32,9 @@ struct SegmentCheckOptions {
   // moves its geometry a kilometre, and a plan file that does (q̇ = 1e7) would spend the whole
   // query budget on it. The walk stops there and says so. Default 1,000 m.
   double max_path_sweep = 1000;
+  // check_path stops at the first sample whose distance falls below this (m): a caller that
+  // asks only whether a path keeps a clearance has its answer there. Default −∞: never.
+  double stop_below = -std::numeric_limits<double>::infinity();
 };
 
 // The smallest signed distance found along a segment.
@@ -67,6 +71,9 @@ struct PathCheckResult {
   bool complete = true;
   int stopped_segment = 0;
   double stopped_s = 0;
+  // True when the walk ended at a sample below SegmentCheckOptions::stop_below: the figures
+  // cover the path up to that sample (segment, s), and min_distance is below stop_below.
+  bool stopped_below = false;
 };
 
 // Checks straight segments q(s) = q0 + s (q1 − q0), s ∈ [0, 1], with obstacle time
@@ -90,7 +97,8 @@ class SegmentChecker {
   // obstacles move). So no stretch where a pair could come closer than `clearance` is skipped,
   // yet clear stretches, and stretches whose near pairs barely move, cost one query. Allocates
   // nothing after the first call with a given joint count and pair count. Stops after
-  // max_path_samples queries or max_path_sweep of sweep (complete false).
+  // max_path_samples queries or max_path_sweep of sweep (complete false), and at the first
+  // sample below stop_below (stopped_below true).
   // A curved path sampled at the rows: `deviation` (one row per segment, one column per joint)
   // bounds how far each joint of the true path strays from the straight segment between two
   // rows (rad; m for prismatic joints). Each pair's allowance on a segment then shrinks by what

@@ -406,10 +406,13 @@ constexpr int kCollisionPieces = 4;
 // failures.
 class CollisionWalk {
  public:
-  CollisionWalk(const Problem& problem, const Plan& plan, const ValidationThresholds& thresholds)
+  // With `verdict_only` each piece stops at its first sample that breaks the clearance.
+  CollisionWalk(const Problem& problem, const Plan& plan, const ValidationThresholds& thresholds,
+                bool verdict_only)
       : problem_(problem),
         plan_(plan),
         clearance_(thresholds.min_clearance),
+        verdict_only_(verdict_only),
         sub_(std::max(1, thresholds.collision_samples)),
         timed_(plan.t.size() == static_cast<size_t>(problem.steps + 1)) {
     const int N = problem.steps, pieces = std::clamp(N, 1, kCollisionPieces);
@@ -433,6 +436,7 @@ class CollisionWalk {
     collision::SegmentCheckOptions options;
     options.max_path_samples = std::max(1, options.max_path_samples / pieces());
     options.max_path_sweep /= pieces();
+    if (verdict_only_) options.stop_below = clearance_;
     collision::SegmentChecker checker(*problem_.model, options);
     dynamics::Data data(*problem_.model);
     Eigen::MatrixXd path, stray;
@@ -541,6 +545,7 @@ class CollisionWalk {
   const Problem& problem_;
   const Plan& plan_;
   double clearance_;
+  bool verdict_only_;
   int sub_;                      // path rows an interval
   bool timed_;                   // the plan has its own times; else the problem's grid
   std::vector<int> first_knot_;  // piece p walks knots first_knot_[p] … first_knot_[p + 1]
@@ -556,7 +561,7 @@ Validation validate(const Problem& problem, const Plan& plan,
   if (!check_shape(problem, plan, v)) return v;
   dynamics::Data data(*problem.model);
   std::optional<CollisionWalk> walk;
-  if (has_clearance_checks(problem)) walk.emplace(problem, plan, thresholds);
+  if (has_clearance_checks(problem)) walk.emplace(problem, plan, thresholds, verdict_only);
   // Item 0 is the physics, item p + 1 the collision walk's piece p; each writes only its own.
   std::vector<int> items(1 + (walk ? walk->pieces() : 0));
   std::iota(items.begin(), items.end(), 0);

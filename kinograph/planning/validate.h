@@ -33,10 +33,11 @@ struct ValidationThresholds {
 
 /// Validates `plan` for `problem`: fills every figure of Validation, lists each failed check
 /// in failures, and sets valid. Malformed plans (wrong sizes, NaN) are invalid, never a crash.
-/// With verdict_only, the clearance is not reported when another check has failed, so
-/// min_clearance may be left unset then. The physics and the pieces of the collision walk run
-/// on the process's worker pool (graph/worker_pool.h) when it is free; the result is the same
-/// either way.
+/// With verdict_only, the collision walk stops at the first sample that breaks the clearance
+/// (min_clearance is then that sample's figure, not the path's least), and the clearance is not
+/// reported when another check has failed, so min_clearance may be left unset then. The
+/// physics and the pieces of the collision walk run on the process's worker pool
+/// (graph/worker_pool.h) when it is free; the result is the same either way.
 Validation validate(const Problem& problem, const Plan& plan,
                     const ValidationThresholds& thresholds = {}, bool verdict_only = false);
 

@@ -412,6 +412,42 @@ TEST_F(RrSegment, PathCheckStopsAtItsSweepBound) {
   EXPECT_NEAR(whole.swept, 2 * checker.lever()[0], 1e-9);
 }
 
+// With stop_below the walk ends at its first sample below it: a path that never comes that
+// close is walked exactly as without it; one that does ends there, with fewer queries, a
+// minimum below the threshold and the walk counted complete (no budget ran out).
+TEST_F(RrSegment, PathCheckStopsAtItsFirstSampleBelowStopBelow) {
+  CollisionWorld world(model);
+  add_obstacle(world, Shape::sphere(0.05), at(0.9, 0, 1.3));
+  std::mt19937 rng(21);
+  SegmentChecker full(model), first(model, {.stop_below = 0.0});
+  int stopped = 0, shorter = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const Eigen::MatrixXd path = random_path(rng, 12);
+    const PathCheckResult all = full.check_path(world, data, path);
+    const PathCheckResult r = first.check_path(world, data, path);
+    EXPECT_FALSE(all.stopped_below);
+    EXPECT_TRUE(r.complete);
+    if (all.min_distance >= 0) {
+      EXPECT_FALSE(r.stopped_below) << trial;
+      EXPECT_EQ(r.samples, all.samples) << trial;
+      EXPECT_EQ(r.min_distance, all.min_distance) << trial;
+      EXPECT_EQ(r.lower_bound, all.lower_bound) << trial;
+      continue;
+    }
+    ++stopped;
+    EXPECT_TRUE(r.stopped_below) << trial;
+    EXPECT_LT(r.min_distance, 0) << trial;
+    EXPECT_LE(r.samples, all.samples) << trial;
+    // The same walk up to there: its first sample below, never past the full walk's least.
+    EXPECT_GE(r.min_distance, all.min_distance) << trial;
+    EXPECT_TRUE(r.segment < all.segment || (r.segment == all.segment && r.s <= all.s)) << trial;
+    shorter += r.samples < all.samples;
+  }
+  EXPECT_GT(stopped, 0);  // the seed must exercise both cases
+  EXPECT_LT(stopped, 40);
+  EXPECT_GT(shorter, 0);
+}
+
 // Moving obstacles: samples at most max_time_step apart in time, and the sphere that passes
 // through the arm mid-path is found.
 TEST_F(RrSegment, PathCheckFollowsMovingObstaclesInTime) {

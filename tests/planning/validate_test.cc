@@ -87,6 +87,31 @@ TEST(Validate, TheSameVerdictWithAndWithoutThePoolsHelp) {
   testing::expect_same_validation(shared, alone);
 }
 
+// A caller that asks only for the verdict (the replanner's stopping rule) gets the same figures
+// for a clear plan, and for a colliding one the same failure from a walk that stopped at its
+// first sample below the clearance.
+TEST(Validate, TheVerdictAloneIsTheFullVerdict) {
+  Fixture f;
+  collision::Obstacle ball;
+  ball.id = 4;
+  ball.shape = collision::Shape::sphere(0.05);
+  ball.pose.translation() = Eigen::Vector3d(0, 0, -1.5);  // out of reach, below the base
+  f.problem.obstacles.push_back(ball);
+  const Validation clear = validate(f.problem, f.plan);
+  ASSERT_TRUE(clear.valid) << all_failures(clear);
+  testing::expect_same_validation(clear, validate(f.problem, f.plan, {}, true));
+  // The ball on the upper link, which holds still at 0.5 rad: every sample touches it.
+  f.problem.obstacles[0].pose.translation() =
+      Eigen::Vector3d(std::sin(0.5) * 0.5, 0, std::cos(0.5) * 0.5);
+  const Validation full = validate(f.problem, f.plan);
+  const Validation verdict = validate(f.problem, f.plan, {}, true);
+  EXPECT_FALSE(verdict.valid);
+  EXPECT_TRUE(mentions_all(verdict, {"collision: ", "obstacle 4 overlap"}))
+      << all_failures(verdict);
+  EXPECT_EQ(verdict.failures, full.failures);
+  EXPECT_EQ(verdict.min_clearance, full.min_clearance);  // the first sample is the least here
+}
+
 // The collision walk is cut into pieces; a collision in a late piece is reported at its own
 // time on the plan's clock.
 TEST(Validate, ACollisionLateInThePlanIsReportedAtItsTime) {
