@@ -53,15 +53,20 @@ std::string all_failures(const Validation& v) {
   return s;
 }
 
+// A 5 cm ball below the RR arm's base, out of its reach: an obstacle the walk must check.
+collision::Obstacle ball_out_of_reach(int id) {
+  collision::Obstacle ball;
+  ball.id = id;
+  ball.shape = collision::Shape::sphere(0.05);
+  ball.pose.translation() = Eigen::Vector3d(0, 0, -1.5);
+  return ball;
+}
+
 // A plan file with q = 1e308 made the collision walk run for ever; it now stops at its query
 // bound and the plan is invalid, saying the rest was not checked.
 TEST(Validate, APathTooLongToWalkIsInvalidNotEndless) {
   Fixture f;
-  collision::Obstacle ball;
-  ball.id = 0;
-  ball.shape = collision::Shape::sphere(0.05);
-  ball.pose.translation() = Eigen::Vector3d(0, 0, -1.5);  // out of reach, below the base
-  f.problem.obstacles.push_back(ball);
+  f.problem.obstacles.push_back(ball_out_of_reach(0));
   ASSERT_TRUE(validate(f.problem, f.plan).valid);
   f.plan.q(5, 0) = 1e308;
   const Validation v = validate(f.problem, f.plan);
@@ -92,11 +97,7 @@ TEST(Validate, TheSameVerdictWithAndWithoutThePoolsHelp) {
 // first sample below the clearance.
 TEST(Validate, TheVerdictAloneIsTheFullVerdict) {
   Fixture f;
-  collision::Obstacle ball;
-  ball.id = 4;
-  ball.shape = collision::Shape::sphere(0.05);
-  ball.pose.translation() = Eigen::Vector3d(0, 0, -1.5);  // out of reach, below the base
-  f.problem.obstacles.push_back(ball);
+  f.problem.obstacles.push_back(ball_out_of_reach(4));
   const Validation clear = validate(f.problem, f.plan);
   ASSERT_TRUE(clear.valid) << all_failures(clear);
   testing::expect_same_validation(clear, validate(f.problem, f.plan, {}, true));
