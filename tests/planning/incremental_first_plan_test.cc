@@ -4,8 +4,10 @@
 
 #include <string>
 
+#include "bench/common/iiwa_goals.h"
 #include "kinograph/dynamics/kinematics.h"
 #include "kinograph/planning/batch/batch_planner.h"
+#include "kinograph/planning/goal_sampler.h"
 #include "kinograph/planning/incremental/first_plan.h"
 #include "kinograph/planning/incremental/incremental_planner.h"
 #include "kinograph/planning/io/scene.h"
@@ -89,6 +91,43 @@ TEST(IncrementalFirstPlan, SettledPlanIsAtLeastAsGood) {
     EXPECT_LT(max_abs(first.q - batch.q), 2e-2);
     EXPECT_GE(first.stats.iterations, batch.stats.iterations);
   }
+}
+
+// A batch plan that does not validate is the answer as it is, with the tree at it: no settling
+// updates and no second solve on the incremental graph (neither makes such a plan valid where
+// the batch planner's own attempts failed).
+TEST(IncrementalFirstPlan, AnInvalidBatchPlanIsAnsweredAsItIs) {
+  IncrementalPlannerOptions options;
+  const Problem p = testing::weak_elbow_acrobot(options.batch);
+  const Plan batch = BatchPlanner(options.batch).plan(p);
+  ASSERT_FALSE(batch.success());
+  IncrementalPlanner planner(options);
+  const Plan first = planner.plan(p);
+  EXPECT_FALSE(first.success());
+  EXPECT_EQ(first.stats.status, batch.stats.status);
+  EXPECT_EQ(max_abs(first.q - batch.q), 0.0);
+  EXPECT_EQ(first.stats.iterations, batch.stats.iterations) << "no second solve";
+  EXPECT_EQ(planner.last_stats().updates, 0) << "not settled";
+  EXPECT_TRUE(planner.has_plan());
+}
+
+// A settle is a polish of at most kSettleUpdates updates. On this task-1 goal the batch plan is
+// valid but far above the tree's optimum (its cost some thousand times a typical one), and the
+// tree does not validate within them: the answer is the batch plan.
+TEST(IncrementalFirstPlan, ASettleThatDoesNotValidateSoonLeavesTheBatchPlan) {
+  const Scene scene = load_scene(kScenes + "iiwa_desk.yaml");
+  GoalSampler sampler(scene.problem, bench::iiwa_goal_options(1));
+  Problem p = scene.problem;
+  p.goal.q = sampler.sample(9)[8];
+  const Plan batch = BatchPlanner().plan(p);
+  ASSERT_TRUE(batch.success()) << failures(batch);
+  IncrementalPlanner planner;
+  const Plan first = planner.plan(p);
+  ASSERT_TRUE(first.success()) << failures(first);
+  EXPECT_EQ(planner.last_stats().updates, kSettleUpdates) << "the settle used its budget";
+  EXPECT_EQ(max_abs(first.q - batch.q), 0.0);
+  EXPECT_EQ(first.stats.cost, batch.stats.cost);
+  EXPECT_EQ(max_abs(planner.current_plan().q - batch.q), 0.0);
 }
 
 // The carried graph replans like one built from scratch: a goal change around the ball.

@@ -854,23 +854,11 @@ TEST(OuterLoopOptions, DampingCarry) {
   EXPECT_LT(carried.stats.iterations, restarted.stats.iterations);
 }
 
-// The Acrobot with an elbow far too weak to swing it up, and options for one attempt at it
-// (no restarts, no continuation in the effort limits).
-Problem weak_elbow_acrobot(BatchPlannerOptions& o) {
-  Problem p = load_scene(kScenes + "acrobot_swingup.yaml").problem;
-  auto weak = std::make_shared<dynamics::Model>(*p.model);
-  weak->bodies[1].limits.effort = 0.2;
-  p.model = weak;
-  o.max_restarts = 0;
-  o.effort_continuation.clear();
-  return p;
-}
-
 // At the largest penalty the weak elbow's violation stops shrinking, and the loop gives up
 // after max_stalled_updates such updates instead of running to max_outer_iterations.
 TEST(OuterLoopOptions, MaxStalledUpdates) {
   BatchPlannerOptions o;
-  const Problem p = weak_elbow_acrobot(o);
+  const Problem p = testing::weak_elbow_acrobot(o);
   const Plan stalled = BatchPlanner(o).plan(p);
   o.outer_loop.max_stalled_updates = 0;
   const Plan ran_on = BatchPlanner(o).plan(p);
@@ -886,7 +874,7 @@ TEST(OuterLoopOptions, MaxStalledUpdates) {
 // warm-up and the rows on the interpolant, which stall too. Both report the failure.
 TEST(BatchPlannerOptions, AbandonViolation) {
   BatchPlannerOptions o;
-  const Problem p = weak_elbow_acrobot(o);
+  const Problem p = testing::weak_elbow_acrobot(o);
   o.abandon_violation = 1;
   const Plan abandoned = BatchPlanner(o).plan(p);
   o.abandon_violation = 0;

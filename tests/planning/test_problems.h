@@ -10,6 +10,7 @@
 #include "kinograph/dynamics/inverse_dynamics.h"
 #include "kinograph/dynamics/kinematics.h"
 #include "kinograph/dynamics/payload.h"
+#include "kinograph/planning/batch/batch_planner.h"
 #include "kinograph/planning/io/scene.h"
 #include "kinograph/planning/plan.h"
 #include "kinograph/planning/problem.h"
@@ -75,6 +76,19 @@ inline Problem acrobot_swingup() {
   p.start_q = Eigen::Vector2d(0, 0);
   p.start_qd = Eigen::Vector2d(0, 0);
   p.goal.q = Eigen::Vector2d(M_PI, 0);
+  return p;
+}
+
+/// The Acrobot with an elbow far too weak (±0.2 N·m) to swing it up, and options `o` set for
+/// one attempt at it (no restarts, no continuation in the effort limits).
+inline Problem weak_elbow_acrobot(BatchPlannerOptions& o) {
+  Problem p =
+      load_scene(std::string(KINOGRAPH_SOURCE_DIR) + "/robots/scenes/acrobot_swingup.yaml").problem;
+  auto weak = std::make_shared<dynamics::Model>(*p.model);
+  weak->bodies[1].limits.effort = 0.2;
+  p.model = weak;
+  o.max_restarts = 0;
+  o.effort_continuation.clear();
   return p;
 }
 

@@ -146,6 +146,8 @@ Plan IncrementalPlanner::plan(const Problem& problem, const Plan* warm) {
     stats_.penalty = tree_->constraints.penalty();
     p.stats.solve_time_s = seconds_since(t0);
     plan_ = p;
+    spdlog::debug("iDFGP warm start on the incremental graph: {}, {:.1f} ms",
+                  p.success() ? "valid" : "not valid", p.stats.solve_time_s * 1e3);
     if (!p.success()) {
       if (std::optional<Plan> batch = carried_batch_plan(problem, warm)) {
         add_counts(batch->stats, p.stats);
@@ -164,14 +166,16 @@ Plan IncrementalPlanner::plan(const Problem& problem, const Plan* warm) {
     return batch;
   }
   tree_.reset();
+  // A batch plan that does not validate is carried as it is: where the batch planner's own
+  // attempts all failed, neither settling it nor a re-solve on the incremental graph makes it
+  // valid; they would only add their time to the failure.
   std::optional<Plan> carried = carry_first_plan(problem, batch, solution);
-  if (carried && carried->success()) {
+  if (carried) {
     carried->stats.solve_time_s = seconds_since(t0);
     plan_ = *carried;
     return *carried;
   }
-  // Not carried, or neither the batch plan nor its settled tree validates: the outer loop on
-  // the incremental graph sometimes still reaches a valid plan.
+  // Not carried: the outer loop on the incremental graph builds the tree.
   Plan p;
   try {
     tree_ = solve_incremental_graph(problem, anchored(problem, batch.q, batch.qd, batch.qdd),
@@ -183,7 +187,7 @@ Plan IncrementalPlanner::plan(const Problem& problem, const Plan* warm) {
   stats_ = IncrementalStats();
   stats_.method = "batch-L";
   plan_ = p;
-  settle(p, /*first_plan=*/false);
+  if (p.success()) settle(p, /*first_plan=*/false);
   stats_.method = p.stats.method;
   if (!p.success() && batch.success()) {
     const SolveStats own = p.stats;
@@ -231,22 +235,23 @@ std::optional<Plan> IncrementalPlanner::carry_first_plan(const Problem& problem,
   stats_.penalty = tree_->constraints.penalty();
   plan_ = batch;
   Plan p = batch;
-  if (!batch.success() || options_.settle_first_plan) settle(p, /*first_plan=*/true);
+  if (batch.success() && options_.settle_first_plan) settle(p, /*first_plan=*/true);
   stats_.method = batch.stats.method;
   return p;
 }
 
 void IncrementalPlanner::settle(Plan& plan, bool first_plan) {
   const IncrementalTree::Snapshot before = tree_->snapshot();
-  const Plan settled = replan(ProblemChange());
-  // A carried first plan is replaced by a valid settled plan that costs no more (or by any
-  // valid one when it failed); a re-solved one by a valid settled plan or when it failed.
-  const bool take = first_plan ? settled.success() &&
-                                     (!plan.success() || settled.stats.cost <= plan.stats.cost)
-                               : settled.success() || !plan.success();
+  const Plan settled = replan_within(ProblemChange(), kSettleUpdates);
+  spdlog::debug("iDFGP settle: {} updates, {} rounds, {:.1f} ms, {}, cost {:.6g} (answered {:.6g})",
+                stats_.updates, stats_.rounds, stats_.incremental_time_s * 1e3,
+                settled.success() ? "valid" : "not valid", settled.stats.cost, plan.stats.cost);
+  // A carried first plan is replaced by a valid settled plan that costs no more; a re-solved
+  // one by any valid settled plan.
+  const bool take = settled.success() && (!first_plan || settled.stats.cost <= plan.stats.cost);
   // A settled tree that validates is kept even when its plan costs a little more (the next
   // replan starts at its optimum); one that does not returns to the answered plan.
-  if (!settled.success() && (first_plan || plan.success())) {
+  if (!settled.success()) {
     spdlog::debug("iDFGP: the settled tree does not validate; rebuilt at the answered plan");
     if (!tree_->restore(before)) {
       spdlog::warn("incremental planner: the Bayes tree could not be rebuilt at the plan");
@@ -261,6 +266,10 @@ void IncrementalPlanner::settle(Plan& plan, bool first_plan) {
 }
 
 Plan IncrementalPlanner::replan(const ProblemChange& change) {
+  return replan_within(change, options_.max_updates);
+}
+
+Plan IncrementalPlanner::replan_within(const ProblemChange& change, int max_updates) {
   const auto t0 = Clock::now();
   stats_ = IncrementalStats();  // a refused change must not report the previous replan's figures
   stats_.method = "incremental";
@@ -277,14 +286,14 @@ Plan IncrementalPlanner::replan(const ProblemChange& change) {
     return failed_plan("incremental", PlanStatus::kInvalidProblem, e.what());
   }
   problem_ = next;
-  return answer_replan(t0);
+  return answer_replan(t0, max_updates);
 }
 
-Plan IncrementalPlanner::answer_replan(Clock::time_point t0) {
+Plan IncrementalPlanner::answer_replan(Clock::time_point t0, int max_updates) {
   tree_->compact_if_sparse();
   PlanStatus status = PlanStatus::kMaxUpdates;
   std::string reason;
-  std::optional<Plan> valid_plan = run_updates(plan_.stats.cost, status, reason);
+  std::optional<Plan> valid_plan = run_updates(plan_.stats.cost, max_updates, status, reason);
   stats_.penalty = tree_->constraints.penalty();
   stats_.incremental_time_s = seconds_since(t0);
   Plan plan = valid_plan ? std::move(*valid_plan) : make_plan();
@@ -472,7 +481,7 @@ Plan IncrementalPlanner::shift(const Problem& next, int m) {
   t.replace(std::move(keep), std::move(added), removed_slots);
   retired_steps_ += static_cast<uint32_t>(m) + 1;
   problem_ = next;
-  return answer_replan(t0);
+  return answer_replan(t0, options_.max_updates);
 }
 
 void IncrementalPlanner::replace_factors(const ProblemChange& change, const Problem& next,
@@ -534,8 +543,8 @@ void IncrementalPlanner::replace_factors(const ProblemChange& change, const Prob
   t.replace(std::move(keep), std::move(added), removed_slots);
 }
 
-std::optional<Plan> IncrementalPlanner::run_updates(double previous_cost, PlanStatus& status,
-                                                    std::string& reason) {
+std::optional<Plan> IncrementalPlanner::run_updates(double previous_cost, int max_updates,
+                                                    PlanStatus& status, std::string& reason) {
   IncrementalTree& t = *tree_;
   const AugmentedLagrangianOptions& alo = options_.batch.augmented_lagrangian;
   StoppingRule rule(options_.batch.outer_loop.constraint_tolerance, previous_cost,
@@ -544,7 +553,7 @@ std::optional<Plan> IncrementalPlanner::run_updates(double previous_cost, PlanSt
   t.last_violation = -1;
   std::vector<double> violations;
   std::optional<Plan> answer;
-  while (stats_.updates < options_.max_updates) {
+  while (stats_.updates < max_updates) {
     // Every update relinearizes every moved variable: with the threshold alone a damped step
     // pulls the others back toward their linearization point, against the stiff start prior.
     const graph::ISAM2Result r = t.update(/*force_relinearize=*/true, stats_);
@@ -590,7 +599,7 @@ std::optional<Plan> IncrementalPlanner::run_updates(double previous_cost, PlanSt
     const StoppingRule::Next next = rule.after_settling(worst);
     if (next == StoppingRule::Next::kSettleObjective) continue;
     if (next == StoppingRule::Next::kPolish) {
-      if (stats_.updates >= options_.max_updates) {
+      if (stats_.updates >= max_updates) {
         status = PlanStatus::kConverged;
         break;
       }

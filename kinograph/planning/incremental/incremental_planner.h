@@ -52,10 +52,17 @@ struct IncrementalPlannerOptions {
   /// After the first plan, one replan of the unchanged problem settles the tree at its own
   /// optimum (the batch plan stops short of it), so that later replans do not depend on where
   /// the batch solve stopped; answered when it validates and costs no more than the batch plan.
+  /// It is a polish of a few updates (kSettleUpdates): a tree that does not validate by then is
+  /// not near its optimum and returns to the batch plan.
   bool settle_first_plan = true;
 };
 
 struct IncrementalTree;
+
+/// ISAM2 updates a settle (IncrementalPlannerOptions::settle_first_plan) may take: from a
+/// converged batch plan the first update already validates; a tree that needs more is far from
+/// its optimum and is left at the batch plan rather than spend a replan's budget on it.
+inline constexpr int kSettleUpdates = 3;
 
 /// Plans once (batch) and then replans incrementally as the problem changes. Single-threaded;
 /// keep one per robot.
@@ -67,7 +74,8 @@ class IncrementalPlanner {
   IncrementalPlanner& operator=(const IncrementalPlanner&) = delete;
 
   /// Plans `problem` with BatchPlanner (straight line, detours) and builds the Bayes tree at its
-  /// plan from its final graph and multipliers (then settles it, settle_first_plan). With `warm`
+  /// plan from its final graph and multipliers (then settles a valid one, settle_first_plan; one
+  /// that does not validate is answered as it is, the tree at it). With `warm`
   /// the outer loop runs on the incremental graph from the warm start instead, and when that
   /// does not validate the batch planner's warm start (with its restarts) is carried as above.
   /// Problems that cannot be planned come back with status "invalid_problem" (and no state is
@@ -122,17 +130,21 @@ class IncrementalPlanner {
   /// The first plan carried from a batch solve (null: it could not be carried).
   std::optional<Plan> carry_first_plan(const Problem& problem, const Plan& batch,
                                        BatchSolution& solution);
-  /// One replan of the unchanged problem after a first plan `plan`: its plan answers when it
-  /// validates and (if `plan` validates) costs no more; a settled tree that does not validate
-  /// returns to where it was.
+  /// One replan of the unchanged problem after a valid first plan `plan`: its plan answers
+  /// when it validates and (for a carried batch plan) costs no more; a settled tree that does
+  /// not validate returns to where it was.
   void settle(Plan& plan, bool first_plan);
   /// Replaces the factors `change` affects (next: the changed problem).
   void replace_factors(const ProblemChange& change, const Problem& next,
                        const std::set<int>& changed_obstacles);
-  /// Runs the updates of a replan whose factors are queued and answers it (started at `t0`).
-  Plan answer_replan(std::chrono::steady_clock::time_point t0);
-  /// ISAM2 updates and multiplier rounds until the stopping rule holds.
-  std::optional<Plan> run_updates(double previous_cost, PlanStatus& status, std::string& reason);
+  /// replan() with at most `max_updates` ISAM2 updates.
+  Plan replan_within(const ProblemChange& change, int max_updates);
+  /// Runs the updates of a replan whose factors are queued (at most `max_updates`) and answers
+  /// it (started at `t0`).
+  Plan answer_replan(std::chrono::steady_clock::time_point t0, int max_updates);
+  /// ISAM2 updates and multiplier rounds until the stopping rule holds, at most `max_updates`.
+  std::optional<Plan> run_updates(double previous_cost, int max_updates, PlanStatus& status,
+                                  std::string& reason);
   /// A multiplier round at the tree's estimate; returns the number of factors re-added.
   int multiplier_round(const std::vector<double>& violations, bool grow,
                        const class StoppingRule& rule);
