@@ -90,12 +90,15 @@ struct Row {
   int problems = 0, first_failed = 0, no_change = 0;
   std::vector<double> first_cost;  // per first plan: its soft cost, NaN where it failed
   std::vector<double> prepare;     // per first plan: Replanner::prepare's wall time [s]
+  std::vector<double> first_s;     // per first plan: its wall time [s], failed ones included
 };
 
 json row_json(const Row& r) {
   return {{"problems", r.problems},
           {"first_plan_failed", r.first_failed},
           {"first_plan_objective_all", r.first_cost},
+          {"first_plan_s_all", r.first_s},
+          {"first_plan_s_median", median(r.first_s)},
           {"prepare_s_median", median(r.prepare)},
           {"no_nearby_change", r.no_change},
           {"DFGP-L", r.L.to_json()},
@@ -106,7 +109,10 @@ json row_json(const Row& r) {
 // Plans `problem` as the first plan of a row's problem; empty (and counted) when it fails.
 std::optional<Plan> first_plan(Row& row, planning::Replanner& planner, const Problem& problem) {
   ++row.problems;
+  const auto t0 = std::chrono::steady_clock::now();
   Plan first = planner.plan(problem, /*new_goal=*/true);
+  row.first_s.push_back(
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   row.first_cost.push_back(first.success() ? first.stats.cost : std::nan(""));
   if (!first.success()) {
     ++row.first_failed;
