@@ -112,8 +112,8 @@ TEST(IncrementalFirstPlan, AnInvalidBatchPlanIsAnsweredAsItIs) {
 }
 
 // A settle is a polish of at most kSettleUpdates updates. On this task-1 goal the batch plan is
-// valid but far above the tree's optimum (its cost some thousand times a typical one), and the
-// tree does not validate within them: the answer is the batch plan.
+// valid but far from the tree's optimum, and the tree does not validate within them: the
+// answer is the batch plan.
 TEST(IncrementalFirstPlan, ASettleThatDoesNotValidateSoonLeavesTheBatchPlan) {
   const Scene scene = load_scene(kScenes + "iiwa_desk.yaml");
   GoalSampler sampler(scene.problem, bench::iiwa_goal_options(1));
