@@ -13,6 +13,30 @@ constexpr PlanStatus kAll[] = {PlanStatus::kConverged,      PlanStatus::kInfeasi
                                PlanStatus::kFailed};
 }  // namespace
 
+SolveTimes& SolveTimes::operator+=(const SolveTimes& other) {
+  initialization_s += other.initialization_s;
+  graph_building_s += other.graph_building_s;
+  linearization_s += other.linearization_s;
+  factorization_s += other.factorization_s;
+  triangular_solve_s += other.triangular_solve_s;
+  multipliers_s += other.multipliers_s;
+  between_knot_checks_s += other.between_knot_checks_s;
+  validation_s += other.validation_s;
+  return *this;
+}
+
+double SolveTimes::total_s() const {
+  return initialization_s + graph_building_s + linearization_s + factorization_s +
+         triangular_solve_s + multipliers_s + between_knot_checks_s + validation_s;
+}
+
+void add_work(SolveStats& into, const SolveStats& from) {
+  into.iterations += from.iterations;
+  into.outer_iterations += from.outer_iterations;
+  into.linear_solves += from.linear_solves;
+  into.times += from.times;
+}
+
 std::string to_string(PlanStatus status) {
   switch (status) {
     case PlanStatus::kConverged: return "converged";

@@ -29,6 +29,26 @@ std::string to_string(PlanStatus status);
 PlanStatus plan_status_from_string(const std::string& name);
 std::ostream& operator<<(std::ostream& os, PlanStatus status);
 
+/// Where the wall time of a plan's batch solves went, in seconds summed over every attempt. The
+/// rest of SolveStats::solve_time_s is bookkeeping, the set-up of effort continuation and, for
+/// an incremental update, all of its Bayes-tree work and checks. A part not run stays 0.
+struct SolveTimes {
+  /// Initial trajectories: the straight line or warm start, detours, the path search.
+  double initialization_s = 0;
+  double graph_building_s = 0;    ///< building the planning graphs
+  double linearization_s = 0;     ///< residuals, Jacobians and normal equations of LM solves
+  double factorization_s = 0;     ///< symbolic analysis and numeric Cholesky of LM solves
+  double triangular_solve_s = 0;  ///< triangular solves of LM solves
+  double multipliers_s = 0;       ///< augmented-Lagrangian multiplier updates
+  /// Checks of the interpolant between the knots that choose the rows of the next solve.
+  double between_knot_checks_s = 0;
+  double validation_s = 0;  ///< validate() on the plan each batch solve ended with
+
+  SolveTimes& operator+=(const SolveTimes& other);
+  /// The sum of the parts.
+  double total_s() const;
+};
+
 /// How a plan was solved.
 struct SolveStats {
   std::string method;        ///< "batch-L", "batch-W", "incremental"
@@ -41,7 +61,11 @@ struct SolveStats {
   double solve_time_s = 0;   ///< wall time of the whole plan() call
   double cost = 0;           ///< final soft cost ½Σ‖r‖² (without constraint terms)
   double max_constraint_violation = 0;  ///< largest must-hold residual at the end
+  SolveTimes times;                     ///< where solve_time_s went
 };
+
+/// Adds the work of `from` (iterations, outer iterations, linear solves and times) to `into`.
+void add_work(SolveStats& into, const SolveStats& from);
 
 /// The checks of validate(), figure by figure; failures lists one line per failed check.
 struct Validation {

@@ -164,6 +164,36 @@ TEST(BatchPlanner, IiwaCarriesTheBlockPastTheBox) {
               plan.validation.max_tau_violation);
 }
 
+// Every part of the time breakdown was measured within the plan call, so the parts are
+// non-negative and sum to at most its wall time; the parts every plan runs are positive.
+void expect_times_account_for(const Plan& plan) {
+  const SolveTimes& t = plan.stats.times;
+  for (double part :
+       {t.initialization_s, t.graph_building_s, t.linearization_s, t.factorization_s,
+        t.triangular_solve_s, t.multipliers_s, t.between_knot_checks_s, t.validation_s}) {
+    EXPECT_GE(part, 0);
+  }
+  EXPECT_GT(t.graph_building_s, 0);
+  EXPECT_GT(t.linearization_s, 0);
+  EXPECT_GT(t.factorization_s, 0);
+  EXPECT_GT(t.triangular_solve_s, 0);
+  EXPECT_GT(t.validation_s, 0);
+  EXPECT_LE(t.total_s(), plan.stats.solve_time_s);
+}
+
+TEST(BatchPlanner, TimesAccountForThePlan) {
+  // The RR reach ranks detours around its ball (initialization); the Acrobot's solves check the
+  // interpolant between the knots before its rows join the graph.
+  const Plan rr = BatchPlanner().plan(rr_reach());
+  ASSERT_TRUE(rr.success()) << rr.stats.reason;
+  expect_times_account_for(rr);
+  EXPECT_GT(rr.stats.times.initialization_s, 0);
+  const Plan acrobot = BatchPlanner().plan(acrobot_swingup());
+  ASSERT_TRUE(acrobot.success()) << acrobot.stats.reason;
+  expect_times_account_for(acrobot);
+  EXPECT_GT(acrobot.stats.times.between_knot_checks_s, 0);
+}
+
 TEST(BatchPlanner, LimitRowsTheSolveAlreadyKeepsAreNotReSolved) {
   // The desk task's knot-only solve comes within 10 % of a limit between some knots but keeps
   // every limit there: the rows added for those intervals change nothing, so the plan is the

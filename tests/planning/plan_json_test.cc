@@ -45,6 +45,7 @@ Plan random_plan(const Problem& problem, unsigned seed) {
   plan.stats.solve_time_s = 0.125;
   plan.stats.cost = 3.5;
   plan.stats.max_constraint_violation = 1.5e-5;
+  plan.stats.times = {0.001, 0.002, 0.05, 0.025, 0.003, 0.004, 0.006, 0.007};
   Validation& v = plan.validation;
   v.valid = false;
   v.failures = {"dynamics residual 0.1 exceeds 0.001", "goal error 0.2 exceeds 0.01"};
@@ -80,6 +81,15 @@ void expect_same_plan(const Plan& a, const Plan& b) {
   EXPECT_EQ(a.stats.solve_time_s, b.stats.solve_time_s);
   EXPECT_EQ(a.stats.cost, b.stats.cost);
   EXPECT_EQ(a.stats.max_constraint_violation, b.stats.max_constraint_violation);
+  const SolveTimes &x = a.stats.times, &y = b.stats.times;
+  EXPECT_EQ(x.initialization_s, y.initialization_s);
+  EXPECT_EQ(x.graph_building_s, y.graph_building_s);
+  EXPECT_EQ(x.linearization_s, y.linearization_s);
+  EXPECT_EQ(x.factorization_s, y.factorization_s);
+  EXPECT_EQ(x.triangular_solve_s, y.triangular_solve_s);
+  EXPECT_EQ(x.multipliers_s, y.multipliers_s);
+  EXPECT_EQ(x.between_knot_checks_s, y.between_knot_checks_s);
+  EXPECT_EQ(x.validation_s, y.validation_s);
   testing::expect_same_validation(a.validation, b.validation);
 }
 
@@ -218,6 +228,12 @@ TEST(PlanJson, ErrorsNameTheKey) {
       std::string::npos);
   EXPECT_NE(broken([](json& j) { j["q"][0][0] = "x"; }).find("p.json"), std::string::npos);
   EXPECT_NE(broken([](json& j) { j["stats"]["status"] = "fine"; }).find("stats.status"),
+            std::string::npos);
+  EXPECT_NE(broken([](json& j) { j["stats"]["times"] = 3; }).find("stats.times"),
+            std::string::npos);
+  EXPECT_NE(broken([](json& j) {
+              j["stats"]["times"]["validation_s"] = "slow";
+            }).find("stats.times.validation_s"),
             std::string::npos);
   EXPECT_THROW(read_plan("/no/such/plan.json", model), PlanFileError);
 }

@@ -8,6 +8,7 @@
 #include <optional>
 #include <sstream>
 
+#include "kinograph/graph/stopwatch.h"
 #include "kinograph/planning/batch/grid_refinement.h"
 #include "kinograph/planning/batch/interval_limits.h"
 #include "kinograph/planning/formulation/initialization.h"
@@ -28,7 +29,11 @@ Plan solved_plan(const Problem& problem, const PlanningGraph& pg, const OuterLoo
   plan.stats.linear_solves = r.linear_solves;
   plan.stats.max_constraint_violation = r.worst.violation;
   plan.stats.cost = soft_cost(pg.entries, pg.values);
+  plan.stats.times = r.times;
+  const auto t0 = std::chrono::steady_clock::now();
   plan.validation = validate(problem, plan, options.validation);
+  plan.stats.times.validation_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return plan;
 }
 
@@ -57,12 +62,9 @@ std::optional<Trajectory> searched_path(const Problem& problem, const Eigen::Vec
   return path_trajectory(problem, *path);
 }
 
-// Adds the work counts of `from` (LM iterations, outer iterations, linear solves, attempts)
-// to `into`.
+// Adds the work of `from` (add_work) and its attempts to `into`.
 void add_counts(SolveStats& into, const SolveStats& from) {
-  into.iterations += from.iterations;
-  into.outer_iterations += from.outer_iterations;
-  into.linear_solves += from.linear_solves;
+  add_work(into, from);
   into.attempts += from.attempts;
 }
 
@@ -88,7 +90,9 @@ Plan BatchPlanner::plan(const Problem& problem, const Plan* warm, BatchSolution*
   }
   Trajectory init;
   Eigen::VectorXd q_goal;
+  double initialization_s = 0;  // this call's own, outside the attempts' solves
   try {
+    const graph::ScopedTimer timer(initialization_s);
     if (warm != nullptr) {
       init = warm_start(problem, *warm);
     } else {
@@ -114,6 +118,7 @@ Plan BatchPlanner::plan(const Problem& problem, const Plan* warm, BatchSolution*
   // first.
   auto add_restarts = [&](bool detour_goes_first, size_t tried) {
     if (detours_added || !may_detour) return false;
+    const graph::ScopedTimer timer(initialization_s);
     detours_added = true;
     const int detours = options_.max_restarts - (may_search ? 1 : 0);
     const std::vector<Detour> vias = detour_candidates(problem, q_goal, options_.detour, detours);
@@ -126,10 +131,13 @@ Plan BatchPlanner::plan(const Problem& problem, const Plan* warm, BatchSolution*
     if (may_search) inits.insert(inits.begin() + tried + (swapped ? 1 : 0), std::nullopt);
     return swapped;
   };
-  if (may_detour && options_.detour_first &&
-      segment_clearance(problem, problem.start_q, q_goal, 2 * options_.detour.samples) < 0) {
-    add_restarts(true, 0);
+  bool straight_line_collides = false;
+  if (may_detour && options_.detour_first) {
+    const graph::ScopedTimer timer(initialization_s);
+    straight_line_collides =
+        segment_clearance(problem, problem.start_q, q_goal, 2 * options_.detour.samples) < 0;
   }
+  if (straight_line_collides) add_restarts(true, 0);
   Plan best;
   SolveStats total;
   BatchSolution attempt;
@@ -163,7 +171,10 @@ Plan BatchPlanner::plan(const Problem& problem, const Plan* warm, BatchSolution*
     if (p) consider(std::move(*p));
   }
   for (size_t a = 0; a < inits.size() && !best.success(); ++a) {
-    if (!inits[a]) inits[a] = searched_path(problem, q_goal, options_.path_search);
+    if (!inits[a]) {
+      const graph::ScopedTimer timer(initialization_s);
+      inits[a] = searched_path(problem, q_goal, options_.path_search);
+    }
     if (!inits[a]) continue;  // no path found: on to the next initialization
     consider(solve(problem, *inits[a], method, solution != nullptr ? &attempt : nullptr));
     if (best.success() || best.stats.status == PlanStatus::kInvalidProblem) break;
@@ -181,6 +192,7 @@ Plan BatchPlanner::plan(const Problem& problem, const Plan* warm, BatchSolution*
   best.stats.reason = own.reason;
   best.stats.cost = own.cost;
   best.stats.max_constraint_violation = own.max_constraint_violation;
+  best.stats.times.initialization_s += initialization_s;
   best.stats.solve_time_s = elapsed();
   return best;
 }
@@ -249,6 +261,7 @@ Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init, const s
   PlanningGraph pg;
   ConstraintState state;
   OuterLoopResult r;
+  SolveTimes own;  // the parts outside the outer loops: graphs and checks between the knots
   const double warmup_step = options_.warmup_integration_step;
   bool warmup = shooting && warmup_step > 0 &&
                 integration_steps(problem.dt(), warmup_step) <
@@ -256,6 +269,7 @@ Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init, const s
   if (from_interpolant) {  // no knot-only solve to leave the interpolant and come back to it
     between.knots_only = false;
     warmup = false;
+    const graph::ScopedTimer timer(own.between_knot_checks_s);
     between.limits =
         intervals_near_limits(problem, plan_from_trajectory(problem, init), kNearLimit);
   }
@@ -266,6 +280,7 @@ Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init, const s
     PlanningGraph next;
     std::vector<DfgConstraintStep> dfg_steps;
     try {
+      const graph::ScopedTimer timer(own.graph_building_s);
       next = build_graph(problem, init, options_.graph, GraphForm::kBatch, between);
       if (options_.formulation == Formulation::kDynamicFactorGraph) {
         dfg_steps = use_dfg_dynamics(next, problem, options_.graph, options_.dfg);
@@ -285,7 +300,9 @@ Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init, const s
     // A converged warm-up that already holds the interpolant's rows is kept too: its objective
     // is that of a graph differing only in the RK4 step, and every row of this one holds.
     if (after_converged) {
+      const auto t_check = std::chrono::steady_clock::now();
       const ConstraintReport worst = worst_constraint(pg.constraints(false), pg.values);
+      own.between_knot_checks_s += graph::seconds_since(t_check);
       if (worst.scaled_violation <= loop.constraint_tolerance) {
         // The new rows' multipliers start at zero, as a solve would start them.
         for (const FactorEntry* e : pg.constraints(false)) state.bind(*e);
@@ -309,10 +326,12 @@ Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init, const s
     const OuterLoopResult stage = solve_outer_loop(pg.graph, pg.values, al, loop, problem.name);
     const int before = r.iterations, before_outer = r.outer_iterations,
               before_solves = r.linear_solves;
+    const SolveTimes before_times = r.times;
     r = stage;
     r.iterations += before;
     r.outer_iterations += before_outer;
     r.linear_solves += before_solves;
+    r.times += before_times;
     spdlog::debug(
         "{}: interval round {}{}: {} LM iterations, {}; {} of {} intervals with limit points",
         problem.name, round, between.integration_step != kMaxIntegrationStep ? " (warm-up)" : "",
@@ -335,10 +354,12 @@ Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init, const s
                             r.iterations >= options_.outer_loop.max_total_iterations))) {
       break;
     }
+    const auto t_check = std::chrono::steady_clock::now();
     const bool added = add_flags(
         between.limits,
         intervals_near_limits(problem, plan_from_values(problem, pg.values, options_.dfg.keys),
                               kNearLimit));
+    own.between_knot_checks_s += graph::seconds_since(t_check);
     if (between.knots_only && shooting) {
       between.knots_only = false;
       if (warmup) between.integration_step = warmup_step;
@@ -356,6 +377,7 @@ Plan BatchPlanner::solve(const Problem& problem, const Trajectory& init, const s
   if (r.status == PlanStatus::kInfeasible) r.reason = infeasible_reason(problem, r);
 
   Plan plan = solved_plan(problem, pg, r, method, options_);
+  plan.stats.times += own;
   plan.stats.solve_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (solution != nullptr) {
@@ -376,16 +398,12 @@ Plan BatchPlanner::solve_by_effort_continuation(const Problem& problem,
     Plan p = solve(stage, last ? warm_start(stage, *last) : straight_line(stage, q_goal), method);
     spdlog::debug("plan {}: effort x{}: {}", problem.name, scale,
                   p.success() ? std::string("valid") : to_string(p.stats.status));
-    stages.iterations += p.stats.iterations;
-    stages.outer_iterations += p.stats.outer_iterations;
-    stages.linear_solves += p.stats.linear_solves;
+    add_work(stages, p.stats);
     if (p.success()) last = std::move(p);
   }
   Plan plan = solve(problem, last ? warm_start(problem, *last) : straight_line(problem, q_goal),
                     method, solution);
-  plan.stats.iterations += stages.iterations;
-  plan.stats.outer_iterations += stages.outer_iterations;
-  plan.stats.linear_solves += stages.linear_solves;
+  add_work(plan.stats, stages);
   return plan;
 }
 

@@ -75,12 +75,6 @@ Trajectory anchored(const Problem& problem, const Eigen::MatrixXd& q, const Eige
 
 bool tracked(const FactorEntry& e) { return e.constrained && e.constrained->has_constraints(); }
 
-void add_counts(SolveStats& to, const SolveStats& from) {
-  to.iterations += from.iterations;
-  to.outer_iterations += from.outer_iterations;
-  to.linear_solves += from.linear_solves;
-}
-
 }  // namespace
 
 graph::ISAM2Options default_incremental_isam2() {
@@ -150,7 +144,7 @@ Plan IncrementalPlanner::plan(const Problem& problem, const Plan* warm) {
                   p.success() ? "valid" : "not valid", p.stats.solve_time_s * 1e3);
     if (!p.success()) {
       if (std::optional<Plan> batch = carried_batch_plan(problem, warm)) {
-        add_counts(batch->stats, p.stats);
+        add_work(batch->stats, p.stats);
         p = std::move(*batch);
       }
       p.stats.solve_time_s = seconds_since(t0);
@@ -197,8 +191,9 @@ Plan IncrementalPlanner::plan(const Problem& problem, const Plan* warm) {
     p.stats.iterations = own.iterations;
     p.stats.outer_iterations = own.outer_iterations;
     p.stats.linear_solves = own.linear_solves;
+    p.stats.times = own.times;
   }
-  add_counts(p.stats, batch.stats);
+  add_work(p.stats, batch.stats);
   p.stats.solve_time_s = seconds_since(t0);
   plan_ = p;
   return p;
@@ -261,7 +256,7 @@ void IncrementalPlanner::settle(Plan& plan, bool first_plan) {
     const SolveStats own = plan.stats;
     plan = settled;
     plan.stats.method = own.method;
-    add_counts(plan.stats, own);
+    add_work(plan.stats, own);
   }
 }
 

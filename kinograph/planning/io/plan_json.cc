@@ -242,9 +242,24 @@ std::array<std::pair<const char*, double*>, 15> validation_figures(Validation& v
            {"final_velocity", &v.final_velocity}}};
 }
 
+// SolveTimes' parts by their names in plan files.
+std::vector<std::pair<const char*, double*>> time_parts(SolveTimes& t) {
+  return {{"initialization_s", &t.initialization_s},
+          {"graph_building_s", &t.graph_building_s},
+          {"linearization_s", &t.linearization_s},
+          {"factorization_s", &t.factorization_s},
+          {"triangular_solve_s", &t.triangular_solve_s},
+          {"multipliers_s", &t.multipliers_s},
+          {"between_knot_checks_s", &t.between_knot_checks_s},
+          {"validation_s", &t.validation_s}};
+}
+
 }  // namespace
 
 json to_json(const SolveStats& s) {
+  SolveTimes times = s.times;
+  json parts = json::object();
+  for (const auto& [key, value] : time_parts(times)) parts[key] = number(*value);
   return {{"method", s.method},
           {"status", to_string(s.status)},
           {"reason", s.reason},
@@ -254,7 +269,8 @@ json to_json(const SolveStats& s) {
           {"attempts", s.attempts},
           {"solve_time_s", number(s.solve_time_s)},
           {"cost", number(s.cost)},
-          {"max_constraint_violation", number(s.max_constraint_violation)}};
+          {"max_constraint_violation", number(s.max_constraint_violation)},
+          {"times", parts}};
 }
 
 json to_json(const Validation& v) {
@@ -299,6 +315,14 @@ SolveStats stats_from_json(const json& j, const std::string& source) {
   real("solve_time_s", s.solve_time_s);
   real("cost", s.cost);
   real("max_constraint_violation", s.max_constraint_violation);
+  if (j.contains("times")) {
+    const json& t = j["times"];
+    if (!t.is_object()) fail(source, "stats.times", "must be an object");
+    for (const auto& [key, value] : time_parts(s.times)) {
+      if (t.contains(key))
+        *value = read_number(t[key], source, std::string("stats.times.") + key, 0);
+    }
+  }
   return s;
 }
 
@@ -362,7 +386,17 @@ std::string summarize(const Plan& plan) {
   os << "\n  iterations: " << s.iterations << " LM, " << s.outer_iterations << " outer, "
      << s.linear_solves << " linear solves, " << s.attempts << " attempt(s)\n";
   os.precision(4);
-  os << "  solve time: " << s.solve_time_s * 1e3 << " ms\n";
+  os << "  solve time: " << s.solve_time_s * 1e3 << " ms";
+  if (s.times.total_s() > 0) {
+    const SolveTimes& t = s.times;
+    os << "\n  time by part (ms): initialization " << t.initialization_s * 1e3 << ", graphs "
+       << t.graph_building_s * 1e3 << ", linearization " << t.linearization_s * 1e3
+       << ", factorization " << t.factorization_s * 1e3 << ", triangular solves "
+       << t.triangular_solve_s * 1e3 << ", multipliers " << t.multipliers_s * 1e3
+       << ", checks between knots " << t.between_knot_checks_s * 1e3 << ", validation "
+       << t.validation_s * 1e3 << ", the rest " << (s.solve_time_s - t.total_s()) * 1e3;
+  }
+  os << "\n";
   os << "  cost: " << s.cost << "\n";
   os << "  max constraint violation: " << s.max_constraint_violation << "\n";
   os << summarize(plan.validation);

@@ -107,6 +107,7 @@ struct OuterLoopResult {
   int outer_iterations = 0;
   int linear_solves = 0;
   ConstraintReport worst;  ///< at the end
+  SolveTimes times;        ///< the LM and multiplier parts (validation_s stays 0)
 };
 
 /// Runs LM on `graph` from `values` inside the augmented-Lagrangian outer loop until the
