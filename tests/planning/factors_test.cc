@@ -320,6 +320,46 @@ TEST(DynamicsStepFactor, JacobiansOnIiwaWithPayloadAndAcrobot) {
   }
 }
 
+TEST(DynamicsStepFactor, TorqueBoundsAloneLinearizeWhereverAHingeIsOn) {
+  std::mt19937 rng(5);
+  auto iiwa = std::make_shared<const dynamics::Model>(dynamics::attach_box_payload(
+      *load("robots/iiwa14/iiwa14.urdf"), "iiwa_link_ee_kuka", 2.0, {0.1, 0.1, 0.1},
+      Eigen::Isometry3d(Eigen::Translation3d(0, 0, 0.05))));
+  const graph::Values v = random_states(7, 0, rng);
+  auto ws = std::make_shared<DynamicsWorkspace>(iiwa);
+  dynamics::Data d(*iiwa);
+  const Eigen::VectorXd tau =
+      dynamics::rnea(*iiwa, d, v.at(q_key(0)), v.at(v_key(0)), v.at(a_key(0)));
+  Eigen::VectorXd r;
+  Eigen::MatrixXd J;
+  // Every torque within its bound and no multiplier: every hinge is off.
+  DynamicsStepOptions loose;
+  loose.limit_epsilon = 0;
+  DynamicsStepFactor clear(0, iiwa, ws, loose);
+  for (int j = 0; j < 7; ++j) ASSERT_LT(std::abs(tau[j]), iiwa->bodies[j].limits.effort);
+  bind(clear, 100);
+  clear.linearize(v, r, J);
+  EXPECT_EQ(r.cwiseAbs().maxCoeff(), 0);
+  EXPECT_EQ(J.cwiseAbs().maxCoeff(), 0);
+  // A multiplier pushing on one row inside its bound turns that hinge on.
+  Eigen::VectorXd upper = Eigen::VectorXd::Zero(7);
+  upper[1] = 1e7;  // λ/√μ far beyond √μ times the row's scaled distance to its bound
+  bind(clear, 100, Eigen::VectorXd::Zero(7), upper);
+  clear.linearize(v, r, J);
+  EXPECT_GT(J.row(1).cwiseAbs().maxCoeff(), 0);
+  auto c = check_jacobians(clear, v, {1e-6, 1e-5, false});
+  EXPECT_TRUE(c.ok) << c.report();
+  // Bounds tight enough that torques pass them: those rows need their Jacobian rows.
+  DynamicsStepOptions tight;
+  tight.limit_epsilon = iiwa->bodies[0].limits.effort - 1;
+  DynamicsStepFactor pressed(0, iiwa, ws, tight);
+  bind(pressed, 100);
+  pressed.linearize(v, r, J);
+  EXPECT_GT(J.cwiseAbs().maxCoeff(), 0);
+  c = check_jacobians(pressed, v, {1e-6, 1e-5, false});
+  EXPECT_TRUE(c.ok) << c.report();
+}
+
 TEST(PoseFactor, Jacobians) {
   std::mt19937 rng(4);
   auto model = load("robots/iiwa14/iiwa14.urdf");

@@ -1,5 +1,6 @@
 #include "kinograph/planning/factors/dynamics_factors.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -55,21 +56,30 @@ DynamicsStepFactor::DynamicsStepFactor(int k, std::shared_ptr<const dynamics::Mo
       model_(std::move(model)),
       data_(std::move(workspace)) {
   rows_for(*model_, options, &joint_of_row_);
+  bounds_only_ = std::all_of(rows().begin(), rows().end(),
+                             [](const RowSpec& r) { return r.kind == RowKind::kBounds; });
   cache_evaluations();
 }
 
 void DynamicsStepFactor::compute(const graph::FactorValues& x, Eigen::Ref<Eigen::VectorXd> z,
                                  const graph::Jacobians* J) const {
   dynamics::Data& d = data_->local();
-  if (J == nullptr) {
+  // Torque bounds alone, every hinge off: no Jacobian row is needed, and τ alone costs about a
+  // third of τ with its derivatives.
+  bool derivatives = J != nullptr;
+  if (!derivatives || bounds_only_) {
     dynamics::rnea(*model_, d, x[0], x[1], x[2]);
-  } else {
-    dynamics::rnea_derivatives(*model_, d, x[0], x[1], x[2]);
+    bool needed = false;
+    for (size_t i = 0; derivatives && !needed && i < joint_of_row_.size(); ++i) {
+      needed = jacobian_row_needed(static_cast<int>(i), d.tau[joint_of_row_[i]]);
+    }
+    derivatives = needed;
   }
+  if (derivatives) dynamics::rnea_derivatives(*model_, d, x[0], x[1], x[2]);
   for (size_t i = 0; i < joint_of_row_.size(); ++i) {
     const int j = joint_of_row_[i];
     z[static_cast<int>(i)] = d.tau[j];
-    if (J != nullptr) {
+    if (derivatives) {
       const int r = static_cast<int>(i);
       J->block(0).row(r) = d.dtau_dq.row(j);
       J->block(1).row(r) = d.dtau_dqd.row(j);

@@ -44,6 +44,7 @@ class DynamicsStepFactor final : public ConstrainedFactor {
   std::shared_ptr<const dynamics::Model> model_;
   std::shared_ptr<DynamicsWorkspace> data_;
   std::vector<int> joint_of_row_;
+  bool bounds_only_ = false;  // every row a torque bound (no equality, no minimum torque)
 };
 
 }  // namespace kinograph::planning
