@@ -5,8 +5,13 @@
 #include <btBulletCollisionCommon.h>
 
 #include <assimp/Importer.hpp>
+#include <atomic>
+#include <filesystem>
+#include <map>
+#include <mutex>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #ifndef BT_USE_DOUBLE_PRECISION
@@ -39,9 +44,13 @@ void collect_vertices(const aiScene* scene, const aiNode* node, const aiMatrix4x
   }
 }
 
+// The file a mesh Shape names.
+std::string mesh_file(const Shape& s) {
+  return s.mesh_path.rfind("file://", 0) == 0 ? s.mesh_path.substr(7) : s.mesh_path;
+}
+
 std::vector<Eigen::Vector3d> load_mesh_vertices(const Shape& s) {
-  std::string path = s.mesh_path;
-  if (path.rfind("file://", 0) == 0) path = path.substr(7);
+  const std::string path = mesh_file(s);
   Assimp::Importer importer;
   const aiScene* scene = importer.ReadFile(path, aiProcess_JoinIdenticalVertices);
   if (scene == nullptr || scene->mRootNode == nullptr) {
@@ -58,7 +67,74 @@ std::vector<Eigen::Vector3d> load_mesh_vertices(const Shape& s) {
   return vertices;
 }
 
+// A mesh's hull as the shapes made from it share it.
+struct MeshHull {
+  std::shared_ptr<const btConvexShape> shape;
+  Eigen::Vector3d bound_center = Eigen::Vector3d::Zero();
+  double bound_radius = 0;
+};
+
+// A mesh file as read: path, scale, size and modification time (a rewritten file is read again).
+using MeshKey = std::tuple<std::string, double, double, double, std::uintmax_t, std::int64_t>;
+
+// Hulls stay cached for the process's life; past this many (scenes of ever new meshes) the
+// cache starts over, the shapes made meanwhile keeping theirs.
+constexpr size_t kMaxCachedHulls = 256;
+
+std::mutex g_hulls_mutex;
+std::map<MeshKey, MeshHull> g_hulls;
+std::atomic<int> g_hulls_computed{0};
+
+MeshHull compute_hull(const Shape& shape) {
+  const std::vector<Eigen::Vector3d> vertices = load_mesh_vertices(shape);
+  auto hull = std::make_unique<btConvexHullShape>();
+  Eigen::Vector3d lo = vertices.front(), hi = vertices.front();
+  for (const Eigen::Vector3d& v : vertices) {
+    hull->addPoint(btVector3(v.x(), v.y(), v.z()), false);
+    lo = lo.cwiseMin(v);
+    hi = hi.cwiseMax(v);
+  }
+  hull->recalcLocalAabb();
+  hull->optimizeConvexHull();  // keep only hull vertices: support queries scan them all
+  // btConvexHullShape adds its margin outside the hull; 0 keeps the hull exact.
+  hull->setMargin(0);
+  MeshHull out;
+  out.bound_center = (lo + hi) / 2;
+  for (const Eigen::Vector3d& v : vertices) {
+    out.bound_radius = std::max(out.bound_radius, (v - out.bound_center).norm());
+  }
+  out.shape = std::move(hull);
+  ++g_hulls_computed;
+  return out;
+}
+
+// The hull of a mesh Shape, from the cache when its file has not changed since it was read.
+MeshHull mesh_hull(const Shape& shape) {
+  const std::string path = mesh_file(shape);
+  std::error_code size_error, time_error;
+  const std::uintmax_t size = std::filesystem::file_size(path, size_error);
+  const auto time = std::filesystem::last_write_time(path, time_error);
+  if (size_error || time_error) return compute_hull(shape);  // the reader says what is wrong
+  const MeshKey key{path,
+                    shape.mesh_scale.x(),
+                    shape.mesh_scale.y(),
+                    shape.mesh_scale.z(),
+                    size,
+                    static_cast<std::int64_t>(time.time_since_epoch().count())};
+  {
+    const std::lock_guard<std::mutex> lock(g_hulls_mutex);
+    const auto it = g_hulls.find(key);
+    if (it != g_hulls.end()) return it->second;
+  }
+  MeshHull hull = compute_hull(shape);  // unlocked: other meshes' hulls meanwhile
+  const std::lock_guard<std::mutex> lock(g_hulls_mutex);
+  if (g_hulls.size() >= kMaxCachedHulls) g_hulls.clear();
+  return g_hulls.emplace(key, std::move(hull)).first->second;  // the first one made, if two
+}
+
 }  // namespace
+
+int mesh_hulls_computed() { return g_hulls_computed.load(); }
 
 ConvexShape::ConvexShape(const Shape& shape) : shape_(shape) {
   const Eigen::Vector3d& sz = shape.size;
@@ -97,23 +173,10 @@ ConvexShape::ConvexShape(const Shape& shape) : shape_(shape) {
       break;
     }
     case ShapeKind::kMesh: {
-      const std::vector<Eigen::Vector3d> vertices = load_mesh_vertices(shape);
-      auto hull = std::make_unique<btConvexHullShape>();
-      Eigen::Vector3d lo = vertices.front(), hi = vertices.front();
-      for (const Eigen::Vector3d& v : vertices) {
-        hull->addPoint(btVector3(v.x(), v.y(), v.z()), false);
-        lo = lo.cwiseMin(v);
-        hi = hi.cwiseMax(v);
-      }
-      hull->recalcLocalAabb();
-      hull->optimizeConvexHull();  // keep only hull vertices: support queries scan them all
-      // btConvexHullShape adds its margin outside the hull; 0 keeps the hull exact.
-      hull->setMargin(0);
-      bullet_ = std::move(hull);
-      bound_center_ = (lo + hi) / 2;
-      for (const Eigen::Vector3d& v : vertices) {
-        bound_radius_ = std::max(bound_radius_, (v - bound_center_).norm());
-      }
+      MeshHull hull = mesh_hull(shape);
+      bullet_ = std::move(hull.shape);
+      bound_center_ = hull.bound_center;
+      bound_radius_ = hull.bound_radius;
       break;
     }
   }

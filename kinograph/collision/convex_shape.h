@@ -14,6 +14,8 @@ namespace kinograph::collision {
 // for cheap culling. Margins are chosen so the Bullet shape is exactly the described solid:
 // spheres and capsules carry their radius as margin; boxes, cylinders and mesh hulls have
 // margin 0 (a box's default 0.04 margin rounds its edges; a hull's margin would inflate it).
+// A mesh's hull is read and computed once per process for each file (path, size, modification
+// time) and scale, and shared, read-only, by every shape made from it since.
 class ConvexShape {
  public:
   // Builds the Bullet shape. Throws std::invalid_argument for non-positive sizes and for a
@@ -38,7 +40,7 @@ class ConvexShape {
 
  private:
   Shape shape_;
-  std::unique_ptr<btConvexShape> bullet_;
+  std::shared_ptr<const btConvexShape> bullet_;
   Eigen::Vector3d bound_center_ = Eigen::Vector3d::Zero();
   double bound_radius_ = 0;
 };
@@ -47,5 +49,9 @@ class ConvexShape {
 // compiled for double but linked against the float libraries (or the reverse) fails to link
 // instead of crashing at run time (docs/build.md).
 void bullet_precision_link_guard();
+
+// How many mesh hulls this process has read and computed (each file and scale once while the
+// file stays the same).
+int mesh_hulls_computed();
 
 }  // namespace kinograph::collision
