@@ -30,8 +30,9 @@ PlanStatus plan_status_from_string(const std::string& name);
 std::ostream& operator<<(std::ostream& os, PlanStatus status);
 
 /// Where the wall time of a plan's batch solves went, in seconds summed over every attempt. The
-/// rest of SolveStats::solve_time_s is bookkeeping, the set-up of effort continuation and, for
-/// an incremental update, all of its Bayes-tree work and checks. A part not run stays 0.
+/// rest of SolveStats::solve_time_s is the problem check (the first collision world of a mesh
+/// robot reads its hulls there), bookkeeping, the set-up of effort continuation and, for an
+/// incremental update, all of its Bayes-tree work and checks. A part not run stays 0.
 struct SolveTimes {
   /// Initial trajectories: the straight line or warm start, detours, the path search.
   double initialization_s = 0;
